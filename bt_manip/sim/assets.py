@@ -1,0 +1,57 @@
+"""Where robot and world assets live on this machine.
+
+Committed files never hold absolute paths. URDFs refer to meshes through URIs that are resolved
+here at load time:
+
+- ``package://example-robot-data/...``: the ``example-robot-data`` wheel, installed under
+  ``<site-packages>/cmeel.prefix/share/``.
+- ``pybullet_data://...``: the data folder that ships with ``pybullet``.
+- plain relative paths: relative to the file that names them.
+"""
+
+from __future__ import annotations
+
+import functools
+from importlib import metadata
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+"""The checkout (or source tree) that holds ``robots/``, ``worlds/`` and ``trees/``."""
+
+
+@functools.cache
+def example_robot_data_share() -> Path:
+    """The ``share`` folder that holds ``example-robot-data/robots/...``."""
+    dist = metadata.distribution("example-robot-data")
+    share = Path(str(dist.locate_file("cmeel.prefix/share")))
+    if not (share / "example-robot-data").is_dir():
+        raise FileNotFoundError(f"example-robot-data assets not found under {share}")
+    return share
+
+
+@functools.cache
+def pybullet_data_dir() -> Path:
+    """The data folder shipped with pybullet (``husky/``, ``plane.urdf``, ...)."""
+    import pybullet_data
+
+    return Path(pybullet_data.getDataPath())
+
+
+def ur3_urdf() -> Path:
+    """The UR3 description of example-robot-data (elbow limited to +-pi, ``world`` link)."""
+    return example_robot_data_share() / "example-robot-data/robots/ur_description/urdf/ur3_robot.urdf"
+
+
+def resolve_uri(uri: str, relative_to: Path | None = None) -> Path:
+    """Turn an asset URI into an absolute path on this machine (the file may not exist)."""
+    if uri.startswith("package://"):
+        rest = uri[len("package://"):]
+        return example_robot_data_share() / rest
+    if uri.startswith("pybullet_data://"):
+        return pybullet_data_dir() / uri[len("pybullet_data://"):]
+    if uri.startswith("file://"):
+        uri = uri[len("file://"):]
+    p = Path(uri)
+    if not p.is_absolute() and relative_to is not None:
+        p = relative_to / p
+    return p.resolve()
