@@ -1,0 +1,186 @@
+"""``bt-manip``: the command line. Argument parsing only; the work is done by the modules.
+
+Verbs:
+  run TREE.xml [--world W]   tick a tree (against a world's sim clock when one is given)
+  world W.yaml               load a world, print its summary, optionally let it settle
+  validate TREE.xml          check a tree without running it, listing every problem
+  show TREE.xml              print a tree as text (or Graphviz with --dot)
+  nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
+
+Exit codes: 0 success, 1 the tree failed or ran out of budget, 2 bad input, 130 interrupted.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions, Runner
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that reports bad arguments with exit code 2 and one line, no usage dump."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        self.exit(EXIT_BAD_INPUT, f"{self.prog}: {message} (see {self.prog} --help)\n")
+
+
+def _positive(kind: type) -> Any:
+    def convert(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+        if not value > 0 or (isinstance(value, float) and not math.isfinite(value)):
+            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+        return value
+
+    return convert
+
+
+def _bb_pair(text: str) -> tuple[str, str]:
+    key, sep, value = text.partition("=")
+    if not sep or not key.strip():
+        raise argparse.ArgumentTypeError(f"expected key=value, got '{text}'")
+    return key.strip(), value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="bt-manip", description="Behaviour-tree tasks for mobile manipulators "
+                     "in PyBullet (BehaviorTree.CPP v4 XML).")
+    from bt_manip import __version__
+
+    parser.add_argument("--version", action="version", version=f"bt-manip {__version__}")
+    sub = parser.add_subparsers(dest="verb", metavar="VERB", parser_class=_Parser)
+    sub.required = True
+
+    run = sub.add_parser("run", help="tick a tree until it succeeds, fails or runs out of budget")
+    run.add_argument("tree", help="BehaviorTree.CPP v4 XML file")
+    run.add_argument("--world", help="world file (YAML); without it only built-in nodes can run")
+    run.add_argument("--seed", type=int, default=0, help="seed for the world's randomisation")
+    run.add_argument("--tree-id", help="which BehaviorTree to run (default: main_tree_to_execute)")
+    run.add_argument("--models", action="append", default=[], metavar="MODELS.xml",
+                     help="TreeNodesModel files declaring extra nodes")
+    run.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE",
+                     help="set a root blackboard entry before the first tick")
+    run.add_argument("--bb-out", metavar="FILE.json", help="write the root blackboard at the end")
+    run.add_argument("--report", metavar="FILE.json", help="write the run report as JSON")
+    run.add_argument("--max-ticks", type=_positive(int), help="stop after this many ticks")
+    run.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S",
+                     help="stop after this much sim time (default 600 s)")
+    run.add_argument("--tick-hz", type=_positive(float), default=20.0,
+                     help="tree tick rate (default 20 Hz; physics runs at the world's rate)")
+    run.add_argument("--realtime", type=_positive(float), nargs="?", const=1.0, default=None,
+                     metavar="FACTOR", help="pace the run to FACTOR x real time (default 1)")
+    run.add_argument("--quiet", action="store_true", help="print only the summary")
+    run.set_defaults(func=cmd_run)
+
+    world = sub.add_parser("world", help="load a world and print its summary")
+    world.add_argument("world", help="world file (YAML)")
+    world.add_argument("--seed", type=int, default=0)
+    world.add_argument("--settle", type=float, default=0.0, metavar="S",
+                       help="step S seconds of sim with no commands and report what moved")
+    world.set_defaults(func=cmd_world)
+
+    try:
+        from bt_manip.bt.cli_verbs import add_verbs
+    except ImportError:
+        add_verbs = None
+    if add_verbs is not None:
+        add_verbs(sub)
+    return parser
+
+
+def _print_problems(problems: Sequence[Problem]) -> None:
+    for problem in problems:
+        print(problem, file=sys.stderr)
+
+
+def cmd_world(args: argparse.Namespace) -> int:
+    from bt_manip.sim.world import World
+
+    with World(args.world, seed=args.seed) as world:
+        print(world.summary())
+        if args.settle > 0:
+            before = world.snapshot()
+            world.step(round(args.settle * world.rate_hz))
+            after = world.snapshot()
+            worst = max((math.dist(before[k]["pos"], after[k]["pos"]), k)
+                        for k in before if k != "time") if len(before) > 1 else (0.0, "-")
+            print(f"  after {args.settle:g} s of sim with no commands, the largest drift is "
+                  f"{worst[0] * 1000:.3f} mm ({worst[1]})")
+    return 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    from bt_manip.bt import TreeContext, load_tree
+    from bt_manip.clock import MonotonicClock
+
+    world = None
+    if args.world:
+        from bt_manip.sim.world import World
+
+        world = World(args.world, seed=args.seed)
+    try:
+        context = TreeContext(clock=world.clock if world is not None else MonotonicClock(),
+                              world=world)
+        tree = load_tree(args.tree, tree_id=args.tree_id, models=args.models, context=context,
+                         blackboard=dict(args.bb))
+        if world is not None and not args.quiet:
+            print(world.summary())
+        on_tick = None if args.quiet else _live_view(tree)
+        options = RunOptions(tick_hz=args.tick_hz, max_sim_time=args.max_sim_time,
+                             max_ticks=args.max_ticks, realtime=args.realtime)
+        runner = Runner(tree, world, options, on_tick=on_tick)
+        report = runner.run()
+        if on_tick is not None and hasattr(on_tick, "close"):
+            on_tick.close()
+        report.tree = args.tree
+        report.world = args.world or ""
+        report.seed = args.seed if world is not None else None
+        print(report.summary())
+        if args.report:
+            report.write(args.report)
+        if args.bb_out:
+            Path(args.bb_out).parent.mkdir(parents=True, exist_ok=True)
+            Path(args.bb_out).write_text(
+                json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n")
+        return report.exit_code
+    finally:
+        if world is not None:
+            world.close()
+
+
+def _live_view(tree: Any) -> Any:
+    """A live tree view in a terminal, or status-change log lines otherwise."""
+    from bt_manip.viz.console import LiveTreeView, StatusLog
+
+    if sys.stdout.isatty():
+        return LiveTreeView(tree)
+    return StatusLog(tree)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``bt-manip`` console script; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args))
+    except InputError as exc:
+        _print_problems(exc.problems)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:
+        return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,226 @@
+"""The run loop: tick the tree, step the world, stop on a result or a budget, report.
+
+One :class:`Runner` owns a run. Each iteration ticks the tree once and then steps physics
+``rate_hz / tick_hz`` times (240 Hz / 20 Hz = 12 steps by default). Nothing waits on the wall
+clock unless pacing is asked for (``realtime``), so a headless run goes as fast as physics
+allows. Without a world the tree runs on the monotonic clock and the loop paces itself at the
+tick rate, as BehaviorTree.CPP's ``tickWhileRunning`` does.
+
+Exit codes (:data:`EXIT_CODES`): 0 root SUCCESS, 1 root FAILURE or budget spent, 2 bad input,
+130 interrupted (the tree is halted first).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any, Protocol
+
+import py_trees
+
+EXIT_SUCCESS = 0
+EXIT_FAILURE = 1
+EXIT_BAD_INPUT = 2
+EXIT_INTERRUPTED = 130
+EXIT_CODES = {"SUCCESS": EXIT_SUCCESS, "FAILURE": EXIT_FAILURE, "BUDGET": EXIT_FAILURE,
+              "INTERRUPTED": EXIT_INTERRUPTED}
+
+
+class TickableTree(Protocol):
+    """What the runner needs of a tree (``bt_manip.bt.Tree`` provides it)."""
+
+    root: py_trees.behaviour.Behaviour
+
+    def tick(self) -> py_trees.common.Status: ...
+
+    def halt(self) -> None: ...
+
+
+@dataclass
+class RunOptions:
+    """How to run: tick rate, budgets and pacing."""
+
+    tick_hz: float = 20.0
+    max_sim_time: float | None = 600.0
+    max_ticks: int | None = None
+    realtime: float | None = None
+    """Pace sim time to ``realtime`` x wall time (1.0 = real time); None runs flat out."""
+
+
+@dataclass
+class NodeRecord:
+    """A node's final state for the report."""
+
+    path: str
+    node: str
+    status: str
+    reason: str = ""
+
+
+@dataclass
+class RunReport:
+    """What happened in a run; written as JSON by ``--report``."""
+
+    status: str
+    reason: str
+    sim_time: float
+    wall_time: float
+    ticks: int
+    tree: str = ""
+    world: str = ""
+    seed: int | None = None
+    nodes: list[NodeRecord] = field(default_factory=list)
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def exit_code(self) -> int:
+        return EXIT_CODES[self.status]
+
+    @property
+    def real_time_factor(self) -> float:
+        return self.sim_time / self.wall_time if self.wall_time > 0 else math.inf
+
+    def to_json(self) -> dict[str, Any]:
+        data = asdict(self)
+        data["real_time_factor"] = (round(self.real_time_factor, 3)
+                                    if math.isfinite(self.real_time_factor) else None)
+        data["exit_code"] = self.exit_code
+        return data
+
+    def write(self, path: str | Path) -> None:
+        Path(path).parent.mkdir(parents=True, exist_ok=True)
+        Path(path).write_text(json.dumps(self.to_json(), indent=2) + "\n")
+
+    def summary(self) -> str:
+        rtf = self.real_time_factor
+        rtf_text = f"{rtf:.1f}x real time" if math.isfinite(rtf) else "instant"
+        lines = [f"result: {self.status}" + (f" ({self.reason})" if self.reason else ""),
+                 f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
+                 f"({rtf_text}), {self.ticks} ticks"]
+        failed = [n for n in self.nodes if n.status == "FAILURE" and n.reason]
+        for n in failed[:10]:
+            lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}")
+        return "\n".join(lines)
+
+
+def node_records(root: py_trees.behaviour.Behaviour) -> list[NodeRecord]:
+    """Every node under ``root`` with its status and feedback, paths joined by '/'."""
+    out: list[NodeRecord] = []
+
+    def walk(node: py_trees.behaviour.Behaviour, prefix: str) -> None:
+        path = f"{prefix}/{node.name}" if prefix else node.name
+        node_id = getattr(node, "node_id", type(node).__name__)
+        out.append(NodeRecord(path, node_id, node.status.name, node.feedback_message or ""))
+        for child in node.children:
+            walk(child, path)
+
+    walk(root, "")
+    return out
+
+
+class Runner:
+    """Ticks a tree against a world (or the monotonic clock) until it ends or a budget is spent.
+
+    Args:
+        tree: anything with ``root``, ``tick()`` and ``halt()``.
+        world: a :class:`bt_manip.sim.world.World`, or None for trees of built-ins only.
+        options: tick rate, budgets, pacing.
+        on_tick: called after every tick with the runner (live views, recorders).
+    """
+
+    def __init__(self, tree: TickableTree, world: Any = None, options: RunOptions | None = None,
+                 on_tick: Callable[[Runner], None] | None = None) -> None:
+        self.tree = tree
+        self.world = world
+        self.options = options or RunOptions()
+        self.on_tick = on_tick
+        self.ticks = 0
+        if world is not None:
+            ratio = world.rate_hz / self.options.tick_hz
+            self.steps_per_tick = max(1, round(ratio))
+        else:
+            self.steps_per_tick = 0
+        self._start_sim = self._now()
+
+    def _now(self) -> float:
+        if self.world is not None:
+            return self.world.time
+        return time.monotonic()
+
+    @property
+    def sim_time(self) -> float:
+        return self._now() - self._start_sim
+
+    def run(self) -> RunReport:
+        """Run to the end; Ctrl-C halts the tree and gives status INTERRUPTED."""
+        opts = self.options
+        wall0 = time.perf_counter()
+        self._start_sim = self._now()
+        status, reason = "BUDGET", ""
+        try:
+            while True:
+                result = self.tree.tick()
+                self.ticks += 1
+                if self.on_tick is not None:
+                    self.on_tick(self)
+                if result == py_trees.common.Status.SUCCESS:
+                    status = "SUCCESS"
+                    break
+                if result == py_trees.common.Status.FAILURE:
+                    status = "FAILURE"
+                    reason = self._failure_reason()
+                    break
+                if opts.max_ticks is not None and self.ticks >= opts.max_ticks:
+                    reason = f"tick budget of {opts.max_ticks} spent"
+                    break
+                if opts.max_sim_time is not None and self.sim_time >= opts.max_sim_time:
+                    reason = f"time budget of {opts.max_sim_time:g} s spent"
+                    break
+                self._advance(wall0)
+        except KeyboardInterrupt:
+            status, reason = "INTERRUPTED", "interrupted by the user"
+        if status in ("BUDGET", "INTERRUPTED"):
+            self.tree.halt()
+            self._make_safe()
+        wall = time.perf_counter() - wall0
+        return RunReport(status=status, reason=reason, sim_time=self.sim_time, wall_time=wall,
+                         ticks=self.ticks, nodes=self._records())
+
+    def _advance(self, wall0: float) -> None:
+        opts = self.options
+        if self.world is not None:
+            self.world.step(self.steps_per_tick)
+            if opts.realtime:
+                ahead = self.sim_time / opts.realtime - (time.perf_counter() - wall0)
+                if ahead > 0:
+                    time.sleep(ahead)
+        else:
+            time.sleep(1.0 / opts.tick_hz)
+
+    def _records(self) -> list[NodeRecord]:
+        records = getattr(self.tree, "node_records", None)
+        if callable(records):
+            return [NodeRecord(r.path, r.node, r.status, r.reason) for r in records()]
+        return node_records(self.tree.root)
+
+    def _failure_reason(self) -> str:
+        """The deepest failed node's reason: what the user needs to read first."""
+        failed = [r for r in self._records() if r.status == "FAILURE" and r.reason]
+        if not failed:
+            return ""
+        deepest = max(failed, key=lambda r: r.path.count("/"))
+        return f"{deepest.path}: {deepest.reason}"
+
+    def _make_safe(self) -> None:
+        """Leave every robot stopped and holding its arm after a halt."""
+        if self.world is None:
+            return
+        for robot in self.world.robots.values():
+            for method in ("stop_base", "hold_arm"):
+                fn = getattr(robot, method, None)
+                if callable(fn):
+                    fn()

@@ -1,0 +1,378 @@
+"""The World: a world file built into a PyBullet simulation with its own clock.
+
+``World(path, seed=...)`` reads a world file (:mod:`bt_manip.sim.world_spec`), connects a private
+PyBullet client in DIRECT mode, builds walls, furniture, movable objects and robots, and then
+only moves when :meth:`World.step` is called. The sim clock advances by one physics period per
+step, so everything timed against it is independent of the wall clock, and the same seed gives
+the same run bit for bit.
+
+Randomisation: each object or robot with a ``randomize`` range gets offsets drawn from a
+generator seeded by (world seed, entity name), so adding an entity does not change the others.
+"""
+
+from __future__ import annotations
+
+import math
+import zlib
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+from bt_manip.clock import ManualClock
+from bt_manip.errors import InputError, Problem
+from bt_manip.sim.world_spec import (
+    BodySpec,
+    Part,
+    Pose2D,
+    Pose3D,
+    Range2D,
+    WallSpec,
+    WorldSpec,
+    parse_world,
+)
+
+OVERLAP_TOLERANCE = 0.002
+"""Penetration (m) between two bodies at spawn beyond which they are reported as overlapping."""
+
+
+@dataclass
+class BodyInfo:
+    """What the World knows about a body it made."""
+
+    name: str
+    body_id: int
+    kind: str  # "ground" | "wall" | "furniture" | "object" | "robot"
+    spec: Any
+    line: int
+
+
+def _sample(rng: np.random.Generator, r: Range2D) -> tuple[float, float, float]:
+    return (float(rng.uniform(*r.x)), float(rng.uniform(*r.y)), float(rng.uniform(*r.yaw)))
+
+
+def entity_rng(seed: int, name: str) -> np.random.Generator:
+    """The random generator of one named entity for one world seed."""
+    return np.random.default_rng([int(seed) & 0xFFFFFFFF, zlib.crc32(name.encode())])
+
+
+def _half(part: Part) -> list[float]:
+    return [part.size[0] / 2, part.size[1] / 2, part.size[2] / 2]
+
+
+def _shape_args(part: Part) -> dict[str, Any]:
+    if part.shape == "box":
+        return {"shapeType": pb.GEOM_BOX, "halfExtents": _half(part)}
+    if part.shape == "cylinder":
+        return {"shapeType": pb.GEOM_CYLINDER, "radius": part.size[0], "height": part.size[2]}
+    return {"shapeType": pb.GEOM_SPHERE, "radius": part.size[0]}
+
+
+def _volume(part: Part) -> float:
+    if part.shape == "box":
+        return part.size[0] * part.size[1] * part.size[2]
+    if part.shape == "cylinder":
+        return math.pi * part.size[0] ** 2 * part.size[2]
+    return 4.0 / 3.0 * math.pi * part.size[0] ** 3
+
+
+class World:
+    """A loaded world: PyBullet client, named bodies, robots, named poses and the sim clock.
+
+    Args:
+        path: the world file (YAML).
+        seed: picks the randomised starts; the same seed gives the same run.
+        gui: open PyBullet's own window instead of DIRECT mode (needs a display).
+    """
+
+    def __init__(self, path: str | Path, seed: int = 0, *, gui: bool = False) -> None:
+        self.spec: WorldSpec = parse_world(path)
+        self.path = Path(path)
+        self.seed = int(seed)
+        self.rate_hz = self.spec.physics.rate_hz
+        self.dt = 1.0 / self.rate_hz
+        self.clock = ManualClock()
+        self.step_count = 0
+        self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
+        self.infos: dict[str, BodyInfo] = {}
+        self.robots: dict[str, Any] = {}
+        self.poses: dict[str, Pose2D] = dict(self.spec.poses)
+        self._step_listeners: list[Callable[[World], None]] = []
+        try:
+            self._setup_physics()
+            self._build()
+        except BaseException:
+            self.close()
+            raise
+
+    # -- construction ----------------------------------------------------------------------
+    def _setup_physics(self) -> None:
+        c = self.client
+        ph = self.spec.physics
+        pb.resetSimulation(physicsClientId=c)
+        pb.setTimeStep(self.dt, physicsClientId=c)
+        pb.setGravity(*ph.gravity, physicsClientId=c)
+        pb.setPhysicsEngineParameter(
+            numSolverIterations=ph.solver_iterations,
+            enableConeFriction=0,
+            deterministicOverlappingPairs=1,
+            physicsClientId=c,
+        )
+        plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
+        ground = pb.createMultiBody(0, plane, -1, [0, 0, 0], physicsClientId=c)
+        pb.changeDynamics(ground, -1, lateralFriction=ph.ground_friction, physicsClientId=c)
+        self.infos["ground"] = BodyInfo("ground", ground, "ground", None, 0)
+
+    def _build(self) -> None:
+        problems: list[Problem] = []
+        for wall in self.spec.walls:
+            self._add(wall.name, self._make_wall(wall), "wall", wall, wall.line)
+        for body in self.spec.furniture:
+            self._add(body.name, self._make_body(body, (0.0, 0.0, 0.0)), "furniture", body, body.line)
+        for body in self.spec.objects:
+            offset = _sample(entity_rng(self.seed, body.name), body.randomize)
+            self._add(body.name, self._make_body(body, offset), "object", body, body.line)
+        for rspec in self.spec.robots:
+            try:
+                robot = self._make_robot(rspec)
+            except InputError as exc:
+                problems += [Problem(str(self.path), rspec.line, f"robot '{rspec.name}': {p}")
+                             for p in exc.problems]
+                continue
+            self.robots[rspec.name] = robot
+            self._add(rspec.name, robot.body_id, "robot", rspec, rspec.line)
+        problems += self._overlaps()
+        if problems:
+            raise InputError(problems)
+
+    def _add(self, name: str, body_id: int, kind: str, spec: Any, line: int) -> None:
+        self.infos[name] = BodyInfo(name, body_id, kind, spec, line)
+
+    def _make_wall(self, wall: WallSpec) -> int:
+        """One static body per wall: a box for each solid stretch between doors."""
+        c = self.client
+        (x0, y0), (x1, y1) = wall.start, wall.end
+        length = wall.length
+        ux, uy = (x1 - x0) / length, (y1 - y0) / length
+        yaw = math.atan2(uy, ux)
+        stretches: list[tuple[float, float]] = []
+        pos = 0.0
+        for door in wall.doors:
+            lo = door.at - door.width / 2
+            if lo > pos + 1e-6:
+                stretches.append((pos, lo))
+            pos = door.at + door.width / 2
+        if length > pos + 1e-6:
+            stretches.append((pos, length))
+        quat = pb.getQuaternionFromEuler((0, 0, yaw))
+        halves = [[(b - a) / 2, wall.thickness / 2, wall.height / 2] for a, b in stretches]
+        # frames are relative to the wall's start point, along the wall's axis
+        frames = [[(a + b) / 2, 0.0, wall.height / 2] for a, b in stretches]
+        n = len(stretches)
+        col = pb.createCollisionShapeArray(
+            [pb.GEOM_BOX] * n, halfExtents=halves, collisionFramePositions=frames,
+            physicsClientId=c)
+        vis = pb.createVisualShapeArray(
+            [pb.GEOM_BOX] * n, halfExtents=halves, visualFramePositions=frames,
+            physicsClientId=c)
+        body = pb.createMultiBody(0, col, vis, [x0, y0, 0.0], quat, physicsClientId=c)
+        pb.changeVisualShape(body, -1, rgbaColor=wall.colour, physicsClientId=c)
+        return body
+
+    def _make_body(self, spec: BodySpec, offset: tuple[float, float, float]) -> int:
+        c = self.client
+        pos, quat = self._placed_pose(spec, offset)
+        if spec.urdf is not None:
+            body = pb.loadURDF(str(spec.urdf), pos, quat, useFixedBase=not spec.movable,
+                               globalScaling=spec.scale, physicsClientId=c)
+        else:
+            body = self._make_compound(spec, pos, quat)
+        if spec.movable:
+            for link in range(-1, pb.getNumJoints(body, physicsClientId=c)):
+                pb.changeDynamics(body, link, lateralFriction=spec.friction,
+                                  physicsClientId=c)
+        return body
+
+    def _placed_pose(self, spec: BodySpec, offset: tuple[float, float, float]
+                     ) -> tuple[list[float], list[float]]:
+        x, y, z = spec.pose.xyz
+        yaw0 = pb.getEulerFromQuaternion(spec.pose.quat)
+        quat = list(spec.pose.quat)
+        if offset[2] != 0.0:
+            quat = list(pb.getQuaternionFromEuler((yaw0[0], yaw0[1], yaw0[2] + offset[2])))
+        if spec.planar and spec.parts:
+            z = -min(p.bottom() for p in spec.parts) * spec.scale
+        return [x + offset[0], y + offset[1], z], quat
+
+    def _make_compound(self, spec: BodySpec, pos: list[float], quat: list[float]) -> int:
+        c = self.client
+        s = spec.scale
+        parts = [Part(p.shape, tuple(v * s for v in p.size), tuple(v * s for v in p.xyz),  # type: ignore[arg-type]
+                      p.rpy, p.colour) for p in spec.parts]
+        volumes = [_volume(p) for p in parts]
+        com = (np.average([p.xyz for p in parts], axis=0, weights=volumes)
+               if spec.movable else np.zeros(3))
+        if len(parts) == 1 and parts[0].rpy == (0.0, 0.0, 0.0) and parts[0].xyz == (0.0, 0.0, 0.0):
+            col = pb.createCollisionShape(**_shape_args(parts[0]), physicsClientId=c)
+            vis = pb.createVisualShape(**_shape_args(parts[0]), rgbaColor=parts[0].colour or spec.colour,
+                                       physicsClientId=c)
+        else:
+            types = [_shape_args(p)["shapeType"] for p in parts]
+            radii = [p.size[0] for p in parts]
+            halves = [_half(p) for p in parts]
+            lengths = [p.size[2] for p in parts]
+            frames = [list(np.subtract(p.xyz, com)) for p in parts]
+            orns = [list(pb.getQuaternionFromEuler(p.rpy)) for p in parts]
+            col = pb.createCollisionShapeArray(
+                types, radii=radii, halfExtents=halves, lengths=lengths,
+                collisionFramePositions=frames, collisionFrameOrientations=orns,
+                physicsClientId=c)
+            vis = pb.createVisualShapeArray(
+                types, radii=radii, halfExtents=halves, lengths=lengths,
+                visualFramePositions=frames, visualFrameOrientations=orns, physicsClientId=c)
+        # the body frame sits at the centre of mass; shift the spawn point to match
+        rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        base = np.asarray(pos) + rot @ com
+        body = pb.createMultiBody(spec.mass, col, vis, list(base), quat, physicsClientId=c)
+        pb.changeVisualShape(body, -1, rgbaColor=spec.colour, physicsClientId=c)
+        return body
+
+    def _make_robot(self, rspec: Any) -> Any:
+        from bt_manip.sim.robot import Robot, RobotDescription
+
+        desc = RobotDescription.load(rspec.description_path)
+        dx, dy, dyaw = _sample(entity_rng(self.seed, rspec.name), rspec.randomize)
+        pose = rspec.pose
+        robot = Robot.spawn(self.client, desc, pose.x + dx, pose.y + dy, pose.yaw + dyaw)
+        if rspec.arm_state is not None:
+            states = getattr(desc, "states", {}) or {}
+            if rspec.arm_state not in states:
+                raise InputError.single(str(self.path), rspec.line,
+                                        f"unknown arm_state '{rspec.arm_state}'; "
+                                        f"known: {', '.join(states) or 'none'}")
+            robot.reset_arm(states[rspec.arm_state])
+        return robot
+
+    def _overlaps(self) -> list[Problem]:
+        """Movable objects and robots must not start inside anything else."""
+        problems = []
+        c = self.client
+        movers = [i for i in self.infos.values() if i.kind in ("object", "robot")]
+        others = [i for i in self.infos.values() if i.kind != "ground"]
+        reported: set[frozenset[str]] = set()
+        for a in movers:
+            for b in others:
+                pair = frozenset((a.name, b.name))
+                if a.name == b.name or pair in reported:
+                    continue
+                pts = pb.getClosestPoints(a.body_id, b.body_id, 0.0, physicsClientId=c)
+                depth = min((p[8] for p in pts), default=0.0)
+                if depth < -OVERLAP_TOLERANCE:
+                    reported.add(pair)
+                    line = max(a.line, b.line)
+                    problems.append(Problem(
+                        str(self.path), line,
+                        f"'{a.name}' and '{b.name}' overlap by {-depth * 1000:.0f} mm at spawn; "
+                        "move one of them apart"))
+        return problems
+
+    # -- running ------------------------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance physics by ``n`` periods of ``dt`` and the sim clock with it."""
+        for _ in range(n):
+            pb.stepSimulation(physicsClientId=self.client)
+            self.step_count += 1
+            self.clock.t = self.step_count * self.dt
+        for listener in self._step_listeners:
+            listener(self)
+
+    def add_step_listener(self, fn: Callable[[World], None]) -> None:
+        """Call ``fn(world)`` after every :meth:`step` call (viewers, recorders)."""
+        self._step_listeners.append(fn)
+
+    @property
+    def time(self) -> float:
+        """Sim time in seconds since the world was built."""
+        return self.clock.now()
+
+    # -- queries ------------------------------------------------------------------------------
+    def body_id(self, name: str) -> int:
+        """The PyBullet id of a named body; KeyError naming the known ones otherwise."""
+        if name not in self.infos:
+            raise KeyError(f"no body named '{name}' in {self.path.name}; known: "
+                           f"{', '.join(sorted(self.infos))}")
+        return self.infos[name].body_id
+
+    def name_of(self, body_id: int) -> str | None:
+        for info in self.infos.values():
+            if info.body_id == body_id:
+                return info.name
+        return None
+
+    def obstacle_body_ids(self) -> list[int]:
+        """Static structure and furniture: what navigation must keep clear of."""
+        return [i.body_id for i in self.infos.values() if i.kind in ("wall", "furniture")]
+
+    @property
+    def movable(self) -> dict[str, int]:
+        """Movable objects by name."""
+        return {i.name: i.body_id for i in self.infos.values() if i.kind == "object"}
+
+    def body_pose(self, name: str) -> Pose3D:
+        """World pose of a body's base (centre of mass frame, as PyBullet reports it)."""
+        pos, quat = pb.getBasePositionAndOrientation(self.body_id(name), physicsClientId=self.client)
+        return Pose3D(tuple(pos), tuple(quat))  # type: ignore[arg-type]
+
+    def snapshot(self) -> dict[str, Any]:
+        """Every body's base pose and velocity and every joint state, exactly as floats."""
+        c = self.client
+        out: dict[str, Any] = {"time": self.time}
+        for info in self.infos.values():
+            if info.kind in ("ground", "wall", "furniture"):
+                continue
+            b = info.body_id
+            pos, quat = pb.getBasePositionAndOrientation(b, physicsClientId=c)
+            lin, ang = pb.getBaseVelocity(b, physicsClientId=c)
+            joints = [pb.getJointState(b, j, physicsClientId=c)[:2]
+                      for j in range(pb.getNumJoints(b, physicsClientId=c))]
+            out[info.name] = {"pos": pos, "quat": quat, "lin": lin, "ang": ang, "joints": joints}
+        return out
+
+    def summary(self) -> str:
+        """A few lines describing the world for the console."""
+        kinds: dict[str, int] = {}
+        for info in self.infos.values():
+            kinds[info.kind] = kinds.get(info.kind, 0) + 1
+        lines = [f"world '{self.spec.name}' ({self.path}), seed {self.seed}, "
+                 f"{self.rate_hz:g} Hz physics",
+                 f"  {kinds.get('wall', 0)} walls, {kinds.get('furniture', 0)} furniture, "
+                 f"{kinds.get('object', 0)} movable objects, {len(self.robots)} robots"]
+        for name, robot in self.robots.items():
+            x, y, yaw = robot.base_pose2d()
+            lines.append(f"  robot {name} ({robot.description.name}) at "
+                         f"x={x:.3f} y={y:.3f} yaw={math.degrees(yaw):.1f} deg")
+        if self.poses:
+            lines.append("  named poses: " + ", ".join(sorted(self.poses)))
+        return "\n".join(lines)
+
+    # -- teardown --------------------------------------------------------------------------------
+    def close(self) -> None:
+        """Disconnect the PyBullet client (idempotent)."""
+        if getattr(self, "client", None) is not None and self.client >= 0:
+            try:
+                pb.disconnect(physicsClientId=self.client)
+            except pb.error:
+                pass
+            self.client = -1
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        self.close()

@@ -1,0 +1,630 @@
+"""The world file format: YAML read into checked dataclasses.
+
+A world file describes, in metres, radians and kilograms (see ``worlds/README.md``):
+
+``walls``      static wall segments (``from``/``to``, ``thickness``, ``height``) with ``doors`` cut
+               into them (``at`` = distance of the door centre from ``from``, ``width``);
+``furniture``  static bodies: a primitive ``shape``, a list of ``parts``, or a ``urdf`` file;
+``objects``    movable bodies, the same forms plus ``mass``, ``friction`` and ``randomize``;
+``robots``     a robot ``description`` (``robots/<name>.yaml``), a start ``pose``, an
+               ``arm_state`` and ``randomize``;
+``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees.
+
+Every problem found is collected with its file and line; :func:`parse_world` raises one
+:class:`~bt_manip.errors.InputError` with all of them.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.sim.yaml_lines import LineDict, LineList, load_yaml
+
+COLOURS: dict[str, tuple[float, float, float, float]] = {
+    "white": (0.95, 0.95, 0.95, 1.0),
+    "grey": (0.6, 0.6, 0.6, 1.0),
+    "dark_grey": (0.3, 0.3, 0.3, 1.0),
+    "black": (0.1, 0.1, 0.1, 1.0),
+    "red": (0.85, 0.15, 0.15, 1.0),
+    "green": (0.2, 0.7, 0.25, 1.0),
+    "blue": (0.2, 0.35, 0.85, 1.0),
+    "yellow": (0.95, 0.8, 0.1, 1.0),
+    "orange": (0.95, 0.55, 0.1, 1.0),
+    "brown": (0.55, 0.35, 0.2, 1.0),
+    "wood": (0.7, 0.52, 0.33, 1.0),
+    "beige": (0.87, 0.8, 0.66, 1.0),
+    "purple": (0.5, 0.25, 0.65, 1.0),
+    "cyan": (0.2, 0.75, 0.8, 1.0),
+}
+
+
+class Pose2D(NamedTuple):
+    """A planar pose: position in metres, heading in radians."""
+
+    x: float
+    y: float
+    yaw: float
+
+
+@dataclass(frozen=True)
+class Pose3D:
+    """A full pose: position and quaternion (x, y, z, w)."""
+
+    xyz: tuple[float, float, float]
+    quat: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Range2D:
+    """Uniform offsets sampled per seed: each is (low, high)."""
+
+    x: tuple[float, float] = (0.0, 0.0)
+    y: tuple[float, float] = (0.0, 0.0)
+    yaw: tuple[float, float] = (0.0, 0.0)
+
+    def is_zero(self) -> bool:
+        return self.x == (0.0, 0.0) and self.y == (0.0, 0.0) and self.yaw == (0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class Part:
+    """One primitive: ``box`` (size = full extents), ``cylinder`` (radius, height) or ``sphere``."""
+
+    shape: str
+    size: tuple[float, float, float]
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    colour: tuple[float, float, float, float] | None = None
+
+    def bottom(self) -> float:
+        """Lowest z of the part in its body frame (rotation about z only is exact)."""
+        half = self.size[2] / 2.0 if self.shape != "sphere" else self.size[0]
+        return self.xyz[2] - half
+
+
+@dataclass
+class DoorSpec:
+    at: float
+    width: float
+    line: int
+
+
+@dataclass
+class WallSpec:
+    name: str
+    start: tuple[float, float]
+    end: tuple[float, float]
+    thickness: float
+    height: float
+    colour: tuple[float, float, float, float]
+    doors: list[DoorSpec]
+    line: int
+
+    @property
+    def length(self) -> float:
+        return math.dist(self.start, self.end)
+
+
+@dataclass
+class BodySpec:
+    """A static piece of furniture or a movable object."""
+
+    name: str
+    movable: bool
+    parts: list[Part]
+    urdf: Path | None
+    pose: Pose3D
+    planar: bool
+    mass: float
+    friction: float
+    colour: tuple[float, float, float, float]
+    randomize: Range2D
+    line: int
+    scale: float = 1.0
+
+
+@dataclass
+class RobotSpec:
+    name: str
+    description: str
+    description_path: Path
+    pose: Pose2D
+    arm_state: str | None
+    randomize: Range2D
+    line: int
+
+
+@dataclass
+class PhysicsSpec:
+    rate_hz: float = 240.0
+    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
+    solver_iterations: int = 50
+    ground_friction: float = 1.0
+
+
+@dataclass
+class WorldSpec:
+    """A parsed, checked world file."""
+
+    path: Path
+    name: str
+    physics: PhysicsSpec
+    walls: list[WallSpec] = field(default_factory=list)
+    furniture: list[BodySpec] = field(default_factory=list)
+    objects: list[BodySpec] = field(default_factory=list)
+    robots: list[RobotSpec] = field(default_factory=list)
+    poses: dict[str, Pose2D] = field(default_factory=dict)
+    pose_lines: dict[str, int] = field(default_factory=dict)
+
+
+TOP_KEYS = {"name", "description", "physics", "walls", "furniture", "objects", "robots", "poses"}
+PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "ground_friction"}
+WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
+DOOR_KEYS = {"at", "width"}
+SHAPE_KEYS = {"shape", "size", "radius", "height"}
+PART_KEYS = SHAPE_KEYS | {"xyz", "rpy", "colour", "color"}
+BODY_KEYS = SHAPE_KEYS | {"name", "parts", "urdf", "scale", "pose", "colour", "color"}
+OBJECT_KEYS = BODY_KEYS | {"mass", "friction", "randomize"}
+ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize"}
+RANDOM_KEYS = {"x", "y", "yaw"}
+
+
+class _Reader:
+    """Walks the YAML tree, converting values and collecting problems."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.problems: list[Problem] = []
+
+    def fail(self, line: int | None, message: str) -> None:
+        self.problems.append(Problem(str(self.path), line, message))
+
+    # -- generic checks ---------------------------------------------------------------
+    def keys(self, d: LineDict, allowed: set[str], where: str) -> None:
+        import difflib
+
+        for key in d:
+            if key not in allowed:
+                close = difflib.get_close_matches(key, sorted(allowed), n=1)
+                hint = f"; did you mean '{close[0]}'?" if close else (
+                    f"; allowed: {', '.join(sorted(allowed))}")
+                self.fail(d.line_of(key), f"unknown key '{key}' in {where}{hint}")
+
+    def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
+        if isinstance(value, LineDict):
+            return value
+        self.fail(line, f"{where} must be a mapping, got {type(value).__name__}")
+        return None
+
+    def seq(self, value: Any, line: int, where: str) -> LineList | None:
+        if value is None:
+            return LineList()
+        if isinstance(value, LineList):
+            return value
+        self.fail(line, f"{where} must be a list, got {type(value).__name__}")
+        return None
+
+    def number(self, d: LineDict, key: str, where: str, default: float | None = None,
+               positive: bool = False, non_negative: bool = False) -> float | None:
+        if key not in d:
+            if default is None:
+                self.fail(d.line, f"{where} is missing '{key}'")
+            return default
+        value = d[key]
+        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
+            return default
+        if positive and value <= 0:
+            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
+            return default
+        if non_negative and value < 0:
+            self.fail(d.line_of(key), f"{where}.{key} must be >= 0, got {value}")
+            return default
+        return float(value)
+
+    def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
+        ok = isinstance(value, list) and len(value) == n and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value)
+        if not ok:
+            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
+            return None
+        return tuple(float(v) for v in value)
+
+    def colour(self, d: LineDict, where: str,
+               default: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+        key = "colour" if "colour" in d else "color" if "color" in d else None
+        if key is None:
+            return default
+        value = d[key]
+        line = d.line_of(key)
+        if isinstance(value, str):
+            if value in COLOURS:
+                return COLOURS[value]
+            self.fail(line, f"{where}.{key}: unknown colour '{value}'; known: "
+                      f"{', '.join(sorted(COLOURS))}, or [r, g, b, a] in 0..1")
+            return default
+        if isinstance(value, list) and len(value) in (3, 4):
+            vec = self.vector(value, len(value), line, f"{where}.{key}")
+            if vec is None:
+                return default
+            if any(not 0.0 <= c <= 1.0 for c in vec):
+                self.fail(line, f"{where}.{key}: components must lie in 0..1")
+                return default
+            return (vec[0], vec[1], vec[2], vec[3] if len(vec) == 4 else 1.0)
+        self.fail(line, f"{where}.{key} must be a colour name or [r, g, b, a]")
+        return default
+
+    def name(self, d: LineDict, where: str, fallback: str | None = None) -> str:
+        value = d.get("name", fallback)
+        if not isinstance(value, str) or not value.strip():
+            self.fail(d.line_of("name"), f"{where} needs a non-empty 'name'")
+            return fallback or "?"
+        return value
+
+    # -- poses --------------------------------------------------------------------------
+    def pose2d(self, value: Any, line: int, where: str) -> Pose2D | None:
+        if isinstance(value, list):
+            vec = self.vector(value, 3, line, f"{where} ([x, y, yaw])")
+            return Pose2D(*vec) if vec else None
+        if isinstance(value, LineDict):
+            allowed = {"x", "y", "yaw", "qz", "qw"}
+            self.keys(value, allowed, where)
+            x = self.number(value, "x", where)
+            y = self.number(value, "y", where)
+            if "yaw" in value and ("qz" in value or "qw" in value):
+                self.fail(value.line, f"{where}: give either 'yaw' or 'qz'/'qw', not both")
+                return None
+            if "qz" in value or "qw" in value:
+                qz = self.number(value, "qz", where)
+                qw = self.number(value, "qw", where)
+                if qz is None or qw is None:
+                    return None
+                if math.hypot(qz, qw) < 1e-9:
+                    self.fail(value.line, f"{where}: qz and qw cannot both be zero")
+                    return None
+                yaw = 2.0 * math.atan2(qz, qw)
+            else:
+                yaw = self.number(value, "yaw", where, default=0.0)
+            if x is None or y is None or yaw is None:
+                return None
+            return Pose2D(x, y, yaw)
+        self.fail(line, f"{where} must be [x, y, yaw] or {{x, y, yaw}} / {{x, y, qz, qw}}")
+        return None
+
+    def body_pose(self, value: Any, line: int, where: str) -> tuple[Pose3D, bool] | None:
+        """``[x, y, yaw]`` (rests on the floor) or ``{xyz: [...], rpy|quat: [...]}``."""
+        import pybullet as pb
+
+        if isinstance(value, list) or (isinstance(value, LineDict) and "xyz" not in value):
+            p2 = self.pose2d(value, line, where)
+            if p2 is None:
+                return None
+            return Pose3D((p2.x, p2.y, 0.0), tuple(pb.getQuaternionFromEuler((0, 0, p2.yaw)))), True
+        if isinstance(value, LineDict):
+            self.keys(value, {"xyz", "rpy", "quat"}, where)
+            xyz = self.vector(value["xyz"], 3, value.line_of("xyz"), f"{where}.xyz")
+            if "rpy" in value and "quat" in value:
+                self.fail(value.line, f"{where}: give either 'rpy' or 'quat', not both")
+                return None
+            quat: tuple[float, ...] | None = (0.0, 0.0, 0.0, 1.0)
+            if "rpy" in value:
+                rpy = self.vector(value["rpy"], 3, value.line_of("rpy"), f"{where}.rpy")
+                quat = tuple(pb.getQuaternionFromEuler(rpy)) if rpy else None
+            elif "quat" in value:
+                quat = self.vector(value["quat"], 4, value.line_of("quat"), f"{where}.quat")
+                if quat is not None:
+                    norm = math.sqrt(sum(c * c for c in quat))
+                    if norm < 1e-9:
+                        self.fail(value.line_of("quat"), f"{where}.quat has zero length")
+                        return None
+                    quat = tuple(c / norm for c in quat)
+            if xyz is None or quat is None:
+                return None
+            return Pose3D(xyz, quat), False  # type: ignore[arg-type]
+        self.fail(line, f"{where} must be [x, y, yaw] or {{xyz: [x, y, z], rpy: [r, p, y]}}")
+        return None
+
+    def randomize(self, d: LineDict, where: str) -> Range2D:
+        if "randomize" not in d:
+            return Range2D()
+        r = self.mapping(d["randomize"], d.line_of("randomize"), f"{where}.randomize")
+        if r is None:
+            return Range2D()
+        self.keys(r, RANDOM_KEYS, f"{where}.randomize")
+        out: dict[str, tuple[float, float]] = {}
+        for key in RANDOM_KEYS & set(r):
+            vec = self.vector(r[key], 2, r.line_of(key), f"{where}.randomize.{key} ([low, high])")
+            if vec is not None:
+                if vec[0] > vec[1]:
+                    self.fail(r.line_of(key), f"{where}.randomize.{key}: low {vec[0]} > high {vec[1]}")
+                else:
+                    out[key] = (vec[0], vec[1])
+        return Range2D(**out)
+
+    # -- shapes ---------------------------------------------------------------------------
+    def shape(self, d: LineDict, where: str, colour: tuple[float, float, float, float],
+              with_offset: bool) -> Part | None:
+        kind = d.get("shape")
+        if kind not in ("box", "cylinder", "sphere"):
+            self.fail(d.line_of("shape"), f"{where}.shape must be box, cylinder or sphere, got {kind!r}")
+            return None
+        if kind == "box":
+            size = self.vector(d.get("size"), 3, d.line_of("size"), f"{where}.size ([x, y, z] extents)")
+            if size is None:
+                return None
+            if any(s <= 0 for s in size):
+                self.fail(d.line_of("size"), f"{where}.size must be positive, got {list(size)}")
+                return None
+        elif kind == "cylinder":
+            r = self.number(d, "radius", where, positive=True)
+            h = self.number(d, "height", where, positive=True)
+            if r is None or h is None:
+                return None
+            size = (r, r, h)
+        else:
+            r = self.number(d, "radius", where, positive=True)
+            if r is None:
+                return None
+            size = (r, r, 2 * r)
+        xyz: tuple[float, ...] | None = (0.0, 0.0, 0.0)
+        rpy: tuple[float, ...] | None = (0.0, 0.0, 0.0)
+        if with_offset:
+            if "xyz" in d:
+                xyz = self.vector(d["xyz"], 3, d.line_of("xyz"), f"{where}.xyz")
+            if "rpy" in d:
+                rpy = self.vector(d["rpy"], 3, d.line_of("rpy"), f"{where}.rpy")
+        if xyz is None or rpy is None:
+            return None
+        return Part(kind, size, xyz, rpy, colour)  # type: ignore[arg-type]
+
+
+def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
+    out: list[WallSpec] = []
+    for i, raw in enumerate(walls):
+        where = f"walls[{i}]"
+        d = rd.mapping(raw, walls.line_of(i), where)
+        if d is None:
+            continue
+        rd.keys(d, WALL_KEYS, where)
+        start = rd.vector(d.get("from"), 2, d.line_of("from"), f"{where}.from ([x, y])")
+        end = rd.vector(d.get("to"), 2, d.line_of("to"), f"{where}.to ([x, y])")
+        thickness = rd.number(d, "thickness", where, default=0.12, positive=True)
+        height = rd.number(d, "height", where, default=1.0, positive=True)
+        colour = rd.colour(d, where, COLOURS["beige"])
+        name = rd.name(d, where, fallback=f"wall_{i}")
+        if start is None or end is None or thickness is None or height is None:
+            continue
+        length = math.dist(start, end)
+        if length < 1e-6:
+            rd.fail(d.line, f"{where}: 'from' and 'to' are the same point")
+            continue
+        doors: list[DoorSpec] = []
+        door_list = rd.seq(d.get("doors"), d.line_of("doors"), f"{where}.doors")
+        for j, rawd in enumerate(door_list or []):
+            dw = f"{where}.doors[{j}]"
+            dd = rd.mapping(rawd, door_list.line_of(j), dw)  # type: ignore[union-attr]
+            if dd is None:
+                continue
+            rd.keys(dd, DOOR_KEYS, dw)
+            at = rd.number(dd, "at", dw)
+            width = rd.number(dd, "width", dw, positive=True)
+            if at is None or width is None:
+                continue
+            if at - width / 2 < 0 or at + width / 2 > length:
+                rd.fail(dd.line, f"{dw}: door from {at - width / 2:.3f} to {at + width / 2:.3f} m "
+                        f"does not fit in the wall of length {length:.3f} m")
+                continue
+            doors.append(DoorSpec(at, width, dd.line))
+        doors.sort(key=lambda door: door.at)
+        for a, b in zip(doors, doors[1:], strict=False):
+            if a.at + a.width / 2 > b.at - b.width / 2:
+                rd.fail(b.line, f"{where}: doors at {a.at} m and {b.at} m overlap")
+        out.append(WallSpec(name, start, end, thickness, height, colour, doors, d.line))  # type: ignore[arg-type]
+    return out
+
+
+def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path) -> BodySpec | None:
+    rd.keys(d, OBJECT_KEYS if movable else BODY_KEYS, where)
+    name = rd.name(d, where)
+    colour = rd.colour(d, where, COLOURS["wood"] if not movable else COLOURS["orange"])
+    forms = [k for k in ("shape", "parts", "urdf") if k in d]
+    if len(forms) != 1:
+        rd.fail(d.line, f"{where} ('{name}') needs exactly one of 'shape', 'parts' or 'urdf', "
+                f"got {forms or 'none'}")
+        return None
+    parts: list[Part] = []
+    urdf: Path | None = None
+    if "shape" in d:
+        part = rd.shape(d, where, colour, with_offset=False)
+        if part is None:
+            return None
+        parts = [part]
+    elif "parts" in d:
+        plist = rd.seq(d["parts"], d.line_of("parts"), f"{where}.parts")
+        if not plist:
+            rd.fail(d.line_of("parts"), f"{where}.parts must list at least one part")
+            return None
+        for j, rawp in enumerate(plist):
+            pw = f"{where}.parts[{j}]"
+            pd = rd.mapping(rawp, plist.line_of(j), pw)
+            if pd is None:
+                continue
+            rd.keys(pd, PART_KEYS, pw)
+            part = rd.shape(pd, pw, rd.colour(pd, pw, colour), with_offset=True)
+            if part is not None:
+                parts.append(part)
+        if len(parts) != len(plist):
+            return None
+    else:
+        raw = d["urdf"]
+        if not isinstance(raw, str):
+            rd.fail(d.line_of("urdf"), f"{where}.urdf must be a path")
+            return None
+        from bt_manip.sim.assets import resolve_uri
+
+        urdf = resolve_uri(raw, base)
+        if not urdf.is_file():
+            rd.fail(d.line_of("urdf"), f"{where}.urdf: file not found: {raw} (looked at {urdf})")
+            return None
+        for problem in _check_urdf_meshes(urdf):
+            rd.fail(d.line_of("urdf"), f"{where}.urdf: {problem}")
+    scale = rd.number(d, "scale", where, default=1.0, positive=True) or 1.0
+    mass = 0.0
+    friction = 0.8
+    if movable:
+        m = rd.number(d, "mass", where, positive=True)
+        if m is None:
+            return None
+        mass = m
+        friction = rd.number(d, "friction", where, default=0.8, non_negative=True) or 0.0
+    if "pose" not in d:
+        rd.fail(d.line, f"{where} ('{name}') is missing 'pose'")
+        return None
+    got = rd.body_pose(d["pose"], d.line_of("pose"), f"{where}.pose")
+    if got is None:
+        return None
+    pose, planar = got
+    randomize = rd.randomize(d, where) if movable else Range2D()
+    return BodySpec(name, movable, parts, urdf, pose, planar, mass, friction, colour,
+                    randomize, d.line, scale)
+
+
+def _check_urdf_meshes(urdf: Path) -> list[str]:
+    """Every mesh a URDF names must exist (relative to the file, or a known package URI)."""
+    import defusedxml.ElementTree as SafeET
+
+    from bt_manip.sim.assets import resolve_uri
+
+    try:
+        tree = SafeET.parse(urdf)
+    except Exception as exc:  # noqa: BLE001 - any parse failure is reported the same way
+        return [f"cannot parse {urdf.name}: {exc}"]
+    missing = []
+    for mesh in tree.getroot().iter("mesh"):
+        fn = mesh.get("filename", "")
+        if not resolve_uri(fn, urdf.parent).is_file():
+            missing.append(f"mesh not found: {fn} (named in {urdf.name})")
+    return missing
+
+
+def _find_robot(name: str, world_dir: Path) -> Path | None:
+    from bt_manip.sim.assets import REPO_ROOT
+
+    as_path = (world_dir / name) if not Path(name).is_absolute() else Path(name)
+    if name.endswith((".yaml", ".yml")) and as_path.is_file():
+        return as_path.resolve()
+    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
+        candidate = folder / f"{name}.yaml"
+        if candidate.is_file():
+            return candidate.resolve()
+    return None
+
+
+def _known_robots(world_dir: Path) -> list[str]:
+    from bt_manip.sim.assets import REPO_ROOT
+
+    names: set[str] = set()
+    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
+        if folder.is_dir():
+            names.update(p.stem for p in folder.glob("*.yaml"))
+    return sorted(names)
+
+
+def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
+    out: list[RobotSpec] = []
+    for i, raw in enumerate(robots):
+        where = f"robots[{i}]"
+        d = rd.mapping(raw, robots.line_of(i), where)
+        if d is None:
+            continue
+        rd.keys(d, ROBOT_KEYS, where)
+        name = rd.name(d, where)
+        desc = d.get("description")
+        if not isinstance(desc, str):
+            rd.fail(d.line_of("description"), f"{where} ('{name}') needs 'description': a robot "
+                    f"name such as {', '.join(_known_robots(base)) or 'husky_ur3'}")
+            continue
+        desc_path = _find_robot(desc, base)
+        if desc_path is None:
+            import difflib
+
+            known = _known_robots(base)
+            close = difflib.get_close_matches(desc, known, n=1)
+            hint = f"did you mean '{close[0]}'?" if close else f"known: {', '.join(known) or 'none'}"
+            rd.fail(d.line_of("description"), f"{where}: unknown robot '{desc}'; {hint}")
+            continue
+        pose = rd.pose2d(d.get("pose", [0, 0, 0]), d.line_of("pose"), f"{where}.pose")
+        arm_state = d.get("arm_state")
+        if arm_state is not None and not isinstance(arm_state, str):
+            rd.fail(d.line_of("arm_state"), f"{where}.arm_state must be a state name")
+            arm_state = None
+        if pose is None:
+            continue
+        out.append(RobotSpec(name, desc, desc_path, pose, arm_state, rd.randomize(d, where), d.line))
+    return out
+
+
+def parse_world(path: str | Path) -> WorldSpec:
+    """Read and check a world file; raise InputError listing every problem found."""
+    path = Path(path)
+    data = load_yaml(path)
+    rd = _Reader(path)
+    if not isinstance(data, LineDict):
+        raise InputError.single(str(path), 1, "a world file must be a YAML mapping "
+                                "(name, walls, furniture, objects, robots, poses)")
+    rd.keys(data, TOP_KEYS, "the world")
+    base = path.resolve().parent
+    physics = PhysicsSpec()
+    if "physics" in data:
+        ph = rd.mapping(data["physics"], data.line_of("physics"), "physics")
+        if ph is not None:
+            rd.keys(ph, PHYSICS_KEYS, "physics")
+            physics.rate_hz = rd.number(ph, "rate_hz", "physics", 240.0, positive=True) or 240.0
+            if "gravity" in ph:
+                g = rd.vector(ph["gravity"], 3, ph.line_of("gravity"), "physics.gravity")
+                physics.gravity = g or physics.gravity  # type: ignore[assignment]
+            physics.solver_iterations = int(
+                rd.number(ph, "solver_iterations", "physics", 50, positive=True) or 50)
+            physics.ground_friction = rd.number(ph, "ground_friction", "physics", 1.0,
+                                                non_negative=True) or 0.0
+    spec = WorldSpec(path=path, name=str(data.get("name", path.stem)), physics=physics)
+    walls = rd.seq(data.get("walls"), data.line_of("walls"), "walls")
+    spec.walls = _parse_walls(rd, walls) if walls else []
+    for key, movable in (("furniture", False), ("objects", True)):
+        items = rd.seq(data.get(key), data.line_of(key), key)
+        for i, raw in enumerate(items or []):
+            d = rd.mapping(raw, items.line_of(i), f"{key}[{i}]")  # type: ignore[union-attr]
+            if d is not None:
+                body = _parse_body(rd, d, f"{key}[{i}]", movable, base)
+                if body is not None:
+                    (spec.objects if movable else spec.furniture).append(body)
+    robots = rd.seq(data.get("robots"), data.line_of("robots"), "robots")
+    spec.robots = _parse_robots(rd, robots, base) if robots else []
+    if "poses" in data:
+        poses = rd.mapping(data["poses"], data.line_of("poses"), "poses")
+        for name, raw in (poses or {}).items():
+            p = rd.pose2d(raw, poses.line_of(name), f"poses.{name}")  # type: ignore[union-attr]
+            if p is not None:
+                spec.poses[name] = p
+                spec.pose_lines[name] = poses.line_of(name)  # type: ignore[union-attr]
+    _check_unique_names(rd, spec)
+    if rd.problems:
+        raise InputError(rd.problems)
+    return spec
+
+
+def _check_unique_names(rd: _Reader, spec: WorldSpec) -> None:
+    seen: dict[str, int] = {}
+    entries: list[tuple[str, int]] = [(w.name, w.line) for w in spec.walls]
+    entries += [(b.name, b.line) for b in spec.furniture + spec.objects]
+    entries += [(r.name, r.line) for r in spec.robots]
+    for name, line in entries:
+        if name in seen:
+            rd.fail(line, f"name '{name}' is used twice (first at line {seen[name]}); names must be unique")
+        else:
+            seen[name] = line

@@ -1,0 +1,92 @@
+"""YAML loading that remembers where each value came from.
+
+World files are user input: every complaint about them names the file and line. PyYAML's
+safe loader is extended so that mappings become :class:`LineDict` (a dict that knows the line of
+itself and of each key) and sequences become :class:`LineList` (a list that knows the line of
+each item).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from bt_manip.errors import InputError, Problem
+
+
+class LineDict(dict):
+    """A mapping read from YAML, with ``line`` (1-based) and ``key_lines[key]``."""
+
+    line: int = 0
+    key_lines: dict[str, int]
+
+    def line_of(self, key: str) -> int:
+        return self.key_lines.get(key, self.line)
+
+
+class LineList(list):
+    """A sequence read from YAML, with ``line`` and ``item_lines[i]``."""
+
+    line: int = 0
+    item_lines: list[int]
+
+    def line_of(self, index: int) -> int:
+        return self.item_lines[index] if index < len(self.item_lines) else self.line
+
+
+class _Loader(yaml.SafeLoader):
+    """Safe loader that keeps line numbers and refuses duplicate keys."""
+
+
+def _construct_mapping(loader: _Loader, node: yaml.MappingNode) -> LineDict:
+    loader.flatten_mapping(node)
+    out = LineDict()
+    out.line = node.start_mark.line + 1
+    out.key_lines = {}
+    for key_node, value_node in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        if not isinstance(key, str):
+            key = str(key)
+        if key in out:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key '{key}'", key_node.start_mark
+            )
+        out[key] = loader.construct_object(value_node, deep=True)
+        out.key_lines[key] = key_node.start_mark.line + 1
+    return out
+
+
+def _construct_sequence(loader: _Loader, node: yaml.SequenceNode) -> LineList:
+    out = LineList(loader.construct_object(child, deep=True) for child in node.value)
+    out.line = node.start_mark.line + 1
+    out.item_lines = [child.start_mark.line + 1 for child in node.value]
+    return out
+
+
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
+
+MAX_YAML_BYTES = 4 * 1024 * 1024
+
+
+def load_yaml(path: str | Path) -> Any:
+    """Read a YAML file; syntax errors become an InputError with the file and line."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError.single(str(path), None, "file not found")
+    if path.stat().st_size > MAX_YAML_BYTES:
+        raise InputError.single(str(path), None, f"file larger than {MAX_YAML_BYTES} bytes")
+    text = path.read_text(encoding="utf-8", errors="replace")
+    try:
+        return yaml.load(text, Loader=_Loader)  # noqa: S506 - _Loader derives from SafeLoader
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else None
+        what = exc.problem or exc.context or "invalid YAML"
+        if exc.context and exc.problem:
+            what = f"{exc.context}, {exc.problem}"
+        raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
+    except yaml.YAMLError as exc:
+        raise InputError([Problem(str(path), None, f"invalid YAML: {exc}")]) from None
