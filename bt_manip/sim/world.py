@@ -63,11 +63,13 @@ def _half(part: Part) -> list[float]:
     return [part.size[0] / 2, part.size[1] / 2, part.size[2] / 2]
 
 
-def _shape_args(part: Part) -> dict[str, Any]:
+def _shape_args(part: Part, visual: bool = False) -> dict[str, Any]:
+    """Keyword arguments of createCollisionShape (or createVisualShape) for one primitive."""
     if part.shape == "box":
         return {"shapeType": pb.GEOM_BOX, "halfExtents": _half(part)}
     if part.shape == "cylinder":
-        return {"shapeType": pb.GEOM_CYLINDER, "radius": part.size[0], "height": part.size[2]}
+        return {"shapeType": pb.GEOM_CYLINDER, "radius": part.size[0],
+                "length" if visual else "height": part.size[2]}
     return {"shapeType": pb.GEOM_SPHERE, "radius": part.size[0]}
 
 
@@ -217,7 +219,7 @@ class World:
                if spec.movable else np.zeros(3))
         if len(parts) == 1 and parts[0].rpy == (0.0, 0.0, 0.0) and parts[0].xyz == (0.0, 0.0, 0.0):
             col = pb.createCollisionShape(**_shape_args(parts[0]), physicsClientId=c)
-            vis = pb.createVisualShape(**_shape_args(parts[0]), rgbaColor=parts[0].colour or spec.colour,
+            vis = pb.createVisualShape(**_shape_args(parts[0], visual=True), rgbaColor=parts[0].colour or spec.colour,
                                        physicsClientId=c)
         else:
             types = [_shape_args(p)["shapeType"] for p in parts]

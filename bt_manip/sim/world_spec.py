@@ -504,12 +504,9 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
         tree = SafeET.parse(urdf)
     except Exception as exc:  # noqa: BLE001 - any parse failure is reported the same way
         return [f"cannot parse {urdf.name}: {exc}"]
-    missing = []
-    for mesh in tree.getroot().iter("mesh"):
-        fn = mesh.get("filename", "")
-        if not resolve_uri(fn, urdf.parent).is_file():
-            missing.append(f"mesh not found: {fn} (named in {urdf.name})")
-    return missing
+    names = dict.fromkeys(mesh.get("filename", "") for mesh in tree.getroot().iter("mesh"))
+    return [f"mesh not found: {fn} (named in {urdf.name})"
+            for fn in names if not resolve_uri(fn, urdf.parent).is_file()]
 
 
 def _find_robot(name: str, world_dir: Path) -> Path | None:

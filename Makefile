@@ -1,0 +1,33 @@
+# bt-manip developer commands. Each target creates .venv on first use.
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+
+.PHONY: demo test lint bench clean
+
+$(STAMP): pyproject.toml
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
+	@touch $(STAMP)
+
+## demo: set up and run the main job (Husky scenario, headless)
+demo: $(STAMP)
+	@mkdir -p out
+	$(BIN)/bt-manip world worlds/tb3_house.yaml --seed 0 --settle 5
+
+## test: run the whole test suite on two processes
+test: $(STAMP)
+	$(BIN)/python -m pytest -n 2 -q
+
+lint: $(STAMP)
+	$(BIN)/ruff check .
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/astar.py
+	$(BIN)/python benchmarks/ik.py
+	$(BIN)/python benchmarks/bt_tick.py
+
+clean:
+	rm -rf $(VENV) out build *.egg-info
