@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError, Problem
-from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions, Runner
+from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, Runner, RunOptions
 
 
 class _Parser(argparse.ArgumentParser):
@@ -52,8 +52,11 @@ def _bb_pair(text: str) -> tuple[str, str]:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="bt-manip", description="Behaviour-tree tasks for mobile manipulators "
-                     "in PyBullet (BehaviorTree.CPP v4 XML).")
+    parser = _Parser(
+        prog="bt-manip",
+        description="Behaviour-tree tasks for mobile manipulators "
+        "in PyBullet (BehaviorTree.CPP v4 XML).",
+    )
     from bt_manip import __version__
 
     parser.add_argument("--version", action="version", version=f"bt-manip {__version__}")
@@ -65,27 +68,59 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--world", help="world file (YAML); without it only built-in nodes can run")
     run.add_argument("--seed", type=int, default=0, help="seed for the world's randomisation")
     run.add_argument("--tree-id", help="which BehaviorTree to run (default: main_tree_to_execute)")
-    run.add_argument("--models", action="append", default=[], metavar="MODELS.xml",
-                     help="TreeNodesModel files declaring extra nodes")
-    run.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE",
-                     help="set a root blackboard entry before the first tick")
+    run.add_argument(
+        "--models",
+        action="append",
+        default=[],
+        metavar="MODELS.xml",
+        help="TreeNodesModel files declaring extra nodes",
+    )
+    run.add_argument(
+        "--bb",
+        action="append",
+        type=_bb_pair,
+        default=[],
+        metavar="KEY=VALUE",
+        help="set a root blackboard entry before the first tick",
+    )
     run.add_argument("--bb-out", metavar="FILE.json", help="write the root blackboard at the end")
     run.add_argument("--report", metavar="FILE.json", help="write the run report as JSON")
     run.add_argument("--max-ticks", type=_positive(int), help="stop after this many ticks")
-    run.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S",
-                     help="stop after this much sim time (default 600 s)")
-    run.add_argument("--tick-hz", type=_positive(float), default=20.0,
-                     help="tree tick rate (default 20 Hz; physics runs at the world's rate)")
-    run.add_argument("--realtime", type=_positive(float), nargs="?", const=1.0, default=None,
-                     metavar="FACTOR", help="pace the run to FACTOR x real time (default 1)")
+    run.add_argument(
+        "--max-sim-time",
+        type=_positive(float),
+        default=600.0,
+        metavar="S",
+        help="stop after this much sim time (default 600 s)",
+    )
+    run.add_argument(
+        "--tick-hz",
+        type=_positive(float),
+        default=20.0,
+        help="tree tick rate (default 20 Hz; physics runs at the world's rate)",
+    )
+    run.add_argument(
+        "--realtime",
+        type=_positive(float),
+        nargs="?",
+        const=1.0,
+        default=None,
+        metavar="FACTOR",
+        help="pace the run to FACTOR x real time (default 1)",
+    )
     run.add_argument("--quiet", action="store_true", help="print only the summary")
     run.set_defaults(func=cmd_run)
 
     world = sub.add_parser("world", help="load a world and print its summary")
     world.add_argument("world", help="world file (YAML)")
     world.add_argument("--seed", type=int, default=0)
-    world.add_argument("--settle", type=float, default=0.0, metavar="S",
-                       help="step S seconds of sim with no commands and report what moved")
+    world.add_argument(
+        "--settle",
+        type=float,
+        default=0.0,
+        metavar="S",
+        help="step S seconds of sim with no commands and report what moved",
+    )
     world.set_defaults(func=cmd_world)
 
     try:
@@ -111,10 +146,17 @@ def cmd_world(args: argparse.Namespace) -> int:
             before = world.snapshot()
             world.step(round(args.settle * world.rate_hz))
             after = world.snapshot()
-            worst = max((math.dist(before[k]["pos"], after[k]["pos"]), k)
-                        for k in before if k != "time") if len(before) > 1 else (0.0, "-")
-            print(f"  after {args.settle:g} s of sim with no commands, the largest drift is "
-                  f"{worst[0] * 1000:.3f} mm ({worst[1]})")
+            worst = (
+                max(
+                    (math.dist(before[k]["pos"], after[k]["pos"]), k) for k in before if k != "time"
+                )
+                if len(before) > 1
+                else (0.0, "-")
+            )
+            print(
+                f"  after {args.settle:g} s of sim with no commands, the largest drift is "
+                f"{worst[0] * 1000:.3f} mm ({worst[1]})"
+            )
     return 0
 
 
@@ -128,19 +170,33 @@ def cmd_run(args: argparse.Namespace) -> int:
 
         world = World(args.world, seed=args.seed)
     try:
-        context = TreeContext(clock=world.clock if world is not None else MonotonicClock(),
-                              world=world)
-        tree = load_tree(args.tree, tree_id=args.tree_id, models=args.models, context=context,
-                         blackboard=dict(args.bb))
+        context = TreeContext(
+            clock=world.clock if world is not None else MonotonicClock(), world=world
+        )
+        tree = load_tree(
+            args.tree,
+            tree_id=args.tree_id,
+            models=args.models,
+            context=context,
+            blackboard=dict(args.bb),
+        )
         if world is not None and not args.quiet:
             print(world.summary())
-        on_tick = None if args.quiet else _live_view(tree)
-        options = RunOptions(tick_hz=args.tick_hz, max_sim_time=args.max_sim_time,
-                             max_ticks=args.max_ticks, realtime=args.realtime)
-        runner = Runner(tree, world, options, on_tick=on_tick)
-        report = runner.run()
-        if on_tick is not None and hasattr(on_tick, "close"):
-            on_tick.close()
+        hooks: list[Any] = [] if args.quiet else [_live_view(tree)]
+        options = RunOptions(
+            tick_hz=args.tick_hz,
+            max_sim_time=args.max_sim_time,
+            max_ticks=args.max_ticks,
+            realtime=args.realtime,
+        )
+        runner = Runner(tree, world, options, on_tick=hooks)
+        try:
+            report = runner.run()
+        finally:
+            for hook in hooks:
+                close = getattr(hook, "close", None)
+                if callable(close):
+                    close()
         report.tree = args.tree
         report.world = args.world or ""
         report.seed = args.seed if world is not None else None
@@ -150,7 +206,8 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.bb_out:
             Path(args.bb_out).parent.mkdir(parents=True, exist_ok=True)
             Path(args.bb_out).write_text(
-                json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n")
+                json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
+            )
         return report.exit_code
     finally:
         if world is not None:

@@ -15,7 +15,7 @@ from __future__ import annotations
 import json
 import math
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
@@ -26,8 +26,12 @@ EXIT_SUCCESS = 0
 EXIT_FAILURE = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
-EXIT_CODES = {"SUCCESS": EXIT_SUCCESS, "FAILURE": EXIT_FAILURE, "BUDGET": EXIT_FAILURE,
-              "INTERRUPTED": EXIT_INTERRUPTED}
+EXIT_CODES = {
+    "SUCCESS": EXIT_SUCCESS,
+    "FAILURE": EXIT_FAILURE,
+    "BUDGET": EXIT_FAILURE,
+    "INTERRUPTED": EXIT_INTERRUPTED,
+}
 
 
 class TickableTree(Protocol):
@@ -86,8 +90,9 @@ class RunReport:
 
     def to_json(self) -> dict[str, Any]:
         data = asdict(self)
-        data["real_time_factor"] = (round(self.real_time_factor, 3)
-                                    if math.isfinite(self.real_time_factor) else None)
+        data["real_time_factor"] = (
+            round(self.real_time_factor, 3) if math.isfinite(self.real_time_factor) else None
+        )
         data["exit_code"] = self.exit_code
         return data
 
@@ -98,9 +103,11 @@ class RunReport:
     def summary(self) -> str:
         rtf = self.real_time_factor
         rtf_text = f"{rtf:.1f}x real time" if math.isfinite(rtf) else "instant"
-        lines = [f"result: {self.status}" + (f" ({self.reason})" if self.reason else ""),
-                 f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
-                 f"({rtf_text}), {self.ticks} ticks"]
+        lines = [
+            f"result: {self.status}" + (f" ({self.reason})" if self.reason else ""),
+            f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
+            f"({rtf_text}), {self.ticks} ticks",
+        ]
         failed = [n for n in self.nodes if n.status == "FAILURE" and n.reason]
         for n in failed[:10]:
             lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}")
@@ -129,15 +136,20 @@ class Runner:
         tree: anything with ``root``, ``tick()`` and ``halt()``.
         world: a :class:`bt_manip.sim.world.World`, or None for trees of built-ins only.
         options: tick rate, budgets, pacing.
-        on_tick: called after every tick with the runner (live views, recorders).
+        on_tick: callables run after every tick with the runner (live views, recorders).
     """
 
-    def __init__(self, tree: TickableTree, world: Any = None, options: RunOptions | None = None,
-                 on_tick: Callable[[Runner], None] | None = None) -> None:
+    def __init__(
+        self,
+        tree: TickableTree,
+        world: Any = None,
+        options: RunOptions | None = None,
+        on_tick: Sequence[Callable[[Runner], None]] = (),
+    ) -> None:
         self.tree = tree
         self.world = world
         self.options = options or RunOptions()
-        self.on_tick = on_tick
+        self.on_tick = list(on_tick)
         self.ticks = 0
         if world is not None:
             ratio = world.rate_hz / self.options.tick_hz
@@ -165,8 +177,8 @@ class Runner:
             while True:
                 result = self.tree.tick()
                 self.ticks += 1
-                if self.on_tick is not None:
-                    self.on_tick(self)
+                for hook in self.on_tick:
+                    hook(self)
                 if result == py_trees.common.Status.SUCCESS:
                     status = "SUCCESS"
                     break
@@ -187,8 +199,14 @@ class Runner:
             self.tree.halt()
             self._make_safe()
         wall = time.perf_counter() - wall0
-        return RunReport(status=status, reason=reason, sim_time=self.sim_time, wall_time=wall,
-                         ticks=self.ticks, nodes=self._records())
+        return RunReport(
+            status=status,
+            reason=reason,
+            sim_time=self.sim_time,
+            wall_time=wall,
+            ticks=self.ticks,
+            nodes=self._records(),
+        )
 
     def _advance(self, wall0: float) -> None:
         opts = self.options

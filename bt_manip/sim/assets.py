@@ -39,18 +39,20 @@ def pybullet_data_dir() -> Path:
 
 def ur3_urdf() -> Path:
     """The UR3 description of example-robot-data (elbow limited to +-pi, ``world`` link)."""
-    return example_robot_data_share() / "example-robot-data/robots/ur_description/urdf/ur3_robot.urdf"
+    return (
+        example_robot_data_share() / "example-robot-data/robots/ur_description/urdf/ur3_robot.urdf"
+    )
 
 
 def resolve_uri(uri: str, relative_to: Path | None = None) -> Path:
     """Turn an asset URI into an absolute path on this machine (the file may not exist)."""
     if uri.startswith("package://"):
-        rest = uri[len("package://"):]
+        rest = uri[len("package://") :]
         return example_robot_data_share() / rest
     if uri.startswith("pybullet_data://"):
-        return pybullet_data_dir() / uri[len("pybullet_data://"):]
+        return pybullet_data_dir() / uri[len("pybullet_data://") :]
     if uri.startswith("file://"):
-        uri = uri[len("file://"):]
+        uri = uri[len("file://") :]
     p = Path(uri)
     if not p.is_absolute() and relative_to is not None:
         p = relative_to / p

@@ -12,6 +12,7 @@ generator seeded by (world seed, entity name), so adding an entity does not chan
 
 from __future__ import annotations
 
+import contextlib
 import math
 import zlib
 from collections.abc import Callable
@@ -68,8 +69,11 @@ def _shape_args(part: Part, visual: bool = False) -> dict[str, Any]:
     if part.shape == "box":
         return {"shapeType": pb.GEOM_BOX, "halfExtents": _half(part)}
     if part.shape == "cylinder":
-        return {"shapeType": pb.GEOM_CYLINDER, "radius": part.size[0],
-                "length" if visual else "height": part.size[2]}
+        return {
+            "shapeType": pb.GEOM_CYLINDER,
+            "radius": part.size[0],
+            "length" if visual else "height": part.size[2],
+        }
     return {"shapeType": pb.GEOM_SPHERE, "radius": part.size[0]}
 
 
@@ -133,7 +137,9 @@ class World:
         for wall in self.spec.walls:
             self._add(wall.name, self._make_wall(wall), "wall", wall, wall.line)
         for body in self.spec.furniture:
-            self._add(body.name, self._make_body(body, (0.0, 0.0, 0.0)), "furniture", body, body.line)
+            self._add(
+                body.name, self._make_body(body, (0.0, 0.0, 0.0)), "furniture", body, body.line
+            )
         for body in self.spec.objects:
             offset = _sample(entity_rng(self.seed, body.name), body.randomize)
             self._add(body.name, self._make_body(body, offset), "object", body, body.line)
@@ -141,8 +147,10 @@ class World:
             try:
                 robot = self._make_robot(rspec)
             except InputError as exc:
-                problems += [Problem(str(self.path), rspec.line, f"robot '{rspec.name}': {p}")
-                             for p in exc.problems]
+                problems += [
+                    Problem(str(self.path), rspec.line, f"robot '{rspec.name}': {p}")
+                    for p in exc.problems
+                ]
                 continue
             self.robots[rspec.name] = robot
             self._add(rspec.name, robot.body_id, "robot", rspec, rspec.line)
@@ -175,11 +183,11 @@ class World:
         frames = [[(a + b) / 2, 0.0, wall.height / 2] for a, b in stretches]
         n = len(stretches)
         col = pb.createCollisionShapeArray(
-            [pb.GEOM_BOX] * n, halfExtents=halves, collisionFramePositions=frames,
-            physicsClientId=c)
+            [pb.GEOM_BOX] * n, halfExtents=halves, collisionFramePositions=frames, physicsClientId=c
+        )
         vis = pb.createVisualShapeArray(
-            [pb.GEOM_BOX] * n, halfExtents=halves, visualFramePositions=frames,
-            physicsClientId=c)
+            [pb.GEOM_BOX] * n, halfExtents=halves, visualFramePositions=frames, physicsClientId=c
+        )
         body = pb.createMultiBody(0, col, vis, [x0, y0, 0.0], quat, physicsClientId=c)
         pb.changeVisualShape(body, -1, rgbaColor=wall.colour, physicsClientId=c)
         return body
@@ -188,18 +196,24 @@ class World:
         c = self.client
         pos, quat = self._placed_pose(spec, offset)
         if spec.urdf is not None:
-            body = pb.loadURDF(str(spec.urdf), pos, quat, useFixedBase=not spec.movable,
-                               globalScaling=spec.scale, physicsClientId=c)
+            body = pb.loadURDF(
+                str(spec.urdf),
+                pos,
+                quat,
+                useFixedBase=not spec.movable,
+                globalScaling=spec.scale,
+                physicsClientId=c,
+            )
         else:
             body = self._make_compound(spec, pos, quat)
         if spec.movable:
             for link in range(-1, pb.getNumJoints(body, physicsClientId=c)):
-                pb.changeDynamics(body, link, lateralFriction=spec.friction,
-                                  physicsClientId=c)
+                pb.changeDynamics(body, link, lateralFriction=spec.friction, physicsClientId=c)
         return body
 
-    def _placed_pose(self, spec: BodySpec, offset: tuple[float, float, float]
-                     ) -> tuple[list[float], list[float]]:
+    def _placed_pose(
+        self, spec: BodySpec, offset: tuple[float, float, float]
+    ) -> tuple[list[float], list[float]]:
         x, y, z = spec.pose.xyz
         yaw0 = pb.getEulerFromQuaternion(spec.pose.quat)
         quat = list(spec.pose.quat)
@@ -212,15 +226,29 @@ class World:
     def _make_compound(self, spec: BodySpec, pos: list[float], quat: list[float]) -> int:
         c = self.client
         s = spec.scale
-        parts = [Part(p.shape, tuple(v * s for v in p.size), tuple(v * s for v in p.xyz),  # type: ignore[arg-type]
-                      p.rpy, p.colour) for p in spec.parts]
+        parts = [
+            Part(
+                p.shape,
+                tuple(v * s for v in p.size),
+                tuple(v * s for v in p.xyz),  # type: ignore[arg-type]
+                p.rpy,
+                p.colour,
+            )
+            for p in spec.parts
+        ]
         volumes = [_volume(p) for p in parts]
-        com = (np.average([p.xyz for p in parts], axis=0, weights=volumes)
-               if spec.movable else np.zeros(3))
+        com = (
+            np.average([p.xyz for p in parts], axis=0, weights=volumes)
+            if spec.movable
+            else np.zeros(3)
+        )
         if len(parts) == 1 and parts[0].rpy == (0.0, 0.0, 0.0) and parts[0].xyz == (0.0, 0.0, 0.0):
             col = pb.createCollisionShape(**_shape_args(parts[0]), physicsClientId=c)
-            vis = pb.createVisualShape(**_shape_args(parts[0], visual=True), rgbaColor=parts[0].colour or spec.colour,
-                                       physicsClientId=c)
+            vis = pb.createVisualShape(
+                **_shape_args(parts[0], visual=True),
+                rgbaColor=parts[0].colour or spec.colour,
+                physicsClientId=c,
+            )
         else:
             types = [_shape_args(p)["shapeType"] for p in parts]
             radii = [p.size[0] for p in parts]
@@ -229,12 +257,23 @@ class World:
             frames = [list(np.subtract(p.xyz, com)) for p in parts]
             orns = [list(pb.getQuaternionFromEuler(p.rpy)) for p in parts]
             col = pb.createCollisionShapeArray(
-                types, radii=radii, halfExtents=halves, lengths=lengths,
-                collisionFramePositions=frames, collisionFrameOrientations=orns,
-                physicsClientId=c)
+                types,
+                radii=radii,
+                halfExtents=halves,
+                lengths=lengths,
+                collisionFramePositions=frames,
+                collisionFrameOrientations=orns,
+                physicsClientId=c,
+            )
             vis = pb.createVisualShapeArray(
-                types, radii=radii, halfExtents=halves, lengths=lengths,
-                visualFramePositions=frames, visualFrameOrientations=orns, physicsClientId=c)
+                types,
+                radii=radii,
+                halfExtents=halves,
+                lengths=lengths,
+                visualFramePositions=frames,
+                visualFrameOrientations=orns,
+                physicsClientId=c,
+            )
         # the body frame sits at the centre of mass; shift the spawn point to match
         rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
         base = np.asarray(pos) + rot @ com
@@ -252,9 +291,11 @@ class World:
         if rspec.arm_state is not None:
             states = getattr(desc, "states", {}) or {}
             if rspec.arm_state not in states:
-                raise InputError.single(str(self.path), rspec.line,
-                                        f"unknown arm_state '{rspec.arm_state}'; "
-                                        f"known: {', '.join(states) or 'none'}")
+                raise InputError.single(
+                    str(self.path),
+                    rspec.line,
+                    f"unknown arm_state '{rspec.arm_state}'; known: {', '.join(states) or 'none'}",
+                )
             robot.reset_arm(states[rspec.arm_state])
         return robot
 
@@ -275,10 +316,14 @@ class World:
                 if depth < -OVERLAP_TOLERANCE:
                     reported.add(pair)
                     line = max(a.line, b.line)
-                    problems.append(Problem(
-                        str(self.path), line,
-                        f"'{a.name}' and '{b.name}' overlap by {-depth * 1000:.0f} mm at spawn; "
-                        "move one of them apart"))
+                    problems.append(
+                        Problem(
+                            str(self.path),
+                            line,
+                            f"'{a.name}' and '{b.name}' overlap by {-depth * 1000:.0f} mm "
+                            "at spawn; move one of them apart",
+                        )
+                    )
         return problems
 
     # -- running ------------------------------------------------------------------------------
@@ -304,8 +349,10 @@ class World:
     def body_id(self, name: str) -> int:
         """The PyBullet id of a named body; KeyError naming the known ones otherwise."""
         if name not in self.infos:
-            raise KeyError(f"no body named '{name}' in {self.path.name}; known: "
-                           f"{', '.join(sorted(self.infos))}")
+            raise KeyError(
+                f"no body named '{name}' in {self.path.name}; known: "
+                f"{', '.join(sorted(self.infos))}"
+            )
         return self.infos[name].body_id
 
     def name_of(self, body_id: int) -> str | None:
@@ -325,7 +372,9 @@ class World:
 
     def body_pose(self, name: str) -> Pose3D:
         """World pose of a body's base (centre of mass frame, as PyBullet reports it)."""
-        pos, quat = pb.getBasePositionAndOrientation(self.body_id(name), physicsClientId=self.client)
+        pos, quat = pb.getBasePositionAndOrientation(
+            self.body_id(name), physicsClientId=self.client
+        )
         return Pose3D(tuple(pos), tuple(quat))  # type: ignore[arg-type]
 
     def snapshot(self) -> dict[str, Any]:
@@ -338,8 +387,10 @@ class World:
             b = info.body_id
             pos, quat = pb.getBasePositionAndOrientation(b, physicsClientId=c)
             lin, ang = pb.getBaseVelocity(b, physicsClientId=c)
-            joints = [pb.getJointState(b, j, physicsClientId=c)[:2]
-                      for j in range(pb.getNumJoints(b, physicsClientId=c))]
+            joints = [
+                pb.getJointState(b, j, physicsClientId=c)[:2]
+                for j in range(pb.getNumJoints(b, physicsClientId=c))
+            ]
             out[info.name] = {"pos": pos, "quat": quat, "lin": lin, "ang": ang, "joints": joints}
         return out
 
@@ -348,14 +399,18 @@ class World:
         kinds: dict[str, int] = {}
         for info in self.infos.values():
             kinds[info.kind] = kinds.get(info.kind, 0) + 1
-        lines = [f"world '{self.spec.name}' ({self.path}), seed {self.seed}, "
-                 f"{self.rate_hz:g} Hz physics",
-                 f"  {kinds.get('wall', 0)} walls, {kinds.get('furniture', 0)} furniture, "
-                 f"{kinds.get('object', 0)} movable objects, {len(self.robots)} robots"]
+        lines = [
+            f"world '{self.spec.name}' ({self.path}), seed {self.seed}, "
+            f"{self.rate_hz:g} Hz physics",
+            f"  {kinds.get('wall', 0)} walls, {kinds.get('furniture', 0)} furniture, "
+            f"{kinds.get('object', 0)} movable objects, {len(self.robots)} robots",
+        ]
         for name, robot in self.robots.items():
             x, y, yaw = robot.base_pose2d()
-            lines.append(f"  robot {name} ({robot.description.name}) at "
-                         f"x={x:.3f} y={y:.3f} yaw={math.degrees(yaw):.1f} deg")
+            lines.append(
+                f"  robot {name} ({robot.description.name}) at "
+                f"x={x:.3f} y={y:.3f} yaw={math.degrees(yaw):.1f} deg"
+            )
         if self.poses:
             lines.append("  named poses: " + ", ".join(sorted(self.poses)))
         return "\n".join(lines)
@@ -364,10 +419,8 @@ class World:
     def close(self) -> None:
         """Disconnect the PyBullet client (idempotent)."""
         if getattr(self, "client", None) is not None and self.client >= 0:
-            try:
+            with contextlib.suppress(pb.error):
                 pb.disconnect(physicsClientId=self.client)
-            except pb.error:
-                pass
             self.client = -1
 
     def __enter__(self) -> World:

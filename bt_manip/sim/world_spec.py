@@ -16,6 +16,7 @@ Every problem found is collected with its file and line; :func:`parse_world` rai
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -190,8 +191,11 @@ class _Reader:
         for key in d:
             if key not in allowed:
                 close = difflib.get_close_matches(key, sorted(allowed), n=1)
-                hint = f"; did you mean '{close[0]}'?" if close else (
-                    f"; allowed: {', '.join(sorted(allowed))}")
+                hint = (
+                    f"; did you mean '{close[0]}'?"
+                    if close
+                    else (f"; allowed: {', '.join(sorted(allowed))}")
+                )
                 self.fail(d.line_of(key), f"unknown key '{key}' in {where}{hint}")
 
     def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
@@ -208,14 +212,25 @@ class _Reader:
         self.fail(line, f"{where} must be a list, got {type(value).__name__}")
         return None
 
-    def number(self, d: LineDict, key: str, where: str, default: float | None = None,
-               positive: bool = False, non_negative: bool = False) -> float | None:
+    def number(
+        self,
+        d: LineDict,
+        key: str,
+        where: str,
+        default: float | None = None,
+        positive: bool = False,
+        non_negative: bool = False,
+    ) -> float | None:
         if key not in d:
             if default is None:
                 self.fail(d.line, f"{where} is missing '{key}'")
             return default
         value = d[key]
-        if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+        ):
             self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
             return default
         if positive and value <= 0:
@@ -227,16 +242,22 @@ class _Reader:
         return float(value)
 
     def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        ok = isinstance(value, list) and len(value) == n and all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-            for v in value)
+        ok = (
+            isinstance(value, list)
+            and len(value) == n
+            and all(
+                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                for v in value
+            )
+        )
         if not ok:
             self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
             return None
         return tuple(float(v) for v in value)
 
-    def colour(self, d: LineDict, where: str,
-               default: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    def colour(
+        self, d: LineDict, where: str, default: tuple[float, float, float, float]
+    ) -> tuple[float, float, float, float]:
         key = "colour" if "colour" in d else "color" if "color" in d else None
         if key is None:
             return default
@@ -245,8 +266,11 @@ class _Reader:
         if isinstance(value, str):
             if value in COLOURS:
                 return COLOURS[value]
-            self.fail(line, f"{where}.{key}: unknown colour '{value}'; known: "
-                      f"{', '.join(sorted(COLOURS))}, or [r, g, b, a] in 0..1")
+            self.fail(
+                line,
+                f"{where}.{key}: unknown colour '{value}'; known: "
+                f"{', '.join(sorted(COLOURS))}, or [r, g, b, a] in 0..1",
+            )
             return default
         if isinstance(value, list) and len(value) in (3, 4):
             vec = self.vector(value, len(value), line, f"{where}.{key}")
@@ -341,20 +365,27 @@ class _Reader:
             vec = self.vector(r[key], 2, r.line_of(key), f"{where}.randomize.{key} ([low, high])")
             if vec is not None:
                 if vec[0] > vec[1]:
-                    self.fail(r.line_of(key), f"{where}.randomize.{key}: low {vec[0]} > high {vec[1]}")
+                    self.fail(
+                        r.line_of(key), f"{where}.randomize.{key}: low {vec[0]} > high {vec[1]}"
+                    )
                 else:
                     out[key] = (vec[0], vec[1])
         return Range2D(**out)
 
     # -- shapes ---------------------------------------------------------------------------
-    def shape(self, d: LineDict, where: str, colour: tuple[float, float, float, float],
-              with_offset: bool) -> Part | None:
+    def shape(
+        self, d: LineDict, where: str, colour: tuple[float, float, float, float], with_offset: bool
+    ) -> Part | None:
         kind = d.get("shape")
         if kind not in ("box", "cylinder", "sphere"):
-            self.fail(d.line_of("shape"), f"{where}.shape must be box, cylinder or sphere, got {kind!r}")
+            self.fail(
+                d.line_of("shape"), f"{where}.shape must be box, cylinder or sphere, got {kind!r}"
+            )
             return None
         if kind == "box":
-            size = self.vector(d.get("size"), 3, d.line_of("size"), f"{where}.size ([x, y, z] extents)")
+            size = self.vector(
+                d.get("size"), 3, d.line_of("size"), f"{where}.size ([x, y, z] extents)"
+            )
             if size is None:
                 return None
             if any(s <= 0 for s in size):
@@ -416,12 +447,15 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
             if at is None or width is None:
                 continue
             if at - width / 2 < 0 or at + width / 2 > length:
-                rd.fail(dd.line, f"{dw}: door from {at - width / 2:.3f} to {at + width / 2:.3f} m "
-                        f"does not fit in the wall of length {length:.3f} m")
+                rd.fail(
+                    dd.line,
+                    f"{dw}: door from {at - width / 2:.3f} to {at + width / 2:.3f} m "
+                    f"does not fit in the wall of length {length:.3f} m",
+                )
                 continue
             doors.append(DoorSpec(at, width, dd.line))
         doors.sort(key=lambda door: door.at)
-        for a, b in zip(doors, doors[1:], strict=False):
+        for a, b in itertools.pairwise(doors):
             if a.at + a.width / 2 > b.at - b.width / 2:
                 rd.fail(b.line, f"{where}: doors at {a.at} m and {b.at} m overlap")
         out.append(WallSpec(name, start, end, thickness, height, colour, doors, d.line))  # type: ignore[arg-type]
@@ -434,8 +468,11 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
     colour = rd.colour(d, where, COLOURS["wood"] if not movable else COLOURS["orange"])
     forms = [k for k in ("shape", "parts", "urdf") if k in d]
     if len(forms) != 1:
-        rd.fail(d.line, f"{where} ('{name}') needs exactly one of 'shape', 'parts' or 'urdf', "
-                f"got {forms or 'none'}")
+        rd.fail(
+            d.line,
+            f"{where} ('{name}') needs exactly one of 'shape', 'parts' or 'urdf', "
+            f"got {forms or 'none'}",
+        )
         return None
     parts: list[Part] = []
     urdf: Path | None = None
@@ -490,8 +527,9 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
         return None
     pose, planar = got
     randomize = rd.randomize(d, where) if movable else Range2D()
-    return BodySpec(name, movable, parts, urdf, pose, planar, mass, friction, colour,
-                    randomize, d.line, scale)
+    return BodySpec(
+        name, movable, parts, urdf, pose, planar, mass, friction, colour, randomize, d.line, scale
+    )
 
 
 def _check_urdf_meshes(urdf: Path) -> list[str]:
@@ -502,11 +540,14 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
 
     try:
         tree = SafeET.parse(urdf)
-    except Exception as exc:  # noqa: BLE001 - any parse failure is reported the same way
+    except Exception as exc:
         return [f"cannot parse {urdf.name}: {exc}"]
     names = dict.fromkeys(mesh.get("filename", "") for mesh in tree.getroot().iter("mesh"))
-    return [f"mesh not found: {fn} (named in {urdf.name})"
-            for fn in names if not resolve_uri(fn, urdf.parent).is_file()]
+    return [
+        f"mesh not found: {fn} (named in {urdf.name})"
+        for fn in names
+        if not resolve_uri(fn, urdf.parent).is_file()
+    ]
 
 
 def _find_robot(name: str, world_dir: Path) -> Path | None:
@@ -543,8 +584,11 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
         name = rd.name(d, where)
         desc = d.get("description")
         if not isinstance(desc, str):
-            rd.fail(d.line_of("description"), f"{where} ('{name}') needs 'description': a robot "
-                    f"name such as {', '.join(_known_robots(base)) or 'husky_ur3'}")
+            rd.fail(
+                d.line_of("description"),
+                f"{where} ('{name}') needs 'description': a robot "
+                f"name such as {', '.join(_known_robots(base)) or 'husky_ur3'}",
+            )
             continue
         desc_path = _find_robot(desc, base)
         if desc_path is None:
@@ -552,7 +596,9 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
 
             known = _known_robots(base)
             close = difflib.get_close_matches(desc, known, n=1)
-            hint = f"did you mean '{close[0]}'?" if close else f"known: {', '.join(known) or 'none'}"
+            hint = (
+                f"did you mean '{close[0]}'?" if close else f"known: {', '.join(known) or 'none'}"
+            )
             rd.fail(d.line_of("description"), f"{where}: unknown robot '{desc}'; {hint}")
             continue
         pose = rd.pose2d(d.get("pose", [0, 0, 0]), d.line_of("pose"), f"{where}.pose")
@@ -562,7 +608,9 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
             arm_state = None
         if pose is None:
             continue
-        out.append(RobotSpec(name, desc, desc_path, pose, arm_state, rd.randomize(d, where), d.line))
+        out.append(
+            RobotSpec(name, desc, desc_path, pose, arm_state, rd.randomize(d, where), d.line)
+        )
     return out
 
 
@@ -572,8 +620,11 @@ def parse_world(path: str | Path) -> WorldSpec:
     data = load_yaml(path)
     rd = _Reader(path)
     if not isinstance(data, LineDict):
-        raise InputError.single(str(path), 1, "a world file must be a YAML mapping "
-                                "(name, walls, furniture, objects, robots, poses)")
+        raise InputError.single(
+            str(path),
+            1,
+            "a world file must be a YAML mapping (name, walls, furniture, objects, robots, poses)",
+        )
     rd.keys(data, TOP_KEYS, "the world")
     base = path.resolve().parent
     physics = PhysicsSpec()
@@ -586,9 +637,11 @@ def parse_world(path: str | Path) -> WorldSpec:
                 g = rd.vector(ph["gravity"], 3, ph.line_of("gravity"), "physics.gravity")
                 physics.gravity = g or physics.gravity  # type: ignore[assignment]
             physics.solver_iterations = int(
-                rd.number(ph, "solver_iterations", "physics", 50, positive=True) or 50)
-            physics.ground_friction = rd.number(ph, "ground_friction", "physics", 1.0,
-                                                non_negative=True) or 0.0
+                rd.number(ph, "solver_iterations", "physics", 50, positive=True) or 50
+            )
+            physics.ground_friction = (
+                rd.number(ph, "ground_friction", "physics", 1.0, non_negative=True) or 0.0
+            )
     spec = WorldSpec(path=path, name=str(data.get("name", path.stem)), physics=physics)
     walls = rd.seq(data.get("walls"), data.line_of("walls"), "walls")
     spec.walls = _parse_walls(rd, walls) if walls else []
@@ -622,6 +675,9 @@ def _check_unique_names(rd: _Reader, spec: WorldSpec) -> None:
     entries += [(r.name, r.line) for r in spec.robots]
     for name, line in entries:
         if name in seen:
-            rd.fail(line, f"name '{name}' is used twice (first at line {seen[name]}); names must be unique")
+            rd.fail(
+                line,
+                f"name '{name}' is used twice (first at line {seen[name]}); names must be unique",
+            )
         else:
             seen[name] = line

@@ -80,7 +80,7 @@ def load_yaml(path: str | Path) -> Any:
         raise InputError.single(str(path), None, f"file larger than {MAX_YAML_BYTES} bytes")
     text = path.read_text(encoding="utf-8", errors="replace")
     try:
-        return yaml.load(text, Loader=_Loader)  # noqa: S506 - _Loader derives from SafeLoader
+        return yaml.load(text, Loader=_Loader)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None

@@ -35,8 +35,10 @@ class StatusLog:
             before = self._last.get(rec.path, "INVALID")
             if rec.status != before:
                 why = f" ({rec.reason})" if rec.reason and rec.status == "FAILURE" else ""
-                print(f"[{runner.sim_time:9.3f} s] {rec.path}: {before} -> {rec.status}{why}",
-                      file=self.stream)
+                print(
+                    f"[{runner.sim_time:9.3f} s] {rec.path}: {before} -> {rec.status}{why}",
+                    file=self.stream,
+                )
                 self._last[rec.path] = rec.status
 
     def close(self) -> None:
