@@ -2,6 +2,7 @@
 
 Verbs:
   run TREE.xml [--world W]   tick a tree (against a world's sim clock when one is given)
+  bench TREE.xml --world W   many seeded episodes in parallel, with statistics
   world W.yaml               load a world, print its summary, optionally let it settle
   validate TREE.xml          check a tree without running it, listing every problem
   show TREE.xml              print a tree as text (or Graphviz with --dot)
@@ -21,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError, Problem
-from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, Runner, RunOptions
+from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions
 
 
 class _Parser(argparse.ArgumentParser):
@@ -49,6 +50,27 @@ def _bb_pair(text: str) -> tuple[str, str]:
     if not sep or not key.strip():
         raise argparse.ArgumentTypeError(f"expected key=value, got '{text}'")
     return key.strip(), value
+
+
+def _fault(text: str) -> Any:
+    from bt_manip.faults import parse_fault
+
+    try:
+        return parse_fault(text)
+    except InputError as exc:
+        raise argparse.ArgumentTypeError(exc.problems[0].message) from None
+
+
+def _add_inject(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--inject",
+        action="append",
+        type=_fault,
+        default=[],
+        metavar="FAULT",
+        help="inject faults, seeded: NAME:failure:P (node NAME fails with probability P), "
+        "slip:P (a held object slips), block:P (an obstacle falls on the route)",
+    )
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -109,7 +131,24 @@ def build_parser() -> argparse.ArgumentParser:
         help="pace the run to FACTOR x real time (default 1)",
     )
     run.add_argument("--quiet", action="store_true", help="print only the summary")
+    _add_inject(run)
     run.set_defaults(func=cmd_run)
+
+    bench = sub.add_parser("bench", help="run many seeded episodes and report statistics")
+    bench.add_argument("tree", help="BehaviorTree.CPP v4 XML file")
+    bench.add_argument("--world", required=True, help="world file (YAML)")
+    bench.add_argument("--runs", type=_positive(int), default=20, help="episodes (default 20)")
+    bench.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    bench.add_argument("--jobs", type=_positive(int), default=2, help="worker processes")
+    bench.add_argument("--out", default="out/bench", help="folder for JSON, CSV and PNG output")
+    bench.add_argument("--tree-id")
+    bench.add_argument("--models", action="append", default=[], metavar="MODELS.xml")
+    bench.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE")
+    bench.add_argument("--max-ticks", type=_positive(int))
+    bench.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S")
+    bench.add_argument("--tick-hz", type=_positive(float), default=20.0)
+    _add_inject(bench)
+    bench.set_defaults(func=cmd_bench)
 
     world = sub.add_parser("world", help="load a world and print its summary")
     world.add_argument("world", help="world file (YAML)")
@@ -160,47 +199,45 @@ def cmd_world(args: argparse.Namespace) -> int:
     return 0
 
 
+def _episode_spec(args: argparse.Namespace) -> Any:
+    from bt_manip.episode import EpisodeSpec
+
+    options = RunOptions(
+        tick_hz=args.tick_hz,
+        max_sim_time=args.max_sim_time,
+        max_ticks=args.max_ticks,
+        realtime=getattr(args, "realtime", None),
+    )
+    return EpisodeSpec(
+        tree=args.tree,
+        world=args.world,
+        seed=args.seed,
+        tree_id=args.tree_id,
+        models=list(args.models),
+        blackboard=dict(args.bb),
+        inject=list(args.inject),
+        options=options,
+    )
+
+
 def cmd_run(args: argparse.Namespace) -> int:
-    from bt_manip.bt import TreeContext, load_tree
-    from bt_manip.clock import MonotonicClock
+    from bt_manip.episode import Episode
 
-    world = None
-    if args.world:
-        from bt_manip.sim.world import World
-
-        world = World(args.world, seed=args.seed)
-    try:
-        context = TreeContext(
-            clock=world.clock if world is not None else MonotonicClock(), world=world
-        )
-        tree = load_tree(
-            args.tree,
-            tree_id=args.tree_id,
-            models=args.models,
-            context=context,
-            blackboard=dict(args.bb),
-        )
+    with Episode(_episode_spec(args)) as episode:
+        tree, world = episode.tree, episode.world
         if world is not None and not args.quiet:
             print(world.summary())
         hooks: list[Any] = [] if args.quiet else [_live_view(tree)]
-        options = RunOptions(
-            tick_hz=args.tick_hz,
-            max_sim_time=args.max_sim_time,
-            max_ticks=args.max_ticks,
-            realtime=args.realtime,
-        )
-        runner = Runner(tree, world, options, on_tick=hooks)
         try:
-            report = runner.run()
+            report = episode.run(hooks)
         finally:
             for hook in hooks:
                 close = getattr(hook, "close", None)
                 if callable(close):
                     close()
-        report.tree = args.tree
-        report.world = args.world or ""
-        report.seed = args.seed if world is not None else None
         print(report.summary())
+        if report.extra.get("injected"):
+            print(f"  faults injected: {len(report.extra['injected'])}")
         if args.report:
             report.write(args.report)
         if args.bb_out:
@@ -209,9 +246,26 @@ def cmd_run(args: argparse.Namespace) -> int:
                 json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
             )
         return report.exit_code
-    finally:
-        if world is not None:
-            world.close()
+
+
+def cmd_bench(args: argparse.Namespace) -> int:
+    from bt_manip.bench import run_bench, summarise, write_outputs
+    from bt_manip.episode import Episode
+
+    base = _episode_spec(args)
+    with Episode(base):  # check the tree and world once, before starting workers
+        pass
+    print(
+        f"bench: {args.runs} episodes of {args.tree} on {args.world}, seeds "
+        f"{args.seed}..{args.seed + args.runs - 1}, {args.jobs} process(es)"
+    )
+    results = run_bench(base, args.runs, jobs=args.jobs)
+    summary = summarise(results, base)
+    print(summary.text())
+    out = Path(args.out)
+    write_outputs(results, summary, out)
+    print(f"wrote {out}/episodes.json, episodes.csv, summary.json, outcomes.png")
+    return 0 if summary.successes == summary.runs else 1
 
 
 def _live_view(tree: Any) -> Any:

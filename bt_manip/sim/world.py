@@ -25,6 +25,7 @@ import pybullet as pb
 
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError, Problem
+from bt_manip.sim.attach import Attachments
 from bt_manip.sim.world_spec import (
     BodySpec,
     Part,
@@ -107,6 +108,7 @@ class World:
         self.robots: dict[str, Any] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
         self._step_listeners: list[Callable[[World], None]] = []
+        self.attachments = Attachments(self)
         try:
             self._setup_physics()
             self._build()
@@ -153,7 +155,7 @@ class World:
                 ]
                 continue
             self.robots[rspec.name] = robot
-            self._add(rspec.name, robot.body_id, "robot", rspec, rspec.line)
+            self._add(rspec.name, robot.body, "robot", rspec, rspec.line)
         problems += self._overlaps()
         if problems:
             raise InputError(problems)

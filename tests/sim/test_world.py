@@ -53,7 +53,7 @@ def test_ten_seconds_with_no_commands_leaves_everything_at_rest(path: Path) -> N
 def _run(path: Path, seed: int) -> dict:
     with World(path, seed=seed) as world:
         for robot in world.robots.values():
-            if robot.description.base_type == "skid_steer":
+            if robot.description.base.type == "skid_steer":
                 robot.set_wheel_velocities(3.0, 2.0)
         world.step(480)
         return world.snapshot()

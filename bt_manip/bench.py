@@ -1,0 +1,271 @@
+"""Monte-Carlo runs of a tree: many seeded episodes in parallel, with statistics.
+
+``bt-manip bench TREE --world W --runs N --seed S [--inject ...] [--jobs J] [--out DIR]`` runs
+episodes with seeds S, S+1, ..., S+N-1 (each seed draws the world's randomised starts and the
+injected faults), in J worker processes, and reports:
+
+- the success rate with a 95 % Wilson score interval;
+- sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
+- failures counted by node and reason (the deepest failed node of each failed episode).
+
+It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import sys
+from collections import Counter
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor, as_completed
+from dataclasses import asdict, dataclass, field, replace
+from multiprocessing import get_context
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from bt_manip.episode import Episode, EpisodeSpec
+
+
+@dataclass
+class EpisodeResult:
+    """The outcome of one episode, small enough to send between processes."""
+
+    seed: int
+    status: str
+    reason: str
+    sim_time: float
+    wall_time: float
+    ticks: int
+    failed_node: str = ""
+    injected: list[dict[str, Any]] = field(default_factory=list)
+
+    @property
+    def success(self) -> bool:
+        return self.status == "SUCCESS"
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float, float]:
+    """95 % Wilson score interval of a binomial proportion (0..1)."""
+    if n == 0:
+        return (0.0, 1.0)
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return (max(0.0, centre - half), min(1.0, centre + half))
+
+
+def run_one(spec: EpisodeSpec) -> EpisodeResult:
+    """Run one episode (in a worker process) and condense its report."""
+    with Episode(spec) as episode:
+        report = episode.run()
+    failed = [n for n in report.nodes if n.status == "FAILURE"]
+    deepest = max(failed, key=lambda n: n.path.count("/")) if failed else None
+    return EpisodeResult(
+        seed=spec.seed,
+        status=report.status,
+        reason=report.reason,
+        sim_time=report.sim_time,
+        wall_time=report.wall_time,
+        ticks=report.ticks,
+        failed_node=deepest.node if deepest is not None and report.status != "SUCCESS" else "",
+        injected=list(report.extra.get("injected", [])),
+    )
+
+
+@dataclass
+class BenchSummary:
+    """Statistics over all episodes."""
+
+    runs: int
+    successes: int
+    success_rate: float
+    ci95: tuple[float, float]
+    sim_time: dict[str, float]
+    wall_time: dict[str, float]
+    real_time_factor: dict[str, float]
+    failures: list[dict[str, Any]]
+    injected: dict[str, int]
+    tree: str = ""
+    world: str = ""
+    first_seed: int = 0
+    inject: list[str] = field(default_factory=list)
+
+    def text(self) -> str:
+        lo, hi = self.ci95
+        lines = [
+            f"success: {self.successes}/{self.runs} = {self.success_rate * 100:.1f} % "
+            f"(95 % interval {lo * 100:.1f}-{hi * 100:.1f} %)",
+            f"sim time per episode: mean {self.sim_time['mean']:.1f} s, median "
+            f"{self.sim_time['median']:.1f} s, p95 {self.sim_time['p95']:.1f} s",
+            f"wall time per episode: mean {self.wall_time['mean']:.2f} s, median "
+            f"{self.wall_time['median']:.2f} s; real-time factor median "
+            f"{self.real_time_factor['median']:.1f}x",
+        ]
+        if self.injected:
+            lines.append(
+                "faults injected: "
+                + ", ".join(f"{k} x{v}" for k, v in sorted(self.injected.items()))
+            )
+        for f in self.failures:
+            lines.append(f"  {f['count']:3d} x {f['node'] or '-'}: {f['reason']}")
+        return "\n".join(lines)
+
+
+def _stats(values: list[float]) -> dict[str, float]:
+    if not values:
+        return {"mean": 0.0, "median": 0.0, "p95": 0.0, "min": 0.0, "max": 0.0}
+    a = np.asarray(values, dtype=float)
+    return {
+        "mean": float(a.mean()),
+        "median": float(np.median(a)),
+        "p95": float(np.percentile(a, 95)),
+        "min": float(a.min()),
+        "max": float(a.max()),
+    }
+
+
+def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
+    n = len(results)
+    wins = sum(r.success for r in results)
+    failures = Counter((r.failed_node, r.reason) for r in results if not r.success)
+    injected = Counter(e["kind"] for r in results for e in r.injected)
+    rtf = [r.sim_time / r.wall_time for r in results if r.wall_time > 0]
+    return BenchSummary(
+        runs=n,
+        successes=wins,
+        success_rate=wins / n if n else 0.0,
+        ci95=wilson_interval(wins, n),
+        sim_time=_stats([r.sim_time for r in results]),
+        wall_time=_stats([r.wall_time for r in results]),
+        real_time_factor=_stats(rtf),
+        failures=[{"node": k[0], "reason": k[1], "count": c} for k, c in failures.most_common()],
+        injected=dict(injected),
+        tree=base.tree,
+        world=base.world or "",
+        first_seed=base.seed,
+        inject=[f.text() for f in base.inject],
+    )
+
+
+def _progress(total: int) -> Callable[[EpisodeResult], None]:
+    """A progress bar in a terminal, a line every 10 % otherwise."""
+    done = {"n": 0, "ok": 0}
+    if sys.stderr.isatty():
+        from rich.progress import Progress
+
+        bar = Progress(transient=True)
+        bar.start()
+        task = bar.add_task("episodes", total=total)
+
+        def tick(r: EpisodeResult) -> None:
+            done["n"] += 1
+            done["ok"] += r.success
+            bar.update(task, advance=1, description=f"{done['ok']}/{done['n']} succeeded")
+            if done["n"] == total:
+                bar.stop()
+
+        return tick
+    step = max(1, total // 10)
+
+    def log(r: EpisodeResult) -> None:
+        done["n"] += 1
+        done["ok"] += r.success
+        if done["n"] % step == 0 or done["n"] == total:
+            print(f"  {done['n']}/{total} episodes, {done['ok']} succeeded", file=sys.stderr)
+
+    return log
+
+
+def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
+    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed."""
+    specs = [replace(base, seed=base.seed + i) for i in range(runs)]
+    progress = _progress(runs)
+    results: list[EpisodeResult] = []
+    if jobs <= 1:
+        for spec in specs:
+            results.append(run_one(spec))
+            progress(results[-1])
+    else:
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+            futures = [pool.submit(run_one, s) for s in specs]
+            for fut in as_completed(futures):
+                results.append(fut.result())
+                progress(results[-1])
+    return sorted(results, key=lambda r: r.seed)
+
+
+def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
+    """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
+    with open(out / "episodes.csv", "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(
+            [
+                "seed",
+                "status",
+                "sim_time",
+                "wall_time",
+                "ticks",
+                "failed_node",
+                "reason",
+                "injected",
+            ]
+        )
+        for r in results:
+            w.writerow(
+                [
+                    r.seed,
+                    r.status,
+                    f"{r.sim_time:.3f}",
+                    f"{r.wall_time:.3f}",
+                    r.ticks,
+                    r.failed_node,
+                    r.reason,
+                    len(r.injected),
+                ]
+            )
+    (out / "summary.json").write_text(json.dumps(asdict(summary), indent=2) + "\n")
+    _plot(results, summary, out / "outcomes.png")
+
+
+def _plot(results: list[EpisodeResult], summary: BenchSummary, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
+    colours = {
+        "SUCCESS": "tab:green",
+        "FAILURE": "tab:red",
+        "BUDGET": "tab:orange",
+        "INTERRUPTED": "tab:grey",
+    }
+    for status, colour in colours.items():
+        pts = [(r.seed, r.sim_time) for r in results if r.status == status]
+        if pts:
+            xs, ys = zip(*pts, strict=True)
+            ax1.scatter(xs, ys, c=colour, label=f"{status} ({len(pts)})", s=18)
+    ax1.set_xlabel("seed")
+    ax1.set_ylabel("sim time (s)")
+    lo, hi = summary.ci95
+    ax1.set_title(
+        f"success {summary.success_rate * 100:.1f} % (95 % CI {lo * 100:.0f}-{hi * 100:.0f} %)"
+    )
+    ax1.legend(fontsize=8)
+    ax2.hist(
+        [r.sim_time for r in results], bins=min(20, max(5, len(results) // 2)), color="tab:blue"
+    )
+    ax2.set_xlabel("sim time per episode (s)")
+    ax2.set_ylabel("episodes")
+    ax2.set_title(f"median real-time factor {summary.real_time_factor['median']:.1f}x")
+    fig.suptitle(f"{Path(summary.tree).name} on {Path(summary.world).name or 'no world'}")
+    fig.tight_layout()
+    fig.savefig(path, dpi=90)
+    plt.close(fig)

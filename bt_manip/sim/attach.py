@@ -1,0 +1,155 @@
+"""Attaching objects to robots with a fixed joint made at run time.
+
+An attachment is a PyBullet fixed constraint between a robot link (by default the gripper's
+end-effector link) and an object, holding the pose they had when it was made. It is only made
+when the object really is in the hand: touching a finger, or within ``max_distance`` (1 cm) of
+one. Otherwise :meth:`Attachments.attach` refuses and says how far the object is.
+
+PyBullet expresses constraint frames relative to each link's centre of mass, not the URDF link
+frame; the relative pose is computed in those frames so nothing jumps when the joint is made.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+DEFAULT_MAX_DISTANCE = 0.01
+"""Farthest an object may be from a finger (m) and still be attached."""
+
+HOLD_FORCE = 2000.0
+"""Maximum force (N) the attach joint applies; high enough that a carried panel does not sag."""
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """An object held to a robot link by a fixed constraint."""
+
+    object_name: str
+    object_body: int
+    robot_name: str
+    robot_body: int
+    link_index: int
+    link_name: str
+    constraint_id: int
+
+
+@dataclass(frozen=True)
+class AttachResult:
+    """Whether an attach/detach happened, and why not when it did not."""
+
+    ok: bool
+    reason: str = ""
+    distance: float | None = None
+
+
+def _com_pose(client: int, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
+    if link < 0:
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    else:
+        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
+        pos, quat = state[0], state[1]
+    return np.asarray(pos), np.asarray(quat)
+
+
+class Attachments:
+    """The attach joints of one world."""
+
+    def __init__(self, world: Any) -> None:
+        self.world = world
+        self._by_object: dict[str, Attachment] = {}
+
+    @property
+    def client(self) -> int:
+        return self.world.client
+
+    def finger_distance(self, robot: Any, body: int) -> float:
+        """Smallest distance (m) between the object and any finger link; <= 0 when touching."""
+        best = float("inf")
+        for link in robot.finger_link_ids:
+            pts = pb.getClosestPoints(
+                robot.body, body, 0.05, linkIndexA=link, physicsClientId=self.client
+            )
+            for p in pts:
+                best = min(best, p[8])
+        return best
+
+    def attach(
+        self,
+        robot_name: str,
+        object_name: str,
+        link: str | None = None,
+        max_distance: float = DEFAULT_MAX_DISTANCE,
+    ) -> AttachResult:
+        """Hold ``object_name`` to a link of ``robot_name`` if it is at the fingers.
+
+        Fails (nothing changes) when the robot or object is unknown, the object is already
+        attached, or it is farther than ``max_distance`` from every finger.
+        """
+        world = self.world
+        robot = world.robots.get(robot_name)
+        if robot is None:
+            return AttachResult(False, f"no robot named '{robot_name}'")
+        if object_name not in world.movable:
+            return AttachResult(False, f"no movable object named '{object_name}'")
+        if object_name in self._by_object:
+            held = self._by_object[object_name]
+            return AttachResult(False, f"'{object_name}' is already attached to {held.robot_name}")
+        body = world.movable[object_name]
+        distance = self.finger_distance(robot, body)
+        if distance > max_distance:
+            far = "more than 5 cm" if distance == float("inf") else f"{distance * 100:.1f} cm"
+            return AttachResult(
+                False,
+                f"'{object_name}' is {far} from the fingers (must touch or be within "
+                f"{max_distance * 100:.1f} cm)",
+                distance,
+            )
+        link_name = link or robot.description.end_effector
+        link_index = robot.link_index(link_name)
+        p_pos, p_quat = _com_pose(self.client, robot.body, link_index)
+        c_pos, c_quat = _com_pose(self.client, body, -1)
+        inv_pos, inv_quat = pb.invertTransform(p_pos.tolist(), p_quat.tolist())
+        rel_pos, rel_quat = pb.multiplyTransforms(
+            inv_pos, inv_quat, c_pos.tolist(), c_quat.tolist()
+        )
+        cid = pb.createConstraint(
+            robot.body,
+            link_index,
+            body,
+            -1,
+            pb.JOINT_FIXED,
+            [0, 0, 0],
+            parentFramePosition=rel_pos,
+            childFramePosition=[0, 0, 0],
+            parentFrameOrientation=rel_quat,
+            childFrameOrientation=[0, 0, 0, 1],
+            physicsClientId=self.client,
+        )
+        pb.changeConstraint(cid, maxForce=HOLD_FORCE, physicsClientId=self.client)
+        self._by_object[object_name] = Attachment(
+            object_name, body, robot_name, robot.body, link_index, link_name, cid
+        )
+        return AttachResult(True, "", distance)
+
+    def detach(self, object_name: str) -> AttachResult:
+        """Remove the attach joint of ``object_name``; fails if it is not attached."""
+        held = self._by_object.pop(object_name, None)
+        if held is None:
+            return AttachResult(False, f"'{object_name}' is not attached")
+        pb.removeConstraint(held.constraint_id, physicsClientId=self.client)
+        return AttachResult(True)
+
+    def is_attached(self, object_name: str, robot_name: str | None = None) -> bool:
+        held = self._by_object.get(object_name)
+        return held is not None and (robot_name is None or held.robot_name == robot_name)
+
+    def held_by(self, robot_name: str) -> list[Attachment]:
+        """What a robot holds through attach joints."""
+        return [a for a in self._by_object.values() if a.robot_name == robot_name]
+
+    def all(self) -> list[Attachment]:
+        return list(self._by_object.values())
