@@ -1,0 +1,77 @@
+"""Fault specifications, seeded fault draws and bench statistics."""
+
+from __future__ import annotations
+
+import pytest
+
+from bt_manip.bench import EpisodeResult, summarise, wilson_interval
+from bt_manip.episode import EpisodeSpec
+from bt_manip.errors import InputError
+from bt_manip.faults import FaultInjector, FaultSpec, parse_fault
+
+
+@pytest.mark.parametrize(
+    ("text", "spec"),
+    [
+        ("Attach:failure:0.3", FaultSpec("failure", 0.3, "Attach")),
+        ("grasp_panel:failure:1", FaultSpec("failure", 1.0, "grasp_panel")),
+        ("slip:0.2", FaultSpec("slip", 0.2)),
+        ("block:0", FaultSpec("block", 0.0)),
+    ],
+)
+def test_parse_fault(text: str, spec: FaultSpec) -> None:
+    assert parse_fault(text) == spec
+    assert parse_fault(spec.text()) == spec
+
+
+@pytest.mark.parametrize(
+    ("text", "why"),
+    [
+        ("Attach:failure:1.5", "not within 0..1"),
+        ("Attach:failure:often", "is not a number"),
+        ("Attach:0.3", "not a fault specification"),
+        ("rain:0.3", "not a fault specification"),
+    ],
+)
+def test_bad_fault_is_an_input_error(text: str, why: str) -> None:
+    with pytest.raises(InputError) as err:
+        parse_fault(text)
+    assert why in str(err.value)
+    assert "expected NAME:failure:P, slip:P or block:P" in str(err.value)
+
+
+def test_fault_draws_are_seeded_and_match_probability() -> None:
+    specs = [FaultSpec("failure", 0.3, "Attach")]
+    a = FaultInjector(specs, seed=5)
+    b = FaultInjector(specs, seed=5)
+    draws_a = [a.node_fails("grasp", "Attach") for _ in range(2000)]
+    draws_b = [b.node_fails("grasp", "Attach") for _ in range(2000)]
+    assert draws_a == draws_b
+    assert 0.26 < sum(draws_a) / 2000 < 0.34
+    assert len(a.events) == sum(draws_a)
+    assert not any(FaultInjector(specs, seed=5).node_fails("grasp", "Detach") for _ in range(100))
+    c = FaultInjector(specs, seed=6)
+    assert [c.node_fails("x", "Attach") for _ in range(2000)] != draws_a
+
+
+def test_wilson_interval() -> None:
+    lo, hi = wilson_interval(49, 50)
+    assert lo == pytest.approx(0.8950, abs=1e-3)
+    assert hi == pytest.approx(0.9965, abs=1e-3)
+    assert wilson_interval(0, 10)[0] == 0.0
+    assert wilson_interval(10, 10)[1] == pytest.approx(1.0)
+
+
+def test_summary_counts_failures_by_node_and_reason() -> None:
+    results = [
+        EpisodeResult(0, "SUCCESS", "", 60.0, 6.0, 1200),
+        EpisodeResult(1, "FAILURE", "root/grasp: too far", 30.0, 3.0, 600, "Attach"),
+        EpisodeResult(2, "FAILURE", "root/grasp: too far", 31.0, 3.0, 620, "Attach"),
+        EpisodeResult(3, "BUDGET", "time budget of 90 s spent", 90.0, 9.0, 1800, "Navigate"),
+    ]
+    s = summarise(results, EpisodeSpec(tree="t.xml", world="w.yaml"))
+    assert (s.runs, s.successes, s.success_rate) == (4, 1, 0.25)
+    assert s.failures[0] == {"node": "Attach", "reason": "root/grasp: too far", "count": 2}
+    assert s.sim_time["median"] == pytest.approx(45.5)
+    assert s.real_time_factor["median"] == pytest.approx(10.0)
+    assert "success: 1/4 = 25.0 %" in s.text()
