@@ -1,0 +1,10 @@
+"""Robot behaviours for trees: importing this package registers them with the node registry.
+
+Arm: MoveJointsSequentially, MoveJoints, Lift. Gripper: OpenGripper, CloseGripper.
+Attach joints: Attach, Detach. Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove,
+CarriedClear.
+"""
+
+from bt_manip.behaviours import arm, attach, conditions, gripper
+
+__all__ = ["arm", "attach", "conditions", "gripper"]

@@ -61,6 +61,7 @@ class Attachments:
     def __init__(self, world: Any) -> None:
         self.world = world
         self._by_object: dict[str, Attachment] = {}
+        self._touched: dict[str, set[str]] = {}
 
     @property
     def client(self) -> int:
@@ -133,6 +134,7 @@ class Attachments:
         self._by_object[object_name] = Attachment(
             object_name, body, robot_name, robot.body, link_index, link_name, cid
         )
+        self._touched[object_name] = set()
         return AttachResult(True, "", distance)
 
     def detach(self, object_name: str) -> AttachResult:
@@ -142,6 +144,27 @@ class Attachments:
             return AttachResult(False, f"'{object_name}' is not attached")
         pb.removeConstraint(held.constraint_id, physicsClientId=self.client)
         return AttachResult(True)
+
+    def record_contacts(self) -> None:
+        """Note every static body (wall, furniture, floor) an attached object touches now.
+
+        The World calls this after each step while anything is attached.
+        """
+        if not self._by_object:
+            return
+        static = {
+            i.body_id: i.name
+            for i in self.world.infos.values()
+            if i.kind in ("wall", "furniture", "ground")
+        }
+        for held in self._by_object.values():
+            for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=self.client):
+                if pt[2] in static:
+                    self._touched[held.object_name].add(static[pt[2]])
+
+    def touched(self, object_name: str) -> list[str]:
+        """Static bodies ``object_name`` has touched since it was last attached."""
+        return sorted(self._touched.get(object_name, ()))
 
     def is_attached(self, object_name: str, robot_name: str | None = None) -> bool:
         held = self._by_object.get(object_name)

@@ -335,6 +335,7 @@ class World:
             pb.stepSimulation(physicsClientId=self.client)
             self.step_count += 1
             self.clock.t = self.step_count * self.dt
+            self.attachments.record_contacts()
         for listener in self._step_listeners:
             listener(self)
 

@@ -45,7 +45,7 @@ def test_ten_seconds_with_no_commands_leaves_everything_at_rest(path: Path) -> N
             q0 = np.array([j[0] for j in before[name]["joints"]])
             q1 = np.array([j[0] for j in after[name]["joints"]])
             if name in world.robots:
-                arm = world.robots[name].description.arm_joints
+                arm = world.robots[name].description.arm.joints
                 idx = [world.robots[name].joint_index(j) for j in arm]
                 assert np.max(np.abs(q1[idx] - q0[idx])) < 1e-3, f"{name} arm sagged"
 

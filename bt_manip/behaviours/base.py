@@ -1,0 +1,151 @@
+"""What every robot behaviour shares: finding its world and robot, failing with a reason, and
+leaving the robot safe when halted.
+
+A robot behaviour is an :class:`~bt_manip.bt.ActionNode` whose ``robot`` port names a robot of
+the world (empty = the world's only robot). It never raises through the tree: anything that
+prevents the action (no world, unknown robot or object, unreachable target, time-out) makes it
+return FAILURE with the reason in ``feedback_message``, which the console and the run report
+show.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.bt import ActionNode, ConditionNode
+
+ROBOT_PORT = PortInformation(
+    data_type=str,
+    required=False,
+    default_value="",
+    description="robot name in the world (empty: the only robot)",
+)
+
+
+class ActionFailed(Exception):
+    """Raised inside a behaviour to end it with FAILURE and this reason."""
+
+
+class WorldAccess:
+    """Mixin: the world and robot a node acts on, resolved from its ports and context."""
+
+    feedback_message: str
+
+    @property
+    def world(self) -> Any:
+        world = self.context.world  # type: ignore[attr-defined]
+        if world is None:
+            raise ActionFailed("this node needs a world (run with --world)")
+        return world
+
+    def robot(self) -> Any:
+        """The robot named by the ``robot`` port, or the only robot of the world."""
+        robots = self.world.robots
+        name = self.get_input("robot") if "robot" in self.INPUT_PORTS else ""  # type: ignore[attr-defined]
+        if not name:
+            if len(robots) != 1:
+                raise ActionFailed(
+                    f'the world has {len(robots)} robots; say which with robot="..." '
+                    f"({', '.join(robots) or 'none'})"
+                )
+            return next(iter(robots.values()))
+        if name not in robots:
+            raise ActionFailed(f"no robot named '{name}'; robots: {', '.join(robots) or 'none'}")
+        return robots[name]
+
+    def robot_name(self) -> str:
+        robot = self.robot()
+        for name, r in self.world.robots.items():
+            if r is robot:
+                return name
+        return ""
+
+    def object_body(self, name: str) -> int:
+        """PyBullet id of a movable object of the world."""
+        movable = self.world.movable
+        if name not in movable:
+            raise ActionFailed(
+                f"no movable object named '{name}'; objects: {', '.join(sorted(movable)) or 'none'}"
+            )
+        return movable[name]
+
+    def faults(self) -> Any:
+        return self.context.services.get("faults")  # type: ignore[attr-defined]
+
+
+class RobotAction(WorldAccess, ActionNode):
+    """An action on a robot. Subclasses implement :meth:`start` and :meth:`step`.
+
+    - ``start()`` runs when the node starts; raise :class:`ActionFailed` to fail at once.
+    - ``step()`` runs every tick and returns SUCCESS, FAILURE or RUNNING (it may raise
+      :class:`ActionFailed`).
+    - When halted while RUNNING, the robot is left safe (base braked, arm holding) and
+      :meth:`on_halt` runs.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
+
+    def initialise(self) -> None:
+        self.feedback_message = ""
+        self._start_error: str | None = None
+        self.started_at = self.now()
+        try:
+            self.start()
+        except ActionFailed as exc:
+            self._start_error = str(exc)
+
+    def update(self) -> Status:
+        if self._start_error is not None:
+            self.feedback_message = self._start_error
+            return Status.FAILURE
+        try:
+            return self.step()
+        except ActionFailed as exc:
+            self.feedback_message = str(exc)
+            self._make_safe()
+            return Status.FAILURE
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
+            self._make_safe()
+            self.on_halt()
+
+    def _make_safe(self) -> None:
+        try:
+            robot = self.robot()
+        except ActionFailed:
+            return
+        robot.halt()
+
+    def elapsed(self) -> float:
+        """Sim time since the node started."""
+        return self.now() - self.started_at
+
+    # -- for subclasses --------------------------------------------------------------------
+    def start(self) -> None:
+        """Prepare the action (read ports, plan); raise ActionFailed to fail."""
+
+    def step(self) -> Status:
+        """One tick of the action."""
+        raise NotImplementedError
+
+    def on_halt(self) -> None:
+        """Extra clean-up when halted."""
+
+
+class WorldCondition(WorldAccess, ConditionNode):
+    """A condition on the world: :meth:`check` returns (ok, reason when not ok)."""
+
+    def update(self) -> Status:
+        try:
+            ok, reason = self.check()
+        except ActionFailed as exc:
+            ok, reason = False, str(exc)
+        self.feedback_message = "" if ok else reason
+        return Status.SUCCESS if ok else Status.FAILURE
+
+    def check(self) -> tuple[bool, str]:
+        raise NotImplementedError

@@ -1,0 +1,69 @@
+"""Contact checks used by robot behaviours: did the arm, or what it carries, hit something?
+
+"Something" is the static world (walls, furniture) and the floor. Touching movable objects is
+allowed (grasping needs contact), and so is the robot's base touching the floor (its wheels).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import Any
+
+import pybullet as pb
+
+
+@functools.cache
+def _arm_links(client: int, body: int, first_arm_joint: int) -> frozenset[int]:
+    """Links moved by the arm: the first arm joint's child link and everything below it."""
+    parents = {
+        j: pb.getJointInfo(body, j, physicsClientId=client)[16]
+        for j in range(pb.getNumJoints(body, physicsClientId=client))
+    }
+    links = {first_arm_joint}
+    changed = True
+    while changed:
+        changed = False
+        for child, parent in parents.items():
+            if parent in links and child not in links:
+                links.add(child)
+                changed = True
+    return frozenset(links)
+
+
+def arm_link_ids(robot: Any) -> frozenset[int]:
+    """PyBullet link indices of the arm and gripper of ``robot``."""
+    first = robot.joint_index(robot.description.arm.joints[0])
+    return _arm_links(robot.client, robot.body, first)
+
+
+def _static_ids(world: Any) -> dict[int, str]:
+    return {
+        info.body_id: info.name
+        for info in world.infos.values()
+        if info.kind in ("wall", "furniture", "ground")
+    }
+
+
+def arm_collisions(world: Any, robot: Any) -> list[str]:
+    """Descriptions of contacts between the arm (or what it holds) and the static world."""
+    static = _static_ids(world)
+    links = arm_link_ids(robot)
+    found: list[str] = []
+    for pt in pb.getContactPoints(bodyA=robot.body, physicsClientId=world.client):
+        link, other = pt[3], pt[2]
+        if link in links and other in static:
+            found.append(f"{robot.link_name(link)} touched '{static[other]}'")
+    found += carried_collisions(world, robot)
+    return sorted(set(found))
+
+
+def carried_collisions(world: Any, robot: Any, robot_name: str | None = None) -> list[str]:
+    """Contacts between objects attached to ``robot`` and the static world."""
+    static = _static_ids(world)
+    name = robot_name or next((n for n, r in world.robots.items() if r is robot), "")
+    found = []
+    for held in world.attachments.held_by(name):
+        for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=world.client):
+            if pt[2] in static:
+                found.append(f"carried '{held.object_name}' touched '{static[pt[2]]}'")
+    return sorted(set(found))

@@ -1,0 +1,125 @@
+"""Conditions on the world: attachments, grasps, where objects are, what they touched."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import pybullet as pb
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
+from bt_manip.behaviours.gripper import held_object
+from bt_manip.bt import registry
+
+OBJECT = PortInformation(str, True, "name of a movable object of the world")
+
+
+@registry.register
+class IsAttached(WorldCondition):
+    """SUCCESS when ``object`` is held by an attach joint (of ``robot``, if given), else FAILURE."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT, "robot": ROBOT_PORT}
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        self.object_body(name)
+        robot = self.get_input("robot") or None
+        if self.world.attachments.is_attached(name, robot):
+            return True, ""
+        return False, f"'{name}' is not attached" + (f" to {robot}" if robot else "")
+
+
+@registry.register
+class IsHolding(WorldCondition):
+    """SUCCESS when the gripper holds ``object`` (every finger touches it, or it is attached);
+    with ``object`` empty, when it holds anything. FAILURE otherwise."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "object": PortInformation(str, False, "object name (empty: any object)", ""),
+        "robot": ROBOT_PORT,
+    }
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        robot = self.robot()
+        if name:
+            body = self.object_body(name)
+            if robot.is_grasping(body) or self.world.attachments.is_attached(name):
+                return True, ""
+            return False, f"the gripper does not hold '{name}'"
+        if held_object(self.world, robot) or self.world.attachments.held_by(self.robot_name()):
+            return True, ""
+        return False, "the gripper holds nothing"
+
+
+@registry.register
+class ObjectInRegion(WorldCondition):
+    """SUCCESS when the centre of ``object`` lies in a box region, else FAILURE.
+
+    The region is either ``inside``, the name of a body (its bounding box, e.g. a bin), or
+    ``min``/``max`` corners as ``x;y;z``.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "object": OBJECT,
+        "inside": PortInformation(str, False, "body whose bounding box is the region", ""),
+        "min": PortInformation(list[float], False, "lower corner x;y;z", []),
+        "max": PortInformation(list[float], False, "upper corner x;y;z", []),
+    }
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        body = self.object_body(name)
+        world = self.world
+        inside = self.get_input("inside")
+        if inside:
+            lo, hi = pb.getAABB(world.body_id(inside), physicsClientId=world.client)
+            region = f"'{inside}'"
+        else:
+            lo, hi = self.get_input("min"), self.get_input("max")
+            if len(lo) != 3 or len(hi) != 3:
+                raise ActionFailed('give inside="body" or min="x;y;z" and max="x;y;z"')
+            region = f"[{lo}, {hi}]"
+        pos, _ = pb.getBasePositionAndOrientation(body, physicsClientId=world.client)
+        if all(lo[i] <= pos[i] <= hi[i] for i in range(3)):
+            return True, ""
+        where = ", ".join(f"{v:.3f}" for v in pos)
+        return False, f"'{name}' at ({where}) is not in {region}"
+
+
+@registry.register
+class ObjectAbove(WorldCondition):
+    """SUCCESS when the lowest point of ``object`` is at least ``height`` m above the floor."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "object": OBJECT,
+        "height": PortInformation(float, False, "clearance above the floor (m)", 0.1),
+    }
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        body = self.object_body(name)
+        lo, _ = pb.getAABB(body, physicsClientId=self.world.client)
+        need = float(self.get_input("height"))
+        if lo[2] >= need:
+            return True, ""
+        return False, f"'{name}' is {lo[2]:.3f} m above the floor, less than {need:g} m"
+
+
+@registry.register
+class CarriedClear(WorldCondition):
+    """SUCCESS when ``object`` has touched no wall, furniture or floor while attached, since
+    it was last attached; FAILURE naming what it touched (or when it is not attached)."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT}
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        self.object_body(name)
+        attachments = self.world.attachments
+        if not attachments.is_attached(name):
+            return False, f"'{name}' is not attached"
+        touched = attachments.touched(name)
+        if touched:
+            return False, f"'{name}' touched {', '.join(touched)} while carried"
+        return True, ""

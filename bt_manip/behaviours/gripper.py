@@ -1,0 +1,111 @@
+"""Gripper behaviours: open and close the parallel fingers under position control."""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ActionFailed, RobotAction
+from bt_manip.bt import registry
+
+SETTLED_SPEED = 0.002
+"""The fingers count as stopped when the opening changes by less than this per tick (m)."""
+
+
+def held_object(world: Any, robot: Any) -> str:
+    """Name of the movable object every finger touches, or ''."""
+    for name, body in world.movable.items():
+        if robot.is_grasping(body):
+            return name
+    return ""
+
+
+class _GripperMove(RobotAction):
+    """Command an opening, then wait until the fingers stop moving."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **RobotAction.INPUT_PORTS,
+        "timeout": PortInformation(float, False, "sim seconds allowed", 3.0),
+    }
+
+    def target(self, robot: Any) -> float:
+        raise NotImplementedError
+
+    def start(self) -> None:
+        robot = self.robot()
+        self.goal = self.target(robot)
+        robot.set_gripper(self.goal)
+        self.last = robot.gripper_opening()
+        self.still_ticks = 0
+
+    def step(self) -> Status:
+        robot = self.robot()
+        opening = robot.gripper_opening()
+        moved = abs(opening - self.last)
+        self.last = opening
+        self.still_ticks = self.still_ticks + 1 if moved < SETTLED_SPEED else 0
+        if self.still_ticks >= 3 and self.elapsed() > 0.2:
+            return self.finished(robot, opening)
+        if self.elapsed() > float(self.get_input("timeout")):
+            raise ActionFailed(
+                f"fingers still moving after {self.get_input('timeout')} s "
+                f"(opening {opening * 1000:.0f} mm, target {self.goal * 1000:.0f} mm)"
+            )
+        return Status.RUNNING
+
+    def finished(self, robot: Any, opening: float) -> Status:
+        return Status.SUCCESS
+
+
+@registry.register
+class OpenGripper(_GripperMove):
+    """Opens the gripper (fully, or to ``opening`` metres between the pads).
+
+    - RUNNING while the fingers move; SUCCESS once they have stopped;
+    - FAILURE if they are still moving after ``timeout`` s.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **_GripperMove.INPUT_PORTS,
+        "opening": PortInformation(float, False, "opening between the pads (m); -1 = fully", -1.0),
+    }
+
+    def target(self, robot: Any) -> float:
+        value = float(self.get_input("opening"))
+        return robot.description.gripper.max_opening if value < 0 else value
+
+
+@registry.register
+class CloseGripper(_GripperMove):
+    """Closes the gripper (fully, or to ``opening`` metres) and reports what it holds.
+
+    - RUNNING while the fingers close; SUCCESS once they have stopped, with ``holding`` set to
+      whether an object is between the fingers (both touch it) and ``object`` to its name;
+    - FAILURE if ``require_object`` is true and the fingers closed on nothing, or on a time-out.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **_GripperMove.INPUT_PORTS,
+        "opening": PortInformation(float, False, "target opening (m); -1 = fully closed", -1.0),
+        "require_object": PortInformation(
+            bool, False, "fail when nothing is between the fingers", False
+        ),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "holding": PortInformation(bool, False, "an object is between the fingers"),
+        "object": PortInformation(str, False, "name of the object between the fingers"),
+    }
+
+    def target(self, robot: Any) -> float:
+        value = float(self.get_input("opening"))
+        return robot.description.gripper.min_opening if value < 0 else value
+
+    def finished(self, robot: Any, opening: float) -> Status:
+        name = held_object(self.world, robot)
+        self.set_output("holding", bool(name))
+        self.set_output("object", name)
+        if not name and self.get_input("require_object"):
+            raise ActionFailed(f"closed on nothing (opening {opening * 1000:.0f} mm)")
+        return Status.SUCCESS
