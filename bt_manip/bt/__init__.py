@@ -1,0 +1,50 @@
+"""Behaviour-tree layer: BehaviorTree.CPP v4 XML, built-in nodes and semantics, on py_trees.
+
+Public API::
+
+    from bt_manip.bt import load_tree, validate_file, Tree, TreeContext, registry, to_xml
+    from bt_manip.bt import ActionNode, ConditionNode   # base classes for robot behaviours
+"""
+
+from bt_manip.bt import controls, decorators, leaves  # noqa: F401  (register the built-ins)
+from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.context import TreeContext
+from bt_manip.bt.node import (
+    ActionNode,
+    BtNode,
+    ConditionNode,
+    ControlNode,
+    DecoratorNode,
+    PortError,
+    TreeRuntimeError,
+)
+from bt_manip.bt.ports import InOutPortInformation
+from bt_manip.bt.registry import registry
+from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.subtree import SubTree
+from bt_manip.bt.tree import NodeRecord, Tree
+from bt_manip.bt.xml_loader import load_tree, load_tree_string, validate, validate_file
+from bt_manip.bt.xml_writer import to_xml
+
+__all__ = [
+    "ActionNode",
+    "Blackboard",
+    "BtNode",
+    "ConditionNode",
+    "ControlNode",
+    "DecoratorNode",
+    "InOutPortInformation",
+    "NodeRecord",
+    "NodeStatus",
+    "PortError",
+    "SubTree",
+    "Tree",
+    "TreeContext",
+    "TreeRuntimeError",
+    "load_tree",
+    "load_tree_string",
+    "registry",
+    "to_xml",
+    "validate",
+    "validate_file",
+]

@@ -1,0 +1,127 @@
+"""The ``validate``, ``show`` and ``nodes`` sub-commands of ``bt-manip``.
+
+``add_verbs(subparsers)`` adds them to an argparse parser; each sets ``func=handler`` where
+``handler(args) -> int`` returns the exit code (0 fine, 2 bad input).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Iterable
+
+from bt_manip.bt.display import render_dot, render_tree
+from bt_manip.bt.models import write_models
+from bt_manip.bt.registry import registry
+from bt_manip.bt.xml_loader import load_tree, validate
+from bt_manip.errors import InputError, Problem
+
+PLUGIN_PACKAGES = ("bt_manip.behaviours",)
+
+
+def load_plugins(extra: Iterable[str] = ()) -> list[Problem]:
+    """Import the modules that register non-built-in nodes; problems for those that fail."""
+    problems = []
+    for module in (*PLUGIN_PACKAGES, *extra):
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError as e:
+            if module in PLUGIN_PACKAGES and e.name == module:
+                continue
+            problems.append(Problem(module, None, f"cannot import module: {e}"))
+    return problems
+
+
+def _print_problems(problems: Iterable[Problem]) -> None:
+    for problem in problems:
+        print(str(problem), file=sys.stderr)
+
+
+def _common(parser: argparse.ArgumentParser, models: bool = True) -> None:
+    if models:
+        parser.add_argument("--models", nargs="+", action="extend", default=[], metavar="FILE",
+                            help="TreeNodesModel files declaring nodes not implemented here")
+    parser.add_argument("--import", dest="imports", action="append", default=[],
+                        metavar="MODULE", help="import MODULE to register its nodes")
+
+
+def add_verbs(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Add ``validate``, ``show`` and ``nodes`` to ``subparsers``."""
+    p = subparsers.add_parser("validate", help="check tree files without running them",
+                              description="Check everything loading checks and report ALL "
+                                          "problems, each as file:line: message.")
+    p.add_argument("trees", nargs="+", metavar="TREE.xml")
+    p.add_argument("--tree-id", default=None, help="main tree to check (default: the file's)")
+    _common(p)
+    p.set_defaults(func=validate_command)
+
+    p = subparsers.add_parser("show", help="print a tree as text (and Graphviz with --dot)")
+    p.add_argument("tree", metavar="TREE.xml")
+    p.add_argument("--tree-id", default=None)
+    p.add_argument("--dot", metavar="FILE", default=None, help="write Graphviz source to FILE")
+    _common(p)
+    p.set_defaults(func=show_command)
+
+    p = subparsers.add_parser("nodes", help="list registered nodes, or export a TreeNodesModel")
+    p.add_argument("--groot", action="store_true",
+                   help="print a TreeNodesModel of every registered non-built-in node (Groot2)")
+    p.add_argument("--builtins", action="store_true",
+                   help="with --groot, also include the BT.CPP built-ins")
+    _common(p, models=False)
+    p.set_defaults(func=nodes_command)
+
+
+def validate_command(args: argparse.Namespace) -> int:
+    failures = load_plugins(args.imports)
+    if failures:
+        _print_problems(failures)
+        return 2
+    status = 0
+    for path in args.trees:
+        problems, warnings = validate(path, args.models, args.tree_id)
+        _print_problems(warnings)
+        if problems:
+            _print_problems(problems)
+            status = 2
+        else:
+            print(f"{path}: OK")
+    return status
+
+
+def show_command(args: argparse.Namespace) -> int:
+    failures = load_plugins(args.imports)
+    if failures:
+        _print_problems(failures)
+        return 2
+    try:
+        tree = load_tree(args.tree, args.tree_id, args.models, placeholders=True)
+    except InputError as e:
+        _print_problems(e.problems)
+        return 2
+    _print_problems(getattr(tree, "warnings", []))
+    print(render_tree(tree))
+    if args.dot:
+        try:
+            with open(args.dot, "w", encoding="utf-8") as f:
+                f.write(render_dot(tree))
+        except OSError as e:
+            _print_problems([Problem(args.dot, None, f"cannot write: {e.strerror}")])
+            return 2
+    return 0
+
+
+def nodes_command(args: argparse.Namespace) -> int:
+    failures = load_plugins(args.imports)
+    if failures:
+        _print_problems(failures)
+        return 2
+    if args.groot:
+        classes = registry.classes(None if args.builtins else False)
+        sys.stdout.write(write_models(classes))
+        return 0
+    for cls in registry.classes():
+        tag = "built-in" if registry.is_builtin(cls.NODE_ID) else "custom"
+        ports = [*cls.INPUT_PORTS, *cls.OUTPUT_PORTS]
+        print(f"{cls.NODE_ID:<26} {cls.KIND:<10} {tag:<9} {', '.join(ports)}")
+    return 0

@@ -1,0 +1,359 @@
+"""BehaviorTree.CPP v4 decorators (one child each), with BT.CPP's semantics.
+
+Durations (Timeout, Delay) read the tree's clock (``TreeContext.clock``): the simulation clock
+when a world is loaded, so they are deterministic and as fast as physics allows.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+from py_trees.ports import PortInformation
+
+from bt_manip.bt.node import BtNode, DecoratorNode
+from bt_manip.bt.ports import Ref
+from bt_manip.bt.registry import registry
+from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
+from bt_manip.bt.status import NodeStatus
+
+RUNNING = NodeStatus.RUNNING
+SUCCESS = NodeStatus.SUCCESS
+FAILURE = NodeStatus.FAILURE
+SKIPPED = NodeStatus.SKIPPED
+TIME_EPS = 1e-9  # seconds: tolerance when comparing clock readings
+
+
+class _Decorator(DecoratorNode):
+    def _start(self) -> None:
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+
+
+@registry.register(builtin=True)
+class Inverter(_Decorator):
+    """Child SUCCESS gives FAILURE and FAILURE gives SUCCESS; RUNNING and SKIPPED pass through."""
+
+    def tick_node(self) -> NodeStatus:
+        self._start()
+        status = self.child.execute_tick()
+        if status is SUCCESS:
+            self.reset_child()
+            return FAILURE
+        if status is FAILURE:
+            self.reset_child()
+            return SUCCESS
+        return status
+
+
+class _Force(_Decorator):
+    RESULT = SUCCESS
+
+    def tick_node(self) -> NodeStatus:
+        self._start()
+        status = self.child.execute_tick()
+        if status.completed:
+            self.reset_child()
+            return self.RESULT
+        return status
+
+
+@registry.register(builtin=True)
+class ForceSuccess(_Force):
+    """Returns SUCCESS when the child finishes (SUCCESS or FAILURE); RUNNING passes through."""
+
+
+@registry.register(builtin=True)
+class ForceFailure(_Force):
+    """Returns FAILURE when the child finishes (SUCCESS or FAILURE); RUNNING passes through."""
+
+    RESULT = FAILURE
+
+
+@registry.register(builtin=True)
+class Repeat(_Decorator):
+    """Ticks the child up to ``num_cycles`` times in a row (-1: forever) while it succeeds.
+
+    The loop runs within one tick while the child finishes synchronously; a RUNNING child
+    returns RUNNING and the loop resumes at the next tick. A child FAILURE stops the loop and
+    returns FAILURE; after ``num_cycles`` successes the node returns SUCCESS. A SKIPPED child
+    makes the node SKIPPED (the count is kept).
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "num_cycles": PortInformation(
+            int, description="repeat a successful child N times; -1 repeats forever"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.count = 0
+
+    def tick_node(self) -> NodeStatus:
+        cycles = self.get_input("num_cycles")
+        loop = self.count < cycles or cycles == -1
+        self._start()
+        while loop:
+            status = self.child.execute_tick()
+            if status is SUCCESS:
+                self.count += 1
+                loop = self.count < cycles or cycles == -1
+                self.reset_child()
+            elif status is FAILURE:
+                self.count = 0
+                self.reset_child()
+                return FAILURE
+            elif status is RUNNING:
+                return RUNNING
+            else:
+                self.reset_child()
+                return SKIPPED
+        self.count = 0
+        return SUCCESS
+
+    def halt(self) -> None:
+        self.count = 0
+        super().halt()
+
+
+@registry.register(builtin=True)
+class RetryUntilSuccessful(_Decorator):
+    """Ticks the child again after a FAILURE, up to ``num_attempts`` times (-1: forever).
+
+    Retries happen within the same tick while the child fails synchronously; a RUNNING child
+    returns RUNNING. Child SUCCESS returns SUCCESS; after ``num_attempts`` failures the node
+    returns FAILURE. A SKIPPED child makes the node SKIPPED.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "num_attempts": PortInformation(
+            int, description="try the child up to N times; -1 tries forever"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.tries = 0
+
+    def tick_node(self) -> NodeStatus:
+        attempts = self.get_input("num_attempts")
+        loop = self.tries < attempts or attempts == -1
+        self._start()
+        while loop:
+            status = self.child.execute_tick()
+            if status is SUCCESS:
+                self.tries = 0
+                self.reset_child()
+                return SUCCESS
+            if status is FAILURE:
+                self.tries += 1
+                attempts = self.get_input("num_attempts")
+                loop = self.tries < attempts or attempts == -1
+                self.reset_child()
+            elif status is RUNNING:
+                return RUNNING
+            else:
+                self.reset_child()
+                return SKIPPED
+        self.tries = 0
+        return FAILURE
+
+    def halt(self) -> None:
+        self.tries = 0
+        super().halt()
+
+
+@registry.register(builtin=True)
+class KeepRunningUntilFailure(_Decorator):
+    """Returns RUNNING while the child succeeds or runs (restarting it), FAILURE when it fails."""
+
+    def tick_node(self) -> NodeStatus:
+        self._start()
+        status = self.child.execute_tick()
+        if status is FAILURE:
+            self.reset_child()
+            return FAILURE
+        if status is SUCCESS:
+            self.reset_child()
+        return RUNNING
+
+
+@registry.register(builtin=True)
+class Timeout(_Decorator):
+    """Halts the child and returns FAILURE when it has been RUNNING for ``msec`` milliseconds.
+
+    The time starts at the first tick; a child that finishes earlier returns its status. With
+    ``msec`` 0 there is no time limit.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "msec": PortInformation(
+            int, description="after this many milliseconds, halt the child if still running"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self._deadline: float | None = None
+        self._started = False
+
+    def tick_node(self) -> NodeStatus:
+        msec = self.get_input("msec")
+        if not self._started:
+            self._started = True
+            self._start()
+            self._deadline = self.now() + msec / 1000.0 if msec > 0 else None
+        if (self._deadline is not None and self.now() >= self._deadline - TIME_EPS
+                and self.child.bt_status is RUNNING):
+            self.reset_child()
+            self._started = False
+            self.feedback_message = f"timed out after {msec} ms"
+            return FAILURE
+        status = self.child.execute_tick()
+        if status.completed:
+            self._started = False
+            self.reset_child()
+        return status
+
+    def halt(self) -> None:
+        self._started = False
+        super().halt()
+
+
+@registry.register(builtin=True)
+class Delay(_Decorator):
+    """Waits ``delay_msec`` milliseconds (returning RUNNING), then ticks the child.
+
+    The wait starts at the first tick; once it is over, the child's status is returned and the
+    next start waits again.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "delay_msec": PortInformation(
+            int, description="milliseconds to wait before ticking the child"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self._started = False
+        self._start_time = 0.0
+
+    def tick_node(self) -> NodeStatus:
+        delay = self.get_input("delay_msec")
+        if not self._started:
+            self._started = True
+            self._start()
+            self._start_time = self.now()
+        if self.now() - self._start_time >= delay / 1000.0 - TIME_EPS:
+            status = self.child.execute_tick()
+            if status.completed:
+                self._started = False
+                self.reset_child()
+            return status
+        return RUNNING
+
+    def halt(self) -> None:
+        self._started = False
+        super().halt()
+
+
+@registry.register(builtin=True)
+class RunOnce(_Decorator):
+    """Ticks the child until it finishes once; afterwards never ticks it again.
+
+    After that first run the node is SKIPPED if ``then_skip`` is true (default), otherwise it
+    returns the child's remembered status forever.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "then_skip": PortInformation(
+            bool, required=False, default_value=True,
+            description="if true, skip after the first execution, otherwise return the "
+                        "status the child returned then"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self._done = False
+        self._returned = NodeStatus.IDLE
+
+    def tick_node(self) -> NodeStatus:
+        skip = self.get_input("then_skip")
+        if self._done:
+            return SKIPPED if skip else self._returned
+        self._start()
+        status = self.child.execute_tick()
+        if status.completed:
+            self._done = True
+            self._returned = status
+            self.reset_child()
+        return status
+
+
+class _ScriptHolder:
+    """Parses a script port once, or again when a referenced script text changes."""
+
+    def __init__(self) -> None:
+        self._text: str | None = None
+        self._script: Script | None = None
+
+    def get(self, node: BtNode, port: str) -> Script:
+        binding = node.bindings.get(port)
+        if not isinstance(binding, Ref):
+            return node.get_input(port)
+        text = str(node.get_input(port))
+        if text != self._text or self._script is None:
+            try:
+                self._script = parse_script(text)
+            except ScriptSyntaxError as e:
+                from bt_manip.bt.node import TreeRuntimeError
+
+                raise TreeRuntimeError(
+                    f"{node.describe()}: script in '{port}' (column {e.column}): {e.message}"
+                ) from None
+            self._text = text
+        return self._script
+
+
+@registry.register(builtin=True)
+class Precondition(_Decorator):
+    """Ticks the child only if the script ``if`` is true; otherwise returns ``else``.
+
+    The condition is evaluated when the child is not already running; once the child started
+    it is ticked until it finishes, then the node returns the child's status.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "if": PortInformation(str, description="script: the condition"),
+        "else": PortInformation(
+            NodeStatus, required=False, default_value=NodeStatus.FAILURE,
+            description="status returned when the condition is false"),
+    }
+    SCRIPT_PORTS = ("if",)
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self._child_running = False
+        self._script = _ScriptHolder()
+
+    def tick_node(self) -> NodeStatus:
+        otherwise = self.get_input("else")
+        if not self._child_running:
+            script = self._script.get(self, "if")
+            from bt_manip.bt.node import _truth
+
+            self._child_running = _truth(self, "if", script)
+        if not self._child_running:
+            return otherwise
+        status = self.child.execute_tick()
+        if status.completed:
+            self.reset_child()
+            self._child_running = False
+        return status
+
+    def halt(self) -> None:
+        self._child_running = False
+        super().halt()

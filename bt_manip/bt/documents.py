@@ -1,0 +1,147 @@
+"""Reading BT.CPP v4 XML documents: ``<root>``, ``<include>``, trees and node models.
+
+:func:`read_document` gathers every ``<BehaviorTree>`` and ``<TreeNodesModel>`` of a file and
+of the files it includes (paths relative to the including file, recursively, cycles refused),
+collecting every problem instead of stopping at the first one.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from bt_manip.bt.models import NodeSpec, read_models
+from bt_manip.bt.xml_parse import Element, XmlError, parse_xml_file, parse_xml_text
+from bt_manip.errors import Problem
+
+
+@dataclass
+class TreeDef:
+    tree_id: str
+    element: Element
+    file: str
+
+
+@dataclass
+class Document:
+    file: str
+    trees: dict[str, TreeDef] = field(default_factory=dict)
+    models: dict[str, NodeSpec] = field(default_factory=dict)
+    main_tree: str | None = None
+    root_line: int = 1
+    problems: list[Problem] = field(default_factory=list)
+    warnings: list[Problem] = field(default_factory=list)
+
+
+def read_document(path: str, text: str | None = None) -> Document:
+    """Read ``path`` (or ``text`` named ``path``) and its includes."""
+    doc = Document(path)
+    _read_into(doc, path, text, stack=(), top=True)
+    return doc
+
+
+def read_model_file(path: str, doc: Document) -> None:
+    """Add the TreeNodesModel declarations of ``path`` to ``doc``."""
+    try:
+        root = parse_xml_file(path)
+    except XmlError as e:
+        doc.problems.append(e.problem)
+        return
+    found = False
+    candidates = [root] if root.tag == "TreeNodesModel" else root.children
+    for element in candidates:
+        if element.tag == "TreeNodesModel":
+            found = True
+            _merge_models(doc, element, path)
+    if not found:
+        doc.problems.append(Problem(path, root.line,
+                                    "no <TreeNodesModel> found; a model file looks like "
+                                    "<root BTCPP_format=\"4\"><TreeNodesModel>...</root>"))
+
+
+def _merge_models(doc: Document, element: Element, file: str) -> None:
+    specs, problems = read_models(element, file)
+    doc.problems.extend(problems)
+    for node_id, spec in specs.items():
+        doc.models.setdefault(node_id, spec)
+
+
+def _read_into(doc: Document, path: str, text: str | None, stack: tuple[str, ...],
+               top: bool) -> None:
+    try:
+        root = parse_xml_text(text, path) if text is not None else parse_xml_file(path)
+    except XmlError as e:
+        doc.problems.append(e.problem)
+        return
+    if root.tag != "root":
+        doc.problems.append(Problem(path, root.line,
+                                    f"the top element must be <root BTCPP_format=\"4\">, "
+                                    f"found <{root.tag}>"))
+        return
+    fmt = root.get("BTCPP_format")
+    if fmt is None:
+        doc.warnings.append(Problem(path, root.line,
+                                    "warning: <root> has no BTCPP_format attribute; reading it "
+                                    "as BTCPP_format=\"4\""))
+    elif fmt.strip() != "4":
+        doc.problems.append(Problem(path, root.line,
+                                    f"BTCPP_format=\"{fmt}\" is not supported; this loader reads "
+                                    "BehaviorTree.CPP version 4 files (BTCPP_format=\"4\")"))
+    if top:
+        doc.main_tree = root.get("main_tree_to_execute")
+        doc.root_line = root.line
+    here = os.path.realpath(path) if text is None else path
+    for child in root.children:
+        if child.tag == "include":
+            _include(doc, path, child, (*stack, here))
+        elif child.tag == "BehaviorTree":
+            _add_tree(doc, path, child)
+        elif child.tag == "TreeNodesModel":
+            _merge_models(doc, child, path)
+        else:
+            doc.problems.append(Problem(path, child.line,
+                                        f"unexpected element <{child.tag}> under <root>; "
+                                        "expected <BehaviorTree>, <include> or <TreeNodesModel>"))
+
+
+def _include(doc: Document, path: str, element: Element, stack: tuple[str, ...]) -> None:
+    target = element.get("path")
+    if element.get("ros_pkg") is not None:
+        doc.problems.append(Problem(path, element.line,
+                                    "<include ros_pkg=...> needs ROS; give a path relative to "
+                                    "this file instead"))
+        return
+    if not target:
+        doc.problems.append(Problem(path, element.line,
+                                    "<include> needs a path attribute, e.g. "
+                                    "<include path=\"subtrees.xml\"/>"))
+        return
+    base = os.path.dirname(os.path.abspath(path)) if os.path.exists(path) else os.getcwd()
+    resolved = os.path.normpath(os.path.join(base, target))
+    if not os.path.isfile(resolved):
+        doc.problems.append(Problem(path, element.line,
+                                    f"included file '{target}' not found (looked for "
+                                    f"{resolved}); the path is relative to the including file"))
+        return
+    real = os.path.realpath(resolved)
+    if real in stack:
+        chain = " -> ".join(os.path.basename(p) for p in (*stack, real))
+        doc.problems.append(Problem(path, element.line, f"include cycle: {chain}; remove one of "
+                                                        "these includes"))
+        return
+    _read_into(doc, resolved, None, stack, top=False)
+
+
+def _add_tree(doc: Document, path: str, element: Element) -> None:
+    tree_id = element.get("ID")
+    if not tree_id:
+        doc.problems.append(Problem(path, element.line,
+                                    "<BehaviorTree> needs an ID, e.g. <BehaviorTree ID=\"Main\">"))
+        return
+    if tree_id in doc.trees:
+        other = doc.trees[tree_id]
+        doc.problems.append(Problem(path, element.line,
+                                    f"BehaviorTree '{tree_id}' is defined twice (also at "
+                                    f"{other.file}:{other.element.line}); rename one"))
+        return
+    doc.trees[tree_id] = TreeDef(tree_id, element, path)

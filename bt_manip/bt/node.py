@@ -1,0 +1,501 @@
+"""Base classes of every bt-manip node, with BehaviorTree.CPP's tick protocol.
+
+Each node is a py_trees behaviour with typed ports declared through py_trees'
+``PortsMixin``/``PortInformation`` (class attributes ``INPUT_PORTS`` and ``OUTPUT_PORTS``), so one
+class serves XML loading, Python authoring, validation and the TreeNodesModel export.
+
+Ticking follows BT.CPP (``TreeNode::executeTick``):
+
+1. pre-condition attributes are checked: when the node is IDLE, ``_failureIf``, ``_successIf``
+   and ``_skipIf`` (in this order) may decide its status without ticking it, and a false
+   ``_while`` skips it; when it is RUNNING, a false ``_while`` halts it and it is SKIPPED;
+2. otherwise the node's own logic runs (``update()`` for leaves);
+3. on SUCCESS or FAILURE, ``_onSuccess`` or ``_onFailure`` then ``_post`` run;
+4. a SKIPPED node keeps its IDLE status but tells its parent it was skipped.
+
+Halting a RUNNING node calls its ``terminate(INVALID)`` exactly once, then ``_onHalted``.
+
+Subclass :class:`ActionNode` or :class:`ConditionNode` for leaves: implement ``update()`` (and
+``initialise()``/``terminate()`` as in py_trees), read ports with :meth:`BtNode.get_input`, write
+them with :meth:`BtNode.set_output`, and put a failure reason in ``feedback_message``.
+"""
+
+from __future__ import annotations
+
+import copy
+import difflib
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import py_trees
+from py_trees.common import Status
+from py_trees.ports import PortInformation, PortsMixin
+
+from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.context import TreeContext
+from bt_manip.bt.ports import (
+    Binding,
+    InOutPortInformation,
+    Literal,
+    Ref,
+    convert_literal,
+    format_literal,
+    parse_reference,
+)
+from bt_manip.bt.script import Script, ScriptRuntimeError, ScriptSyntaxError, parse_script
+from bt_manip.bt.status import NodeStatus
+
+PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
+POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
+IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
+
+_MISSING = object()
+_RUNNING = Status.RUNNING
+_PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
+_BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
+
+
+class TreeRuntimeError(RuntimeError):
+    """A tree cannot go on: a script failed, a port has no value, a node misbehaved."""
+
+
+class PortError(TreeRuntimeError):
+    """An input port has no usable value, or an output port cannot be written."""
+
+
+@dataclass
+class AttributeCheck:
+    """Result of checking a node's attributes against its class."""
+
+    bindings: dict[str, Binding] = field(default_factory=dict)
+    texts: dict[str, str] = field(default_factory=dict)
+    pre: list[tuple[str, Script]] = field(default_factory=list)
+    post: dict[str, Script] = field(default_factory=dict)
+    errors: list[tuple[str, int | None]] = field(default_factory=list)  # (message, column)
+
+
+def closest(word: str, choices: list[str] | set[str], n: int = 3) -> str:
+    """' (did you mean 'a', 'b'?)' or '' when nothing is close."""
+    matches = difflib.get_close_matches(word, sorted(choices), n=n, cutoff=0.5)
+    if not matches:
+        return ""
+    return " (did you mean " + ", ".join(f"'{m}'" for m in matches) + "?)"
+
+
+def parse_condition_scripts(
+    attributes: Mapping[str, Any], check: AttributeCheck, where: str
+) -> None:
+    """Parse the ``_skipIf``... attributes present in ``attributes`` into ``check``."""
+    for key in PRE_CONDITIONS + POST_CONDITIONS:
+        if key not in attributes:
+            continue
+        code = str(attributes[key])
+        check.texts[key] = code
+        try:
+            script = parse_script(code)
+        except ScriptSyntaxError as e:
+            check.errors.append((f"script syntax error in {key} of {where}: {e.message}", e.column))
+            continue
+        if key in PRE_CONDITIONS:
+            check.pre.append((key, script))
+        else:
+            check.post[key] = script
+    check.pre.sort(key=lambda item: PRE_CONDITIONS.index(item[0]))
+
+
+class BtNode(PortsMixin):
+    """Mixin giving a py_trees behaviour BT.CPP's node protocol (see the module docstring)."""
+
+    NODE_ID: ClassVar[str] = ""
+    KIND: ClassVar[str] = "Action"
+    DESCRIPTION: ClassVar[str] = ""
+    MIN_CHILDREN: ClassVar[int] = 0
+    MAX_CHILDREN: ClassVar[int | None] = 0
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
+        super().__init_subclass__(**kwargs)
+        if "NODE_ID" not in cls.__dict__:
+            cls.NODE_ID = cls.__name__
+
+    # ------------------------------------------------------------------ construction
+
+    @classmethod
+    def port_info(cls, port: str) -> PortInformation | None:
+        return cls.INPUT_PORTS.get(port) or cls.OUTPUT_PORTS.get(port)
+
+    @classmethod
+    def check_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
+        """Check and convert ``attributes`` (XML text or Python values) for this class."""
+        check = AttributeCheck()
+        where = f"{cls.NODE_ID}"
+        parse_condition_scripts(attributes, check, where)
+        ports = set(cls.INPUT_PORTS) | set(cls.OUTPUT_PORTS)
+        for key, value in attributes.items():
+            if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+                continue
+            info = cls.port_info(key)
+            if info is None:
+                known = ", ".join(sorted(ports)) if ports else "none"
+                check.errors.append(
+                    (f"'{key}' is not a port of {cls.NODE_ID}{closest(key, ports)}; "
+                     f"its ports are: {known}", None))
+                continue
+            cls._bind_port(key, value, info, check)
+        for port, info in cls.INPUT_PORTS.items():
+            if port not in attributes and info.required and not info.has_default:
+                check.errors.append(
+                    (f"{cls.NODE_ID} is missing its required port '{port}'"
+                     f"{_describe(info)}; add {port}=\"...\"", None))
+        return check
+
+    @classmethod
+    def _bind_port(
+        cls, port: str, value: Any, info: PortInformation, check: AttributeCheck
+    ) -> None:
+        is_output = port in cls.OUTPUT_PORTS
+        if isinstance(value, (Ref, Literal)):
+            check.bindings[port] = value
+            check.texts[port] = (
+                "{" + value.key + "}" if isinstance(value, Ref) else format_literal(value.value))
+            return
+        if isinstance(value, str):
+            key = parse_reference(value)
+            if key is not None:
+                if key in ("=", ""):
+                    key = port
+                check.bindings[port] = Ref(key)
+                check.texts[port] = value
+                return
+            if is_output and not isinstance(info, InOutPortInformation):
+                check.errors.append(
+                    (f"output port '{port}' of {cls.NODE_ID} must be a blackboard reference "
+                     f"like \"{{{port}}}\", got '{value}'", None))
+                return
+            if port in cls.SCRIPT_PORTS:
+                try:
+                    script = parse_script(value)
+                except ScriptSyntaxError as e:
+                    check.errors.append(
+                        (f"script syntax error in {port} of {cls.NODE_ID}: {e.message}", e.column))
+                    return
+                check.bindings[port] = Literal(script)
+                check.texts[port] = value
+                return
+            try:
+                converted = convert_literal(value, info.data_type)
+            except ValueError as e:
+                check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {e}", None))
+                return
+            check.bindings[port] = Literal(converted)
+            check.texts[port] = value
+            return
+        check.bindings[port] = Literal(value)
+        check.texts[port] = format_literal(value)
+
+    def _init_node(self, attributes: Mapping[str, Any]) -> None:
+        check = type(self).check_attributes(attributes)
+        if check.errors:
+            raise ValueError("; ".join(msg for msg, _ in check.errors))
+        self.bindings: dict[str, Binding] = check.bindings
+        self.attribute_texts: dict[str, str] = check.texts
+        self._pre: list[tuple[str, Script]] = check.pre
+        self._post: dict[str, Script] = check.post
+        self.bt_status = NodeStatus.IDLE
+        self.last_status = NodeStatus.IDLE  # what the node last returned, kept after resets
+        self.blackboard = Blackboard()
+        self.context = TreeContext()
+        self.xml_file: str | None = None
+        self.xml_line: int | None = None
+
+    # ------------------------------------------------------------------ ports
+
+    def get_input(self, port_name: str, default: Any = _MISSING) -> Any:
+        """Value of an input port, converted to the port type, references resolved.
+
+        Without a value (port not given and no declared default, or a reference to a missing
+        blackboard entry) returns ``default`` if given, else raises :class:`PortError`.
+        """
+        info = self.INPUT_PORTS.get(port_name)
+        if info is None:
+            raise KeyError(f"{self.describe()}: '{port_name}' is not an input port")
+        binding = self.bindings.get(port_name)
+        if binding is None:
+            if info.has_default:
+                return copy.deepcopy(info.default_value)
+            if default is not _MISSING:
+                return default
+            raise PortError(f"{self.describe()}: input port '{port_name}' has no value")
+        if type(binding) is Literal:
+            return binding.value
+        try:
+            value = self.blackboard.get(binding.key)
+        except KeyError:
+            if default is not _MISSING:
+                return default
+            raise PortError(
+                f"{self.describe()}: input port '{port_name}' reads blackboard entry "
+                f"'{binding.key}', which does not exist") from None
+        if isinstance(value, str) and info.data_type is not str:
+            try:
+                return convert_literal(value, info.data_type)
+            except ValueError as e:
+                raise PortError(
+                    f"{self.describe()}: input port '{port_name}' (entry '{binding.key}'): {e}"
+                ) from None
+        return value
+
+    def set_output(self, port_name: str, value: Any) -> bool:
+        """Write an output (or in/out) port; False when the port is not bound to an entry."""
+        info = self.OUTPUT_PORTS.get(port_name) or self.INPUT_PORTS.get(port_name)
+        if info is None or (port_name not in self.OUTPUT_PORTS
+                            and not isinstance(info, InOutPortInformation)):
+            raise KeyError(f"{self.describe()}: '{port_name}' is not an output port")
+        binding = self.bindings.get(port_name)
+        if not isinstance(binding, Ref):
+            return False
+        self.blackboard.set(binding.key, value)
+        return True
+
+    def _set_output(self, port_name: str, value: Any) -> None:
+        self.set_output(port_name, value)
+
+    # ------------------------------------------------------------------ ticking
+
+    def describe(self) -> str:
+        where = f" (line {self.xml_line})" if self.xml_line else ""
+        name = f" '{self.name}'" if self.name != self.NODE_ID else ""
+        return f"{self.NODE_ID}{name}{where}"
+
+    def now(self) -> float:
+        """Current time of the tree's clock, in seconds."""
+        return self.context.clock.now()
+
+    def _run_script(self, key: str, script: Script) -> Any:
+        try:
+            return script.run(self.blackboard)
+        except ScriptRuntimeError as e:
+            raise TreeRuntimeError(f"{self.describe()}: {key}=\"{script.code}\": {e}") from None
+
+    def _check_preconditions(self) -> NodeStatus | None:
+        state = self.bt_status
+        for key, script in self._pre:
+            if state is NodeStatus.IDLE or state is NodeStatus.SKIPPED:
+                value = _truth(self, key, script)
+                if value:
+                    if key == "_failureIf":
+                        return NodeStatus.FAILURE
+                    if key == "_successIf":
+                        return NodeStatus.SUCCESS
+                    if key == "_skipIf":
+                        return NodeStatus.SKIPPED
+                elif key == "_while":
+                    return NodeStatus.SKIPPED
+            elif (state is NodeStatus.RUNNING and key == "_while"
+                  and not _truth(self, key, script)):
+                self.halt_node()
+                return NodeStatus.SKIPPED
+        return None
+
+    def execute_tick(self) -> NodeStatus:
+        """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
+        new = self._check_preconditions() if self._pre else None
+        if new is None:
+            new = self.tick_node()
+        if self._post and (new is NodeStatus.SUCCESS or new is NodeStatus.FAILURE):
+            if new is NodeStatus.SUCCESS and "_onSuccess" in self._post:
+                self._run_script("_onSuccess", self._post["_onSuccess"])
+            elif new is NodeStatus.FAILURE and "_onFailure" in self._post:
+                self._run_script("_onFailure", self._post["_onFailure"])
+            if "_post" in self._post:
+                self._run_script("_post", self._post["_post"])
+        self.last_status = new
+        if new is not NodeStatus.SKIPPED:
+            self.bt_status = new
+            self.status = _PY_FROM_BT[new]
+        return new
+
+    def tick_node(self) -> NodeStatus:
+        """The node's own logic for one tick (BT.CPP's ``tick()``)."""
+        raise NotImplementedError
+
+    def halt(self) -> None:
+        """Stop the node's activity and make it IDLE (BT.CPP's ``halt()``)."""
+        self.reset_status()
+
+    def halt_node(self) -> None:
+        """Halt, then run the ``_onHalted`` script if any."""
+        self.halt()
+        script = self._post.get("_onHalted") if self._post else None
+        if script is not None:
+            self._run_script("_onHalted", script)
+
+    def reset_status(self) -> None:
+        self.bt_status = NodeStatus.IDLE
+        self.status = Status.INVALID
+
+    def tick(self) -> Any:  # py_trees' generator protocol, for py_trees tools
+        self.execute_tick()
+        yield self
+
+    def stop(self, new_status: Status = Status.INVALID) -> None:
+        """py_trees' stop: for INVALID, halt a RUNNING node (BT.CPP semantics)."""
+        if new_status == Status.INVALID:
+            if self.bt_status is NodeStatus.RUNNING:
+                self.halt_node()
+            self.reset_status()
+        else:
+            self.status = new_status
+            self.bt_status = _BT_FROM_PY[new_status]
+
+    def bt_children(self) -> list[BtNode]:
+        return list(self.children)  # type: ignore[attr-defined]
+
+
+def _truth(node: BtNode, key: str, script: Script) -> bool:
+    from bt_manip.bt.script import to_bool
+
+    value = node._run_script(key, script)
+    try:
+        return to_bool(value)
+    except ScriptRuntimeError as e:
+        raise TreeRuntimeError(f"{node.describe()}: {key}=\"{script.code}\": {e}") from None
+
+
+def _describe(info: PortInformation) -> str:
+    return f" ({info.description})" if info.description else ""
+
+
+class LeafNode(BtNode, py_trees.behaviour.Behaviour):
+    """A leaf: its ``update()`` decides its status, as in py_trees.
+
+    ``initialise()`` runs when the node starts (it was not RUNNING), ``terminate(status)`` once
+    when it finishes (SUCCESS/FAILURE) or is halted while RUNNING (INVALID).
+    """
+
+    def __init__(self, name: str | None = None, **attributes: Any) -> None:
+        super().__init__(name or self.NODE_ID)
+        self._init_node(attributes)
+
+    def tick_node(self) -> NodeStatus:
+        if self.status != _RUNNING:
+            self.initialise()
+        result = self.update()
+        if result not in _BT_FROM_PY or result == Status.INVALID:
+            raise TreeRuntimeError(f"{self.describe()}: update() returned {result!r}")
+        if result != _RUNNING:
+            self.terminate(result)
+        self.status = result
+        return _BT_FROM_PY[result]
+
+    def halt(self) -> None:
+        if self.status == _RUNNING:
+            self.terminate(Status.INVALID)
+        self.reset_status()
+
+
+class ActionNode(LeafNode):
+    """Base class for actions (leaves that act; may return RUNNING)."""
+
+    KIND = "Action"
+
+
+class ConditionNode(LeafNode):
+    """Base class for conditions (leaves that check; return SUCCESS or FAILURE)."""
+
+    KIND = "Condition"
+
+
+class ControlNode(BtNode, py_trees.composites.Composite):
+    """A node with one or more children that decides which to tick (BT.CPP ``ControlNode``)."""
+
+    KIND = "Control"
+    MIN_CHILDREN = 1
+    MAX_CHILDREN = None
+
+    def __init__(
+        self, name: str | None = None, children: list[BtNode] | None = None, **attributes: Any
+    ) -> None:
+        super().__init__(name or self.NODE_ID, children=list(children or []))  # type: ignore[arg-type]
+        self._init_node(attributes)
+        self._check_children()
+
+    def _check_children(self) -> None:
+        n = len(self.children)
+        if n < self.MIN_CHILDREN or (self.MAX_CHILDREN is not None and n > self.MAX_CHILDREN):
+            raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got {n}")
+
+    def halt_child(self, index: int) -> None:
+        child: BtNode = self.children[index]  # type: ignore[assignment]
+        if child.bt_status is NodeStatus.RUNNING:
+            child.halt_node()
+        child.reset_status()
+
+    def reset_children(self) -> None:
+        for index in range(len(self.children)):
+            self.halt_child(index)
+
+    def halt(self) -> None:
+        self.reset_children()
+        self.reset_status()
+
+    def update(self) -> Status:  # not used: tick_node holds the logic
+        return self.status
+
+
+class DecoratorNode(BtNode, py_trees.decorators.Decorator):
+    """A node with exactly one child (BT.CPP ``DecoratorNode``).
+
+    After each tick, a child that finished (SUCCESS/FAILURE) is reset to IDLE, as in BT.CPP.
+    """
+
+    KIND = "Decorator"
+    MIN_CHILDREN = 1
+    MAX_CHILDREN = 1
+
+    def __init__(
+        self, name: str | None = None, child: BtNode | None = None, **attributes: Any
+    ) -> None:
+        if child is None:
+            raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got 0")
+        super().__init__(name or self.NODE_ID, child)  # type: ignore[arg-type]
+        self._init_node(attributes)
+
+    @property
+    def child(self) -> BtNode:
+        return self.decorated  # type: ignore[return-value]
+
+    def execute_tick(self) -> NodeStatus:
+        status = BtNode.execute_tick(self)
+        child = self.child
+        if child.bt_status is NodeStatus.SUCCESS or child.bt_status is NodeStatus.FAILURE:
+            child.reset_status()
+        return status
+
+    def reset_child(self) -> None:
+        child = self.child
+        if child.bt_status is NodeStatus.RUNNING:
+            child.halt_node()
+        child.reset_status()
+
+    def halt(self) -> None:
+        self.reset_child()
+        self.reset_status()
+
+    def update(self) -> Status:
+        return self.status
+
+
+def children_rule(cls: type[BtNode]) -> str:
+    lo, hi = cls.MIN_CHILDREN, cls.MAX_CHILDREN
+    if hi == 0:
+        return "is a leaf and takes no children"
+    if lo == hi:
+        return f"must have exactly {lo} child" + ("" if lo == 1 else "ren")
+    if hi is None:
+        return f"must have at least {lo} child" + ("" if lo == 1 else "ren")
+    return f"must have {lo} to {hi} children"

@@ -1,0 +1,136 @@
+"""Port values: typed literals, blackboard references and their text form.
+
+A port is declared with py_trees' :class:`~py_trees.ports.PortInformation` (type, required,
+description, default). In XML (and in Python authoring) a port gets either a literal, converted
+to the port type when the tree is loaded, or a blackboard reference: ``{key}``, ``{=}`` (the key
+named like the port) or ``{@key}`` (a key of the root blackboard).
+"""
+
+from __future__ import annotations
+
+import typing
+from dataclasses import dataclass
+from typing import Any, get_args, get_origin
+
+from py_trees.ports import PortInformation
+
+from bt_manip.bt.status import NodeStatus
+
+
+@dataclass(frozen=True)
+class InOutPortInformation(PortInformation):
+    """A port that is both read and written (BT.CPP's ``BidirectionalPort``)."""
+
+
+@dataclass(frozen=True)
+class Ref:
+    """A port bound to a blackboard entry."""
+
+    key: str
+
+
+@dataclass(frozen=True)
+class Literal:
+    """A port bound to a constant, already converted to the port type."""
+
+    value: Any
+
+
+Binding = Ref | Literal
+
+_BOOL_TEXT = {"true": True, "false": False, "1": True, "0": False}
+
+
+def parse_reference(text: str) -> str | None:
+    """Blackboard key of ``{key}``, ``{=}``-style text (``=`` is returned as is), else None."""
+    stripped = text.strip()
+    if stripped == "=":
+        return "="
+    if len(stripped) >= 3 and stripped[0] == "{" and stripped[-1] == "}":
+        return stripped[1:-1].strip()
+    return None
+
+
+def convert_literal(text: str, data_type: Any) -> Any:
+    """Convert ``text`` to ``data_type``; raises ValueError saying what was expected."""
+    if data_type is str or data_type is object or data_type is typing.Any:
+        return text
+    s = text.strip()
+    if data_type is bool:
+        low = s.lower()
+        if low in _BOOL_TEXT:
+            return _BOOL_TEXT[low]
+        raise ValueError(f"expected true or false, got '{text}'")
+    if data_type is int:
+        try:
+            return int(s, 0) if s.lower().startswith(("0x", "-0x")) else int(s)
+        except ValueError:
+            raise ValueError(f"expected an integer, got '{text}'") from None
+    if data_type is float:
+        try:
+            return float(s)
+        except ValueError:
+            raise ValueError(f"expected a number, got '{text}'") from None
+    if data_type is NodeStatus:
+        return NodeStatus.parse(s)
+    origin = get_origin(data_type)
+    if origin is list:
+        (item_type,) = get_args(data_type) or (str,)
+        if s == "":
+            return []
+        return [convert_literal(part, item_type) for part in s.split(";")]
+    if origin is typing.Union or str(origin) == "<class 'types.UnionType'>":
+        errors = []
+        for option in get_args(data_type):
+            try:
+                return convert_literal(text, option)
+            except ValueError as e:
+                errors.append(str(e))
+        raise ValueError("; ".join(errors))
+    from_string = getattr(data_type, "from_string", None)
+    if callable(from_string):
+        return from_string(s)
+    name = getattr(data_type, "__name__", str(data_type))
+    raise ValueError(f"a {name} cannot be written as text; use a blackboard reference {{key}}")
+
+
+def format_literal(value: Any) -> str:
+    """Text form of a literal, as it would appear in XML."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, NodeStatus):
+        return value.value
+    if isinstance(value, (list, tuple)):
+        return ";".join(format_literal(v) for v in value)
+    return str(value)
+
+
+def type_name(data_type: Any) -> str:
+    """BT.CPP-style type name for a TreeNodesModel."""
+    names = {int: "int", float: "double", bool: "bool", str: "std::string",
+             NodeStatus: "BT::NodeStatus", object: "BT::AnyTypeAllowed"}
+    if data_type in names:
+        return names[data_type]
+    origin = get_origin(data_type)
+    if origin is list:
+        (item,) = get_args(data_type) or (str,)
+        return f"std::vector<{type_name(item)}>"
+    return getattr(data_type, "__name__", str(data_type))
+
+
+def type_from_name(name: str | None) -> Any:
+    """Python type for a TreeNodesModel type name (unknown names give ``object``)."""
+    if not name:
+        return object
+    table = {"int": int, "unsigned": int, "unsigned int": int, "int64_t": int, "uint64_t": int,
+             "long": int, "double": float, "float": float, "bool": bool, "std::string": str,
+             "string": str, "BT::NodeStatus": NodeStatus, "NodeStatus": NodeStatus,
+             "std::vector<double>": list[float], "std::vector<int>": list[int],
+             "std::vector<std::string>": list[str]}
+    return table.get(name.strip(), object)
+
+
+def direction_of(info: PortInformation, is_output: bool) -> str:
+    if isinstance(info, InOutPortInformation):
+        return "inout"
+    return "output" if is_output else "input"

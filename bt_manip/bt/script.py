@@ -1,0 +1,531 @@
+"""BehaviorTree.CPP's script language: lexer, parser and evaluator.
+
+Used by ``Script``, ``ScriptCondition``, ``Precondition`` and the ``_skipIf``/``_onSuccess``...
+attributes. A script is a list of expressions separated by ``;``; its value is the value of the
+last one. Supported, with BT.CPP's precedence (lowest first):
+
+- assignment ``:=`` (create or overwrite), ``=`` (the entry must exist), ``+= -= *= /=``
+- conditional ``c ? a : b``
+- logical ``&&`` and ``||`` (same precedence, left to right, both sides evaluated)
+- comparisons ``== != < <= > >=`` (chainable: ``1 < x < 3``)
+- string concatenation ``..``; bitwise ``| ^`` and ``&``
+- ``+ -``; ``* /``; prefix ``-``, ``!``, ``~``
+- atoms: numbers (``42``, ``3.5``, ``0x1F``), single- or double-quoted strings, ``true`` and
+  ``false``, blackboard names (``@name`` is the root blackboard), parentheses.
+
+Syntax errors are :class:`ScriptSyntaxError` with the 1-based column; run-time errors (unknown
+variable, bad operand types) are :class:`ScriptRuntimeError`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+FLOAT_EPS = 1.1920928955078125e-07  # float epsilon, the tolerance BT.CPP uses for ==
+
+
+class ScriptSyntaxError(ValueError):
+    """A script does not parse; ``column`` is 1-based within the script text."""
+
+    def __init__(self, message: str, column: int) -> None:
+        super().__init__(message)
+        self.message = message
+        self.column = column
+
+
+class ScriptRuntimeError(RuntimeError):
+    """A script parsed but failed while running (unknown variable, bad operand types...)."""
+
+
+class Variables(Protocol):
+    def exists(self, key: str) -> bool: ...
+    def get(self, key: str) -> Any: ...
+    def set(self, key: str, value: Any) -> None: ...
+
+
+# ---------------------------------------------------------------------------------------------
+# Lexer
+
+_OPERATORS = sorted(
+    [":=", "+=", "-=", "*=", "/=", "==", "!=", "<=", ">=", "&&", "||", "..",
+     "=", "<", ">", "&", "|", "^", "~", "!", "+", "-", "*", "/", "?", ":", "(", ")", ";"],
+    key=len,
+    reverse=True,
+)
+
+
+@dataclass(frozen=True)
+class Token:
+    kind: str  # "num", "str", "name", "bool", "op", "end"
+    text: str
+    value: Any
+    pos: int  # 0-based offset in the script
+
+
+def tokenize(code: str) -> list[Token]:
+    tokens: list[Token] = []
+    i, n = 0, len(code)
+    while i < n:
+        c = code[i]
+        if c in " \t\r\n":
+            i += 1
+            continue
+        if c.isdigit() or (c == "." and i + 1 < n and code[i + 1].isdigit()):
+            tokens.append(_number(code, i))
+            i += len(tokens[-1].text)
+            continue
+        if c in "'\"":
+            end = code.find(c, i + 1)
+            if end < 0:
+                raise ScriptSyntaxError("unterminated string; close it with " + c, i + 1)
+            tokens.append(Token("str", code[i : end + 1], code[i + 1 : end], i))
+            i = end + 1
+            continue
+        if c.isalpha() or c in "_@":
+            j = i + 1
+            while j < n and (code[j].isalnum() or code[j] == "_"):
+                j += 1
+            word = code[i:j]
+            if word == "@":
+                raise ScriptSyntaxError("'@' must be followed by a variable name", i + 1)
+            if word in ("true", "false"):
+                tokens.append(Token("bool", word, word == "true", i))
+            else:
+                tokens.append(Token("name", word, word, i))
+            i = j
+            continue
+        for op in _OPERATORS:
+            if code.startswith(op, i):
+                tokens.append(Token("op", op, op, i))
+                i += len(op)
+                break
+        else:
+            raise ScriptSyntaxError(f"unexpected character '{c}'", i + 1)
+    tokens.append(Token("end", "", None, n))
+    return tokens
+
+
+def _number(code: str, i: int) -> Token:
+    n = len(code)
+    if code.startswith(("0x", "0X"), i):
+        j = i + 2
+        while j < n and code[j] in "0123456789abcdefABCDEF":
+            j += 1
+        if j == i + 2:
+            raise ScriptSyntaxError("hexadecimal number without digits", i + 1)
+        return Token("num", code[i:j], int(code[i + 2 : j], 16), i)
+    j = i
+    while j < n and code[j].isdigit():
+        j += 1
+    is_real = False
+    if j < n and code[j] == "." and j + 1 < n and code[j + 1].isdigit():
+        is_real = True
+        j += 1
+        while j < n and code[j].isdigit():
+            j += 1
+    if j < n and code[j] in "eE":
+        k = j + 1
+        if k < n and code[k] in "+-":
+            k += 1
+        if k < n and code[k].isdigit():
+            is_real = True
+            j = k
+            while j < n and code[j].isdigit():
+                j += 1
+    if j < n and (code[j].isalpha() or code[j] == "_"):
+        raise ScriptSyntaxError(f"malformed number '{code[i:j + 1]}'", i + 1)
+    text = code[i:j]
+    return Token("num", text, float(text) if is_real else int(text), i)
+
+
+# ---------------------------------------------------------------------------------------------
+# AST
+
+
+class Expr:
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        raise NotImplementedError
+
+
+@dataclass
+class Literal(Expr):
+    value: Any
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        return self.value
+
+
+@dataclass
+class Name(Expr):
+    name: str
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        try:
+            return env.get(self.name)
+        except KeyError:
+            raise ScriptRuntimeError(f"variable not found: {self.name}") from None
+
+
+@dataclass
+class Unary(Expr):
+    op: str
+    operand: Expr
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        v = self.operand.eval(env)
+        if self.op == "!":
+            return not to_bool(v)
+        num = to_number(v, self.op)
+        if self.op == "-":
+            return -num
+        return float(~int(num)) if isinstance(num, float) else ~int(num)
+
+
+@dataclass
+class Binary(Expr):
+    op: str
+    lhs: Expr
+    rhs: Expr
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        return binary(self.op, self.lhs.eval(env), self.rhs.eval(env))
+
+
+@dataclass
+class Compare(Expr):
+    ops: list[str]
+    operands: list[Expr]
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        lhs = self.operands[0].eval(env)
+        for op, operand in zip(self.ops, self.operands[1:], strict=True):
+            rhs = operand.eval(env)
+            if not compare(op, lhs, rhs):
+                return False
+            lhs = rhs
+        return True
+
+
+@dataclass
+class IfElse(Expr):
+    cond: Expr
+    then: Expr
+    other: Expr
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        c = self.cond.eval(env)
+        ok = len(c) > 0 if isinstance(c, str) else bool(to_number(c, "?"))
+        return self.then.eval(env) if ok else self.other.eval(env)
+
+
+@dataclass
+class Assign(Expr):
+    op: str
+    target: str
+    value: Expr
+    pos: int = 0
+
+    def eval(self, env: Variables) -> Any:
+        key = self.target
+        exists = env.exists(key)
+        if not exists and self.op != ":=":
+            raise ScriptRuntimeError(
+                f"the blackboard entry [{key}] does not exist yet; use := to create it"
+            )
+        value = self.value.eval(env)
+        if self.op in (":=", "="):
+            if exists:
+                old = env.get(key)
+                if isinstance(value, str) and _is_number(old):
+                    value = _string_to_number(value)
+            env.set(key, value)
+            return value
+        old = env.get(key)
+        if isinstance(value, str) and not _is_number(old):
+            if self.op != "+=":
+                raise ScriptRuntimeError(f"operator {self.op} cannot be used with strings")
+            new = to_text(old) + value
+        else:
+            new = binary(self.op[0], to_number(old, self.op), to_number(value, self.op))
+        env.set(key, new)
+        return new
+
+
+@dataclass
+class Script:
+    """A parsed script: call :meth:`run` with the blackboard to execute it."""
+
+    code: str
+    statements: list[Expr]
+
+    def run(self, env: Variables) -> Any:
+        result: Any = None
+        for statement in self.statements:
+            result = statement.eval(env)
+        return result
+
+    def run_bool(self, env: Variables) -> bool:
+        return to_bool(self.run(env))
+
+
+# ---------------------------------------------------------------------------------------------
+# Value semantics
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, str)
+
+
+def _string_to_number(s: str) -> int | float:
+    text = s.strip()
+    if text == "true":
+        return 1
+    if text == "false":
+        return 0
+    try:
+        return int(text, 0) if text.lower().startswith("0x") else int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        raise ScriptRuntimeError(f"'{s}' is not a number") from None
+
+
+def to_number(v: Any, op: str) -> int | float:
+    if isinstance(v, bool):
+        return int(v)
+    if _is_number(v):
+        return v
+    if isinstance(v, str):
+        return _string_to_number(v)
+    raise ScriptRuntimeError(f"operator [{op}] needs a number, got {type(v).__name__}")
+
+
+def to_bool(v: Any) -> bool:
+    """BT.CPP's cast to bool: numbers are true when non-zero; 'true'/'false'/'1'/'0' strings."""
+    if isinstance(v, bool):
+        return v
+    if _is_number(v):
+        return v != 0
+    if isinstance(v, str):
+        low = v.strip().lower()
+        if low in ("true", "1"):
+            return True
+        if low in ("false", "0"):
+            return False
+        raise ScriptRuntimeError(f"cannot convert '{v}' to a boolean")
+    if v is None:
+        raise ScriptRuntimeError("the script has no value to use as a condition")
+    raise ScriptRuntimeError(f"cannot convert {type(v).__name__} to a boolean")
+
+
+def to_text(v: Any) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, float) and v.is_integer() and math.isfinite(v):
+        return str(int(v))
+    return str(v)
+
+
+def _arith(op: str, a: int | float, b: int | float) -> int | float:
+    if op == "+":
+        return a + b
+    if op == "-":
+        return a - b
+    if op == "*":
+        return a * b
+    if b == 0:
+        if a == 0:
+            return math.nan
+        return math.copysign(math.inf, a) * math.copysign(1.0, b)
+    return a / b
+
+
+def binary(op: str, lhs: Any, rhs: Any) -> Any:
+    if op in ("&&", "||"):
+        a, b = to_bool(lhs), to_bool(rhs)
+        return (a and b) if op == "&&" else (a or b)
+    if op == "..":
+        return to_text(lhs) + to_text(rhs)
+    if op == "+" and isinstance(lhs, str) and isinstance(rhs, str):
+        return lhs + rhs
+    if isinstance(lhs, str) or isinstance(rhs, str):
+        raise ScriptRuntimeError(f"operation [{op}] is not permitted between {lhs!r} and {rhs!r}")
+    a, b = to_number(lhs, op), to_number(rhs, op)
+    if op in ("&", "|", "^"):
+        if float(a) != int(a) or float(b) != int(b):
+            raise ScriptRuntimeError(f"bitwise operator [{op}] needs integers")
+        ia, ib = int(a), int(b)
+        return ia & ib if op == "&" else (ia | ib if op == "|" else ia ^ ib)
+    return _arith(op, a, b)
+
+
+def compare(op: str, lhs: Any, rhs: Any) -> bool:
+    if isinstance(lhs, str) and isinstance(rhs, str):
+        a: Any = lhs
+        b: Any = rhs
+        eq = a == b
+    else:
+        a = to_number(lhs, op)
+        b = to_number(rhs, op)
+        eq = abs(a - b) <= FLOAT_EPS
+    if op == "==":
+        return eq
+    if op == "!=":
+        return not eq
+    if op == "<":
+        return a < b
+    if op == ">":
+        return a > b
+    if op == "<=":
+        return a <= b
+    return a >= b
+
+
+# ---------------------------------------------------------------------------------------------
+# Parser
+
+_ASSIGN_OPS = (":=", "=", "+=", "-=", "*=", "/=")
+_COMPARE_OPS = ("==", "!=", "<", "<=", ">", ">=")
+
+
+class _Parser:
+    def __init__(self, code: str) -> None:
+        self.code = code
+        self.tokens = tokenize(code)
+        self.i = 0
+
+    @property
+    def tok(self) -> Token:
+        return self.tokens[self.i]
+
+    def error(self, message: str, tok: Token | None = None) -> ScriptSyntaxError:
+        t = tok or self.tok
+        found = "end of script" if t.kind == "end" else f"'{t.text}'"
+        return ScriptSyntaxError(f"{message}, found {found}", t.pos + 1)
+
+    def accept(self, *ops: str) -> Token | None:
+        t = self.tok
+        if t.kind == "op" and t.text in ops:
+            self.i += 1
+            return t
+        return None
+
+    def parse(self) -> list[Expr]:
+        statements: list[Expr] = []
+        while self.tok.kind != "end":
+            if self.accept(";"):
+                continue
+            statements.append(self.expression())
+            if self.tok.kind != "end" and not self.accept(";"):
+                raise self.error("expected ';' or an operator")
+        return statements
+
+    def expression(self) -> Expr:
+        start = self.tok
+        lhs = self.conditional()
+        op = self.accept(*_ASSIGN_OPS)
+        if op is None:
+            return lhs
+        if not isinstance(lhs, Name):
+            raise ScriptSyntaxError(
+                f"the left side of '{op.text}' must be a variable name", start.pos + 1
+            )
+        return Assign(op.text, lhs.name, self.expression(), op.pos)
+
+    def conditional(self) -> Expr:
+        cond = self.logical()
+        q = self.accept("?")
+        if q is None:
+            return cond
+        then = self.expression()
+        if not self.accept(":"):
+            raise self.error("expected ':' after the '?' branch")
+        other = self.logical()
+        return IfElse(cond, then, other, q.pos)
+
+    def logical(self) -> Expr:
+        lhs = self.comparison()
+        while (op := self.accept("&&", "||")) is not None:
+            lhs = Binary(op.text, lhs, self.comparison(), op.pos)
+        return lhs
+
+    def comparison(self) -> Expr:
+        first = self.concat()
+        ops: list[str] = []
+        operands = [first]
+        while (op := self.accept(*_COMPARE_OPS)) is not None:
+            ops.append(op.text)
+            operands.append(self.concat())
+        return first if not ops else Compare(ops, operands, first.pos)
+
+    def concat(self) -> Expr:
+        lhs = self.bit_or()
+        while (op := self.accept("..")) is not None:
+            lhs = Binary("..", lhs, self.bit_or(), op.pos)
+        return lhs
+
+    def bit_or(self) -> Expr:
+        lhs = self.bit_and()
+        while (op := self.accept("|", "^")) is not None:
+            lhs = Binary(op.text, lhs, self.bit_and(), op.pos)
+        return lhs
+
+    def bit_and(self) -> Expr:
+        lhs = self.sum()
+        while (op := self.accept("&")) is not None:
+            lhs = Binary("&", lhs, self.sum(), op.pos)
+        return lhs
+
+    def sum(self) -> Expr:
+        lhs = self.product()
+        while (op := self.accept("+", "-")) is not None:
+            lhs = Binary(op.text, lhs, self.product(), op.pos)
+        return lhs
+
+    def product(self) -> Expr:
+        lhs = self.unary()
+        while (op := self.accept("*", "/")) is not None:
+            lhs = Binary(op.text, lhs, self.unary(), op.pos)
+        return lhs
+
+    def unary(self) -> Expr:
+        op = self.accept("-", "!", "~")
+        if op is not None:
+            return Unary(op.text, self.unary(), op.pos)
+        return self.atom()
+
+    def atom(self) -> Expr:
+        t = self.tok
+        if t.kind in ("num", "str", "bool"):
+            self.i += 1
+            return Literal(t.value, t.pos)
+        if t.kind == "name":
+            self.i += 1
+            return Name(t.value, t.pos)
+        if self.accept("("):
+            inner = self.expression()
+            if not self.accept(")"):
+                raise self.error("expected ')'")
+            return inner
+        raise self.error("expected a value (number, 'string', true/false, name or '(')")
+
+
+def parse_script(code: str) -> Script:
+    """Parse ``code``; raises :class:`ScriptSyntaxError` (with column) when it is not valid."""
+    return Script(code, _Parser(code).parse())
+
+
+def run_script(code: str, env: Variables) -> Any:
+    return parse_script(code).run(env)

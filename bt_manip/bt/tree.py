@@ -1,0 +1,126 @@
+"""A loaded (or Python-built) tree: its root, blackboard, context, and how to tick it."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from py_trees.common import Status
+
+from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.context import TreeContext
+from bt_manip.bt.node import BtNode
+from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.subtree import SubTree
+
+
+@dataclass
+class NodeRecord:
+    """One node of a tree as the run report and the console show it."""
+
+    path: str
+    name: str
+    node_id: str
+    status: str
+    reason: str
+    depth: int
+    last_status: str = "IDLE"
+
+    @property
+    def node(self) -> str:
+        """The node ID (same as ``node_id``; the runner's report calls it ``node``)."""
+        return self.node_id
+
+
+class Tree:
+    """A tree ready to tick.
+
+    ``tick()`` ticks the root once and returns a py_trees status; a root that was SKIPPED
+    (every node skipped) returns ``Status.INVALID`` (see :attr:`bt_status` for the BT.CPP
+    status). ``halt()`` stops every RUNNING node; each one's ``terminate(INVALID)`` runs once.
+    """
+
+    def __init__(
+        self,
+        root: BtNode,
+        context: TreeContext | None = None,
+        blackboard: Blackboard | dict[str, Any] | None = None,
+        tree_id: str = "MainTree",
+        source: str | None = None,
+    ) -> None:
+        self.root = root
+        self.context = context or TreeContext()
+        self.blackboard = (
+            blackboard if isinstance(blackboard, Blackboard) else Blackboard.from_dict(blackboard)
+        )
+        self.tree_id = tree_id
+        self.source = source
+        self.bt_status = NodeStatus.IDLE
+        self.tick_count = 0
+        self._wire(root, self.blackboard)
+
+    def _wire(self, node: BtNode, bb: Blackboard) -> None:
+        node.blackboard = bb
+        node.context = self.context
+        if isinstance(node, SubTree):
+            self._wire(node.child, node.make_blackboard(bb))
+            return
+        for child in node.bt_children():
+            self._wire(child, bb)
+
+    def tick(self) -> Status:
+        """Tick the root once; returns its status as a py_trees status."""
+        self.tick_count += 1
+        self.bt_status = self.root.execute_tick()
+        return self.bt_status.to_py_trees()
+
+    def tick_while_running(self, max_ticks: int = 1_000_000) -> NodeStatus:
+        """Tick until the root is not RUNNING (or ``max_ticks``); for tests and scripts."""
+        status = NodeStatus.IDLE
+        for _ in range(max_ticks):
+            self.tick()
+            status = self.bt_status
+            if status is not NodeStatus.RUNNING:
+                break
+        return status
+
+    def halt(self) -> None:
+        """Halt every RUNNING node and make the whole tree IDLE."""
+        if self.root.bt_status is NodeStatus.RUNNING:
+            self.root.halt_node()
+        self.root.reset_status()
+        self.bt_status = NodeStatus.IDLE
+
+    def walk(self) -> Iterator[tuple[str, int, BtNode]]:
+        """Every node with its path and depth, depth first, parents before children."""
+
+        def visit(node: BtNode, path: str, depth: int) -> Iterator[tuple[str, int, BtNode]]:
+            yield path, depth, node
+            seen: dict[str, int] = {}
+            for child in node.bt_children():
+                count = seen.get(child.name, 0) + 1
+                seen[child.name] = count
+                suffix = f"#{count}" if count > 1 else ""
+                yield from visit(child, f"{path}/{child.name}{suffix}", depth + 1)
+
+        yield from visit(self.root, self.root.name, 0)
+
+    def node_records(self) -> list[NodeRecord]:
+        records = []
+        for path, depth, node in self.walk():
+            records.append(
+                NodeRecord(
+                    path=path,
+                    name=node.name,
+                    node_id=node.NODE_ID if not isinstance(node, SubTree) else node.tree_id,
+                    status=node.bt_status.value,
+                    reason=node.feedback_message or "",
+                    depth=depth,
+                    last_status=node.last_status.value,
+                )
+            )
+        return records
+
+    def nodes(self) -> list[BtNode]:
+        return [node for _, _, node in self.walk()]

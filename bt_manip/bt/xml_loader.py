@@ -1,0 +1,339 @@
+"""Loading BT.CPP v4 XML into a :class:`~bt_manip.bt.tree.Tree`, and validating it.
+
+Loading happens in two passes. The check pass visits every ``<BehaviorTree>`` of the document
+once and collects every problem (unknown node IDs with the closest known names, attributes that
+are not ports, missing required ports, bad literals for typed ports, wrong numbers of children,
+undefined or recursive SubTrees, script syntax errors); :func:`validate_file` returns them and
+:func:`load_tree` raises them all in one :class:`~bt_manip.errors.InputError`. The build pass
+then instantiates the main tree, each ``<SubTree>`` instance getting its own copy of its tree.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.context import TreeContext
+from bt_manip.bt.documents import Document, TreeDef, read_document, read_model_file
+from bt_manip.bt.models import NodeSpec, spec_of
+from bt_manip.bt.node import (
+    IGNORED_ATTRIBUTES,
+    POST_CONDITIONS,
+    PRE_CONDITIONS,
+    ActionNode,
+    AttributeCheck,
+    BtNode,
+    ConditionNode,
+    ControlNode,
+    DecoratorNode,
+    TreeRuntimeError,
+    children_rule,
+    closest,
+    parse_condition_scripts,
+)
+from bt_manip.bt.registry import SUBTREE_ID, NodeRegistry, registry
+from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.subtree import SubTree
+from bt_manip.bt.tree import Tree
+from bt_manip.bt.xml_parse import Element
+from bt_manip.errors import InputError, Problem
+
+EXPLICIT_TAGS = ("Action", "Condition", "Control", "Decorator")
+NAME_ATTRIBUTES = ("name", "ID")
+
+
+class _Checker:
+    def __init__(self, doc: Document, reg: NodeRegistry, need_implementation: bool) -> None:
+        self.doc = doc
+        self.reg = reg
+        self.need_implementation = need_implementation
+        self.problems: list[Problem] = []
+        self.edges: dict[str, list[tuple[str, Element, str]]] = {}
+
+    def known_ids(self) -> set[str]:
+        return set(self.reg.ids()) | set(self.doc.models) | {SUBTREE_ID}
+
+    def spec(self, node_id: str) -> NodeSpec | None:
+        cls = self.reg.get(node_id)
+        if cls is not None:
+            return spec_of(cls)
+        return self.doc.models.get(node_id)
+
+    def add(self, file: str, element: Element, message: str) -> None:
+        self.problems.append(Problem(file, element.line, message))
+
+    def check_all(self) -> None:
+        for tree in self.doc.trees.values():
+            self.edges[tree.tree_id] = []
+            roots = tree.element.children
+            if len(roots) != 1:
+                self.add(tree.file, tree.element,
+                         f"BehaviorTree '{tree.tree_id}' must have exactly one root node, "
+                         f"found {len(roots)}")
+            for root in roots:
+                self.check_node(root, tree)
+        self.check_recursion()
+
+    def check_node(self, element: Element, tree: TreeDef) -> None:
+        file = tree.file
+        if element.tag in EXPLICIT_TAGS:
+            node_id = element.get("ID")
+            if not node_id:
+                self.add(file, element, f"<{element.tag}> needs an ID attribute naming the node, "
+                                        f"e.g. <{element.tag} ID=\"MyNode\"/>")
+                for child in element.children:
+                    self.check_node(child, tree)
+                return
+        else:
+            node_id = element.tag
+        attributes = {k: v for k, v in element.attrib.items()
+                      if k != "name" and not (k == "ID" and (element.tag in EXPLICIT_TAGS
+                                                             or node_id == SUBTREE_ID))}
+        if node_id == SUBTREE_ID:
+            self.check_subtree(element, tree, attributes)
+            return
+        spec = self.spec(node_id)
+        if spec is None:
+            self.add(file, element,
+                     f"unknown node '{node_id}'{closest(node_id, self.known_ids())}; register "
+                     "it in Python or declare it in a <TreeNodesModel> (--models FILE)")
+        else:
+            if element.tag in EXPLICIT_TAGS and spec.kind not in (element.tag, "SubTree"):
+                self.add(file, element, f"'{node_id}' is a {spec.kind}, not a {element.tag}; "
+                                        f"write <{spec.kind} ID=\"{node_id}\"> or <{node_id}>")
+            self.check_attributes(element, file, spec, attributes)
+            self.check_children(element, file, spec)
+        for child in element.children:
+            self.check_node(child, tree)
+
+    def check_attributes(self, element: Element, file: str, spec: NodeSpec,
+                         attributes: dict[str, str]) -> None:
+        if spec.cls is not None:
+            check = spec.cls.check_attributes(attributes)
+        else:
+            check = AttributeCheck()
+            parse_condition_scripts(attributes, check, spec.node_id)
+            for key in attributes:
+                if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+                    continue
+                if key not in spec.ports:
+                    declared = ", ".join(sorted(spec.ports)) or "none"
+                    check.errors.append(
+                        (f"'{key}' is not a port of {spec.node_id} in its TreeNodesModel"
+                         f"{closest(key, set(spec.ports))}; declared ports: {declared}", None))
+            if self.need_implementation:
+                check.errors.append(
+                    (f"node '{spec.node_id}' is declared in a TreeNodesModel but has no "
+                     "implementation; import the Python module that registers it", None))
+        for message, column in check.errors:
+            if column is not None:
+                message = f"{message} (column {column} of the script)"
+            self.add(file, element, message)
+
+    def check_children(self, element: Element, file: str, spec: NodeSpec) -> None:
+        n = len(element.children)
+        lo, hi = spec.min_children, spec.max_children
+        if n < lo or (hi is not None and n > hi):
+            rule = children_rule(_Rule(lo, hi))  # type: ignore[arg-type]
+            self.add(file, element, f"{spec.node_id} {rule}, found {n}")
+
+    def check_subtree(self, element: Element, tree: TreeDef, attributes: dict[str, str]) -> None:
+        file = tree.file
+        target = element.get("ID")
+        if not target:
+            self.add(file, element, "<SubTree> needs an ID naming a <BehaviorTree>")
+        elif target not in self.doc.trees:
+            defined = ", ".join(sorted(self.doc.trees)) or "none"
+            self.add(file, element,
+                     f"SubTree '{target}' is not defined{closest(target, set(self.doc.trees))}; "
+                     f"defined trees: {defined} (add <BehaviorTree ID=\"{target}\"> or an "
+                     "<include>)")
+        else:
+            self.edges[tree.tree_id].append((target, element, file))
+        for message, column in SubTree.check_attributes(attributes).errors:
+            if column is not None:
+                message = f"{message} (column {column} of the script)"
+            self.add(file, element, message)
+        if element.children:
+            self.add(file, element, f"SubTree takes no children, found {len(element.children)}; "
+                                    "its content is the <BehaviorTree> it names")
+            for child in element.children:
+                self.check_node(child, tree)
+
+    def check_recursion(self) -> None:
+        state: dict[str, int] = {}  # 1 = on the stack, 2 = done
+        reported: set[tuple[str, int]] = set()
+
+        def visit(tree_id: str, path: list[str]) -> None:
+            state[tree_id] = 1
+            for target, element, file in self.edges.get(tree_id, []):
+                if state.get(target) == 1:
+                    key = (file, element.line)
+                    if key not in reported:
+                        reported.add(key)
+                        cycle = [*path[path.index(target):], target]
+                        self.add(file, element,
+                                 "recursive SubTree: " + " -> ".join(cycle)
+                                 + "; a tree cannot contain itself")
+                elif state.get(target) is None:
+                    visit(target, [*path, target])
+            state[tree_id] = 2
+
+        for tree_id in self.doc.trees:
+            if state.get(tree_id) is None:
+                visit(tree_id, [tree_id])
+
+
+class _Rule:
+    def __init__(self, lo: int, hi: int | None) -> None:
+        self.MIN_CHILDREN = lo
+        self.MAX_CHILDREN = hi
+
+
+def _main_tree(doc: Document, tree_id: str | None) -> tuple[str | None, Problem | None]:
+    wanted = tree_id or doc.main_tree
+    if wanted:
+        if wanted in doc.trees:
+            return wanted, None
+        what = "--tree-id" if tree_id else "main_tree_to_execute"
+        defined = ", ".join(sorted(doc.trees)) or "none"
+        return None, Problem(doc.file, doc.root_line,
+                             f"{what} names tree '{wanted}', which is not defined"
+                             f"{closest(wanted, set(doc.trees))}; defined trees: {defined}")
+    if len(doc.trees) == 1:
+        return next(iter(doc.trees)), None
+    if not doc.trees:
+        return None, Problem(doc.file, doc.root_line, "no <BehaviorTree> in this file")
+    return None, Problem(doc.file, doc.root_line,
+                         "several trees and no main_tree_to_execute; add "
+                         "main_tree_to_execute=\"...\" to <root> or pass --tree-id (trees: "
+                         + ", ".join(sorted(doc.trees)) + ")")
+
+
+def _prepare(path: str, text: str | None, models: Iterable[str] | None, tree_id: str | None,
+             reg: NodeRegistry, need_implementation: bool) -> tuple[Document, str | None,
+                                                                   list[Problem]]:
+    doc = read_document(path, text)
+    for model_file in models or []:
+        read_model_file(model_file, doc)
+    checker = _Checker(doc, reg, need_implementation)
+    checker.check_all()
+    problems = doc.problems + checker.problems
+    main, problem = _main_tree(doc, tree_id)
+    if problem is not None and not (doc.problems and not doc.trees):
+        problems.append(problem)
+    problems.sort(key=lambda p: (p.file != path, p.file, p.line or 0))
+    return doc, main, problems
+
+
+def validate(path: str, models: Iterable[str] | None = None, tree_id: str | None = None,
+             text: str | None = None, reg: NodeRegistry | None = None
+             ) -> tuple[list[Problem], list[Problem]]:
+    """(problems, warnings) of a tree file: everything loading checks, without running."""
+    doc, _, problems = _prepare(path, text, models, tree_id, reg or registry, False)
+    return problems, doc.warnings
+
+
+def validate_file(path: str, models: Iterable[str] | None = None,
+                  tree_id: str | None = None) -> list[Problem]:
+    """Every problem of a tree file (nodes declared in ``models`` count as known); no raise."""
+    return validate(path, models, tree_id)[0]
+
+
+class _Builder:
+    def __init__(self, doc: Document, reg: NodeRegistry, placeholders: bool) -> None:
+        self.doc = doc
+        self.reg = reg
+        self.placeholders = placeholders
+        self._stand_ins: dict[str, type[BtNode]] = {}
+
+    def tree_root(self, tree_id: str) -> BtNode:
+        tree = self.doc.trees[tree_id]
+        return self.node(tree.element.children[0], tree.file)
+
+    def node(self, element: Element, file: str) -> BtNode:
+        node_id = element.get("ID") if element.tag in EXPLICIT_TAGS else element.tag
+        assert node_id is not None
+        name = element.get("name")
+        attributes = {k: v for k, v in element.attrib.items() if k not in NAME_ATTRIBUTES}
+        node: BtNode
+        if node_id == SUBTREE_ID:
+            target = element.get("ID")
+            assert target is not None
+            node = SubTree(target, self.tree_root(target), name=name, **attributes)
+        else:
+            cls = self.reg.get(node_id) or self._stand_in(node_id)
+            children = [self.node(child, file) for child in element.children]
+            if issubclass(cls, ControlNode):
+                node = cls(name, children=children, **attributes)
+            elif issubclass(cls, DecoratorNode):
+                node = cls(name, child=children[0], **attributes)
+            else:
+                node = cls(name, **attributes)
+        node.xml_file = file
+        node.xml_line = element.line
+        return node
+
+    def _stand_in(self, node_id: str) -> type[BtNode]:
+        if not self.placeholders:
+            raise KeyError(node_id)
+        if node_id not in self._stand_ins:
+            self._stand_ins[node_id] = make_stand_in(self.doc.models[node_id])
+        return self._stand_ins[node_id]
+
+
+def make_stand_in(spec: NodeSpec) -> type[BtNode]:
+    """A class standing for a node known only from a model (for ``show``); ticking it fails."""
+    base: type[BtNode] = {"Action": ActionNode, "Condition": ConditionNode,
+                          "Control": ControlNode, "Decorator": DecoratorNode}.get(
+                              spec.kind, ActionNode)
+    inputs = {name: PortInformation(object, required=False, description=p.description)
+              for name, p in spec.ports.items() if p.direction != "output"}
+    outputs = {name: PortInformation(object, required=False, description=p.description)
+               for name, p in spec.ports.items() if p.direction == "output"}
+
+    def tick_node(self: BtNode) -> NodeStatus:
+        raise TreeRuntimeError(f"{self.describe()}: no implementation (declared in a model only)")
+
+    return type(spec.node_id, (base,), {"NODE_ID": spec.node_id, "INPUT_PORTS": inputs,
+                                        "OUTPUT_PORTS": outputs, "tick_node": tick_node,
+                                        "update": lambda self: Status.INVALID,
+                                        "__module__": __name__})
+
+
+def load_tree(
+    path: str,
+    tree_id: str | None = None,
+    models: Iterable[str] | None = None,
+    context: TreeContext | None = None,
+    blackboard: dict[str, Any] | Blackboard | None = None,
+    *,
+    text: str | None = None,
+    placeholders: bool = False,
+    reg: NodeRegistry | None = None,
+) -> Tree:
+    """Load a BT.CPP v4 XML file (or ``text``, named ``path``) into a :class:`Tree`.
+
+    Raises :class:`~bt_manip.errors.InputError` with every problem found. With
+    ``placeholders``, nodes known only from a model get stand-ins that fail when ticked (for
+    showing a tree); otherwise every node needs an implementation.
+    """
+    reg = reg or registry
+    doc, main, problems = _prepare(path, text, models, tree_id, reg, not placeholders)
+    if problems:
+        raise InputError(problems)
+    assert main is not None
+    root = _Builder(doc, reg, placeholders).tree_root(main)
+    tree = Tree(root, context=context, blackboard=blackboard, tree_id=main, source=path)
+    tree.warnings = doc.warnings  # type: ignore[attr-defined]
+    return tree
+
+
+def load_tree_string(text: str, **kwargs: Any) -> Tree:
+    """Load a tree from XML text (includes are relative to the working directory)."""
+    name = kwargs.pop("path", "<string>")
+    return load_tree(name, text=text, **kwargs)

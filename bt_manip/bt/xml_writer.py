@@ -1,0 +1,66 @@
+"""Saving a tree as BT.CPP v4 XML (for trees built in Python).
+
+``to_xml(tree)`` writes the main tree and one ``<BehaviorTree>`` per distinct SubTree ID;
+loading the result with :func:`~bt_manip.bt.load_tree` gives an equivalent tree.
+"""
+
+from __future__ import annotations
+
+from xml.sax.saxutils import quoteattr
+
+from bt_manip.bt.node import BtNode
+from bt_manip.bt.subtree import SubTree
+from bt_manip.bt.tree import Tree
+
+
+def _node_lines(node: BtNode, indent: int, subtrees: dict[str, BtNode], out: list[str]) -> None:
+    pad = "  " * indent
+    if isinstance(node, SubTree):
+        attrs = f" ID={quoteattr(node.tree_id)}"
+        if node.name != node.tree_id:
+            attrs += f" name={quoteattr(node.name)}"
+        subtrees.setdefault(node.tree_id, node.child)
+        children: list[BtNode] = []
+        tag = "SubTree"
+    else:
+        tag = node.NODE_ID
+        attrs = f" name={quoteattr(node.name)}" if node.name != node.NODE_ID else ""
+        children = node.bt_children()
+    for key, text in node.attribute_texts.items():
+        attrs += f" {key}={quoteattr(text)}"
+    if not children:
+        out.append(f"{pad}<{tag}{attrs}/>")
+        return
+    out.append(f"{pad}<{tag}{attrs}>")
+    for child in children:
+        _node_lines(child, indent + 1, subtrees, out)
+    out.append(f"{pad}</{tag}>")
+
+
+def root_to_xml(root: BtNode, tree_id: str = "MainTree") -> str:
+    """XML document for a tree given by its root node."""
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           f'<root BTCPP_format="4" main_tree_to_execute={quoteattr(tree_id)}>']
+    subtrees: dict[str, BtNode] = {}
+    pending = [(tree_id, root)]
+    written: set[str] = set()
+    while pending:
+        current_id, current_root = pending.pop(0)
+        if current_id in written:
+            continue
+        written.add(current_id)
+        out.append(f"  <BehaviorTree ID={quoteattr(current_id)}>")
+        _node_lines(current_root, 2, subtrees, out)
+        out.append("  </BehaviorTree>")
+        for sub_id, sub_root in subtrees.items():
+            if sub_id not in written:
+                pending.append((sub_id, sub_root))
+    out += ["</root>", ""]
+    return "\n".join(out)
+
+
+def to_xml(tree: Tree | BtNode) -> str:
+    """BT.CPP v4 XML for a :class:`Tree` (or a root node)."""
+    if isinstance(tree, Tree):
+        return root_to_xml(tree.root, tree.tree_id)
+    return root_to_xml(tree)
