@@ -1,0 +1,405 @@
+"""URDF composition: several URDF files grafted into one robot, with every mesh path resolved.
+
+PyBullet and Pinocchio must read the very same file, and committed files carry no absolute
+paths. A robot is therefore either one URDF file or a :class:`Recipe`: a ``base`` URDF plus
+:class:`Attachment` s (another URDF hung from a link of the tree built so far by a fixed joint),
+with optional joint-limit overrides. :func:`composed_urdf` writes the result, meshes as absolute
+paths on this machine, to a cache folder (``$BT_MANIP_CACHE`` or ``~/.cache/bt-manip/urdf``)
+under a name keyed by a hash of every input, and returns its path. The write is atomic (temporary
+file + rename), so several processes may compose the same robot at once.
+
+What composition does to each input file:
+
+- mesh ``filename`` s become absolute paths (``package://``, ``pybullet_data://`` and paths
+  relative to the file, see :mod:`bt_manip.sim.assets`);
+- ``gazebo`` and ``transmission`` elements are dropped (neither engine reads them);
+- the links named in ``drop_links`` are removed with every joint touching them;
+- attached links and joints get ``link_prefix`` / ``joint_prefix`` (names must stay unique);
+- links without an ``inertial`` get a tiny one (PyBullet would otherwise invent 1 kg);
+- xacro leftovers ``$(optenv NAME default)`` in attributes are replaced by their default
+  (Pinocchio's URDF parser rejects them).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import tempfile
+import xml.etree.ElementTree as ET
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import defusedxml.ElementTree as SafeET
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.sim.assets import resolve_uri
+
+if TYPE_CHECKING:
+    from bt_manip.sim.robot import RobotDescription
+
+COMPOSER_VERSION = 2
+"""Bumped whenever the output of composition changes for the same inputs."""
+
+MAX_URDF_BYTES = 8 * 1024 * 1024
+FILLER_MASS = 0.001
+FILLER_INERTIA = 1e-7
+DROPPED_TAGS = ("gazebo", "transmission")
+OPTENV = re.compile(r"\$\(optenv\s+\S+\s*([^)]*)\)")
+LIMIT_KEYS = ("lower", "upper", "velocity", "effort")
+CONTACT_KEYS = ("lateral_friction", "rolling_friction", "spinning_friction", "stiffness",
+                "damping")
+RECIPE_KEYS = {"base", "attach", "joint_limits", "contacts"}
+ATTACH_KEYS = {"urdf", "parent", "xyz", "rpy", "joint_name", "link_prefix", "joint_prefix",
+               "drop_links"}
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """A URDF hung from ``parent`` (a link of the tree so far) by a fixed joint at xyz/rpy."""
+
+    urdf: str
+    parent: str
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    joint_name: str = ""
+    link_prefix: str = ""
+    joint_prefix: str = ""
+    drop_links: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Recipe:
+    """How to build one robot URDF: ``base`` plus ``attachments``, paths relative to ``folder``."""
+
+    name: str
+    base: str
+    folder: Path
+    attachments: tuple[Attachment, ...] = ()
+    joint_limits: dict[str, dict[str, float]] = field(default_factory=dict)
+    """Per joint name, any of ``lower``, ``upper``, ``velocity``, ``effort`` to overwrite."""
+    contacts: dict[str, dict[str, float]] = field(default_factory=dict)
+    """Per link name, the PyBullet ``<contact>`` values that replace the link's own."""
+
+
+def cache_dir() -> Path:
+    """Folder for composed URDFs: ``$BT_MANIP_CACHE`` or ``$XDG_CACHE_HOME/bt-manip/urdf``."""
+    env = os.environ.get("BT_MANIP_CACHE")
+    if env:
+        return Path(env)
+    xdg = os.environ.get("XDG_CACHE_HOME")
+    root = Path(xdg) if xdg else Path.home() / ".cache"
+    return root / "bt-manip" / "urdf"
+
+
+def composed_urdf(description: RobotDescription | Recipe | Path | str) -> Path:
+    """Path of the URDF that both PyBullet and Pinocchio load for this robot.
+
+    ``description`` is a :class:`~bt_manip.sim.robot.RobotDescription`, a :class:`Recipe` or a
+    URDF path. A plain URDF without meshes is returned as it is; otherwise the resolved or
+    composed file is written to :func:`cache_dir` once and its path returned.
+    """
+    source = getattr(description, "urdf", description)
+    if isinstance(source, Recipe):
+        return _compose_recipe(source)
+    return _resolve_single(Path(source))
+
+
+def _compose_recipe(recipe: Recipe) -> Path:
+    base_path = resolve_uri(recipe.base, recipe.folder)
+    parts = [base_path] + [resolve_uri(a.urdf, recipe.folder) for a in recipe.attachments]
+    key = _hash_inputs(
+        {
+            "version": COMPOSER_VERSION,
+            "name": recipe.name,
+            "base": str(base_path),
+            "attachments": [asdict(a) for a in recipe.attachments],
+            "limits": recipe.joint_limits,
+            "contacts": recipe.contacts,
+        },
+        parts,
+    )
+    target = cache_dir() / f"{recipe.name}-{key}.urdf"
+    if target.is_file():
+        return target
+    robot = _read_urdf(base_path)
+    robot.set("name", recipe.name)
+    for i, attachment in enumerate(recipe.attachments):
+        _graft(robot, attachment, parts[i + 1], f"{recipe.name}: attachments[{i}]")
+    _override_limits(robot, recipe.joint_limits, recipe.name)
+    _replace_contacts(robot, recipe.contacts, recipe.name)
+    _fill_inertials(robot)
+    _write_atomic(target, _to_text(robot))
+    return target
+
+
+def _resolve_single(path: Path) -> Path:
+    path = path.resolve()
+    root = _read_urdf(path)
+    if root.find(".//mesh") is None:
+        return path
+    key = _hash_inputs({"version": COMPOSER_VERSION, "file": str(path)}, [path])
+    target = cache_dir() / f"{path.stem}-{key}.urdf"
+    if not target.is_file():
+        _write_atomic(target, _to_text(root))
+    return target
+
+
+def _hash_inputs(recipe: dict, files: list[Path]) -> str:
+    digest = hashlib.sha256(json.dumps(recipe, sort_keys=True, default=str).encode())
+    for f in files:
+        digest.update(str(f).encode())
+        digest.update(f.read_bytes())
+    return digest.hexdigest()[:16]
+
+
+def _read_urdf(path: Path) -> ET.Element:
+    """Parse a URDF (no entities), drop simulator-specific tags, make mesh paths absolute."""
+    if not path.is_file():
+        raise InputError.single(str(path), None, "URDF file not found")
+    if path.stat().st_size > MAX_URDF_BYTES:
+        raise InputError.single(str(path), None, f"URDF larger than {MAX_URDF_BYTES} bytes")
+    try:
+        root = SafeET.parse(str(path)).getroot()
+    except Exception as exc:  # defusedxml and expat raise several unrelated types
+        raise InputError.single(str(path), None, f"unreadable URDF: {exc}") from None
+    if root.tag != "robot":
+        raise InputError.single(str(path), None, f"root element is <{root.tag}>, not <robot>")
+    for tag in DROPPED_TAGS:
+        for el in root.findall(tag):
+            root.remove(el)
+    for el in root.iter():
+        for key, value in el.attrib.items():
+            if "$(" in value:
+                el.set(key, OPTENV.sub(lambda m: m.group(1).strip(), value))
+    problems: list[Problem] = []
+    for mesh in root.iter("mesh"):
+        uri = mesh.get("filename", "")
+        resolved = resolve_uri(uri, path.parent)
+        if not resolved.is_file():
+            problems.append(Problem(str(path), None, f"mesh '{uri}' not found (at {resolved})"))
+        mesh.set("filename", str(resolved))
+    if problems:
+        raise InputError(problems)
+    return root
+
+
+def _graft(robot: ET.Element, att: Attachment, path: Path, where: str) -> None:
+    """Add the links and joints of ``path`` under ``att.parent`` of ``robot``."""
+    part = _read_urdf(path)
+    dropped = set(att.drop_links)
+    links = {el.get("name", ""): el for el in part.findall("link")}
+    joints = part.findall("joint")
+    missing = dropped - links.keys()
+    if missing:
+        raise InputError.single(where, None, f"drop_links: no link {sorted(missing)} in {path}")
+    kept_joints = [
+        j for j in joints
+        if _joint_end(j, "parent") not in dropped and _joint_end(j, "child") not in dropped
+    ]
+    kept_links = [name for name in links if name not in dropped]
+    children = {_joint_end(j, "child") for j in kept_joints}
+    roots = [name for name in kept_links if name not in children]
+    if len(roots) != 1:
+        raise InputError.single(where, None, f"{path} must form one tree after drop_links; "
+                                f"found root links {roots}")
+    existing_links = {el.get("name") for el in robot.findall("link")}
+    existing_joints = {el.get("name") for el in robot.findall("joint")}
+    if att.parent not in existing_links:
+        raise InputError.single(where, None, f"parent link '{att.parent}' not in the robot so far")
+
+    def link_name(name: str) -> str:
+        return att.link_prefix + name
+
+    clashes = [link_name(n) for n in kept_links if link_name(n) in existing_links]
+    clashes += [att.joint_prefix + (j.get("name") or "") for j in kept_joints
+                if att.joint_prefix + (j.get("name") or "") in existing_joints]
+    mount_name = att.joint_name or f"{link_name(roots[0])}_mount"
+    if mount_name in existing_joints:
+        clashes.append(mount_name)
+    if clashes:
+        raise InputError.single(where, None, f"names already used in the robot: {clashes}; "
+                                "set link_prefix / joint_prefix")
+
+    known_materials = {m.get("name") for m in robot.findall("material")}
+    for mat in part.findall("material"):
+        if mat.get("name") not in known_materials:
+            robot.append(mat)
+            known_materials.add(mat.get("name"))
+    for name in kept_links:
+        el = links[name]
+        el.set("name", link_name(name))
+        robot.append(el)
+    for j in kept_joints:
+        j.set("name", att.joint_prefix + (j.get("name") or ""))
+        for end in ("parent", "child"):
+            el = j.find(end)
+            if el is not None:
+                el.set("link", link_name(el.get("link", "")))
+        robot.append(j)
+    mount = ET.SubElement(robot, "joint", name=mount_name, type="fixed")
+    ET.SubElement(mount, "parent", link=att.parent)
+    ET.SubElement(mount, "child", link=link_name(roots[0]))
+    ET.SubElement(mount, "origin", xyz=_vec(att.xyz), rpy=_vec(att.rpy))
+
+
+def _joint_end(joint: ET.Element, end: str) -> str:
+    el = joint.find(end)
+    return el.get("link", "") if el is not None else ""
+
+
+def _override_limits(robot: ET.Element, limits: dict[str, dict[str, float]], where: str) -> None:
+    joints = {j.get("name"): j for j in robot.findall("joint")}
+    problems: list[Problem] = []
+    for name, values in limits.items():
+        joint = joints.get(name)
+        if joint is None:
+            problems.append(Problem(where, None, f"joint_limits: no joint '{name}' in the robot"))
+            continue
+        limit = joint.find("limit")
+        if limit is None:
+            limit = ET.SubElement(joint, "limit")
+        for key, value in values.items():
+            limit.set(key, repr(float(value)))
+    if problems:
+        raise InputError(problems)
+
+
+def _replace_contacts(robot: ET.Element, contacts: dict[str, dict[str, float]],
+                      where: str) -> None:
+    links = {el.get("name"): el for el in robot.findall("link")}
+    unknown = sorted(set(contacts) - links.keys())
+    if unknown:
+        raise InputError.single(where, None, f"contacts: no link {unknown} in the robot")
+    for name, values in contacts.items():
+        link = links[name]
+        for old in link.findall("contact"):
+            link.remove(old)
+        contact = ET.SubElement(link, "contact")
+        for key, value in values.items():
+            ET.SubElement(contact, key, value=repr(float(value)))
+
+
+def _fill_inertials(robot: ET.Element) -> None:
+    for link in robot.findall("link"):
+        if link.find("inertial") is not None:
+            continue
+        inertial = ET.SubElement(link, "inertial")
+        ET.SubElement(inertial, "origin", xyz="0 0 0", rpy="0 0 0")
+        ET.SubElement(inertial, "mass", value=repr(FILLER_MASS))
+        i = repr(FILLER_INERTIA)
+        ET.SubElement(inertial, "inertia", ixx=i, ixy="0", ixz="0", iyy=i, iyz="0", izz=i)
+
+
+def _vec(values: tuple[float, ...]) -> str:
+    return " ".join(repr(float(v)) for v in values)
+
+
+def _to_text(root: ET.Element) -> str:
+    ET.indent(root, space="  ")
+    return '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+
+
+def _write_atomic(target: Path, text: str) -> None:
+    """Write ``text`` to ``target`` so that readers see either nothing or the whole file."""
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}-", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
+    """Check a recipe read from the ``urdf:`` mapping of descriptor ``path``.
+
+    Raises :class:`~bt_manip.errors.InputError` naming the file, line and key of each problem.
+    """
+    problems: list[Problem] = []
+
+    def line(d: object, key: str | int | None = None) -> int | None:
+        if key is not None and hasattr(d, "line_of"):
+            return d.line_of(key)  # type: ignore[union-attr]
+        return getattr(d, "line", None)
+
+    def fail(where: object, key: str | int | None, message: str) -> None:
+        problems.append(Problem(str(path), line(where, key), message))
+
+    def vec3(d: dict, key: str, where: str) -> tuple[float, float, float]:
+        value = d.get(key, [0.0, 0.0, 0.0])
+        if not (isinstance(value, list) and len(value) == 3 and all(
+                isinstance(v, int | float) and not isinstance(v, bool) for v in value)):
+            fail(d, key, f"{where}.{key} must be a list of 3 numbers, got {value!r}")
+            return (0.0, 0.0, 0.0)
+        return (float(value[0]), float(value[1]), float(value[2]))
+
+    def table(d: dict, key: str, allowed: tuple[str, ...]) -> dict[str, dict[str, float]]:
+        value = d.get(key) or {}
+        out: dict[str, dict[str, float]] = {}
+        if not isinstance(value, dict):
+            fail(d, key, f"urdf.{key} must be a mapping of names to mappings")
+            return out
+        for item, values in value.items():
+            if not isinstance(values, dict) or not values:
+                fail(value, item, f"urdf.{key}.{item} must be a mapping of {', '.join(allowed)}")
+                continue
+            for k, v in values.items():
+                if k not in allowed:
+                    fail(values, k, f"unknown key '{k}' in urdf.{key}.{item}; allowed: "
+                         f"{', '.join(allowed)}")
+                elif isinstance(v, bool) or not isinstance(v, int | float):
+                    fail(values, k, f"urdf.{key}.{item}.{k} must be a number, got {v!r}")
+            out[str(item)] = {k: float(v) for k, v in values.items()
+                              if k in allowed and isinstance(v, int | float)}
+        return out
+
+    for key in data:
+        if key not in RECIPE_KEYS:
+            allowed = ", ".join(sorted(RECIPE_KEYS))
+            fail(data, key, f"unknown key '{key}' in urdf; allowed: {allowed}")
+    base = data.get("base")
+    if not isinstance(base, str) or not base:
+        fail(data, "base", "urdf.base must name the base URDF (URI or relative path)")
+        base = ""
+    elif not resolve_uri(base, path.parent).is_file():
+        fail(data, "base", f"urdf.base: file '{base}' not found")
+    attachments: list[Attachment] = []
+    raw = data.get("attach") or []
+    if not isinstance(raw, list):
+        fail(data, "attach", "urdf.attach must be a list")
+        raw = []
+    for i, item in enumerate(raw):
+        where = f"urdf.attach[{i}]"
+        if not isinstance(item, dict):
+            fail(raw, i, f"{where} must be a mapping")
+            continue
+        for key in item:
+            if key not in ATTACH_KEYS:
+                fail(item, key, f"unknown key '{key}' in {where}; allowed: "
+                     f"{', '.join(sorted(ATTACH_KEYS))}")
+        texts = {}
+        for key in ("urdf", "parent", "joint_name", "link_prefix", "joint_prefix"):
+            value = item.get(key, "")
+            if not isinstance(value, str) or (key in ("urdf", "parent") and not value):
+                fail(item, key, f"{where}.{key} must be text")
+                value = ""
+            texts[key] = value
+        if texts["urdf"] and not resolve_uri(texts["urdf"], path.parent).is_file():
+            fail(item, "urdf", f"{where}.urdf: file '{texts['urdf']}' not found")
+        drop = item.get("drop_links", [])
+        if not isinstance(drop, list) or not all(isinstance(d, str) for d in drop):
+            fail(item, "drop_links", f"{where}.drop_links must be a list of link names")
+            drop = []
+        attachments.append(Attachment(
+            texts["urdf"], texts["parent"], vec3(item, "xyz", where), vec3(item, "rpy", where),
+            texts["joint_name"], texts["link_prefix"], texts["joint_prefix"], tuple(drop)))
+    limits = table(data, "joint_limits", LIMIT_KEYS)
+    contacts = table(data, "contacts", CONTACT_KEYS)
+    if problems:
+        raise InputError(problems)
+    return Recipe(name, base, path.parent, tuple(attachments), limits, contacts)

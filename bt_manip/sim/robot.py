@@ -1,0 +1,738 @@
+"""Robots: their descriptors (``robots/<name>.yaml``) and a handle to drive one in PyBullet.
+
+:class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
+which URDF (or composition recipe), the base (``skid_steer`` or ``fixed``), the arm joints in
+order, the gripper, the end-effector and grasp frames, named arm states and the footprint.
+
+:class:`Robot` wraps one spawned multibody. Every call passes the PyBullet client id it was
+spawned with; nothing here touches a global client. Joints are position controlled within the
+velocity and effort limits of the descriptor, wheels are velocity controlled. ``stop_base()``
+followed by ``hold_arm()`` leaves the robot safe (wheels braked, arm holding where it is).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import defusedxml.ElementTree as SafeET
+import numpy as np
+import pybullet as pb
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.sim.assets import REPO_ROOT
+from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
+from bt_manip.sim.yaml_lines import LineDict, load_yaml
+
+__all__ = [
+    "ArmSpec",
+    "BaseSpec",
+    "ContactPoint",
+    "Footprint",
+    "GripperSpec",
+    "Robot",
+    "RobotDescription",
+    "composed_urdf",
+    "known_robots",
+    "load_description",
+]
+
+# -- descriptors --------------------------------------------------------------------------------
+ROBOTS_DIR = REPO_ROOT / "robots"
+BASE_TYPES = ("skid_steer", "fixed")
+TOP_KEYS = {"name", "urdf", "spawn_height", "base", "arm", "end_effector", "grasp_frame",
+            "gripper", "states", "footprint"}
+BASE_KEYS = {"type", "left_wheels", "right_wheels", "wheel_radius", "track_width",
+             "max_wheel_speed", "wheel_max_torque", "wheel_friction", "wheel_spinning_friction",
+             "wheel_rolling_friction", "wheel_axle_friction_scale"}
+ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
+GRIPPER_KEYS = {"joints", "finger_links", "open", "closed", "max_force", "max_speed",
+                "pad_friction"}
+FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
+
+
+@dataclass(frozen=True)
+class BaseSpec:
+    """The mobile base: ``skid_steer`` (wheels left/right) or ``fixed`` (welded to the world)."""
+
+    type: str = "fixed"
+    left_wheels: tuple[str, ...] = ()
+    right_wheels: tuple[str, ...] = ()
+    wheel_radius: float = 0.0
+    track_width: float = 0.0
+    """Effective track width (m) for skid-steer kinematics: yaw rate = (vr - vl) / track."""
+    max_wheel_speed: float = 0.0
+    wheel_max_torque: float = 0.0
+    wheel_friction: float = 1.0
+    wheel_spinning_friction: float = 0.0
+    wheel_rolling_friction: float = 0.0
+    wheel_axle_friction_scale: float = 1.0
+    """Friction along the wheel axle relative to ``wheel_friction`` (< 1 lets a skid-steer turn)."""
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """The arm: chain root, joints in order, their speed and effort limits and lower/upper."""
+
+    base_link: str
+    joints: tuple[str, ...]
+    velocity_limits: tuple[float, ...]
+    efforts: tuple[float | None, ...]
+    lower: tuple[float, ...] = ()
+    upper: tuple[float, ...] = ()
+    position_gain: float = 0.3
+
+
+@dataclass(frozen=True)
+class GripperSpec:
+    """Parallel gripper: finger joints (each = pad distance from the centre line, m)."""
+
+    joints: tuple[str, ...]
+    finger_links: tuple[str, ...]
+    open: float
+    closed: float
+    max_force: float
+    max_speed: float = 0.1
+    pad_friction: float = 1.5
+
+    @property
+    def max_opening(self) -> float:
+        """Distance between the pads when fully open (m)."""
+        return max(self.open, self.closed) * len(self.joints)
+
+    @property
+    def min_opening(self) -> float:
+        """Distance between the pads when closed on nothing (m)."""
+        return min(self.open, self.closed) * len(self.joints)
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """Outline of the base for navigation: a rectangle (length x width) or a circle (radius).
+
+    The rectangle is centred ``x_offset`` ahead of the root link frame.
+    """
+
+    length: float = 0.0
+    width: float = 0.0
+    x_offset: float = 0.0
+    radius: float = 0.0
+
+    @property
+    def is_circle(self) -> bool:
+        return self.radius > 0.0
+
+    @property
+    def circumradius(self) -> float:
+        """Radius of the smallest circle around the root frame containing the footprint."""
+        if self.is_circle:
+            return self.radius
+        return math.hypot(abs(self.x_offset) + self.length / 2.0, self.width / 2.0)
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    """A checked robot descriptor (``robots/<name>.yaml``)."""
+
+    name: str
+    path: Path
+    urdf: Path | Recipe
+    base: BaseSpec
+    arm: ArmSpec
+    gripper: GripperSpec
+    end_effector: str
+    grasp_frame: str
+    states: dict[str, tuple[float, ...]]
+    footprint: Footprint
+    spawn_height: float = 0.0
+
+    @classmethod
+    def load(cls, name_or_path: str | Path) -> RobotDescription:
+        """Read ``robots/<name>.yaml`` (or a path to a descriptor) and check it.
+
+        Raises :class:`~bt_manip.errors.InputError` naming the file, line and key of every
+        problem, including names that do not exist in the robot's URDF.
+        """
+        return load_description(name_or_path)
+
+    def state(self, name: str) -> tuple[float, ...]:
+        """Arm joint positions of the named state (``home``, ``tuck``, ...)."""
+        try:
+            return self.states[name]
+        except KeyError:
+            raise KeyError(f"{self.name} has no arm state '{name}'; states: "
+                           f"{', '.join(self.states)}") from None
+
+    @property
+    def urdf_path(self) -> Path:
+        """The URDF PyBullet and Pinocchio load (composed and cached if needed)."""
+        return composed_urdf(self)
+
+
+def find_description(name_or_path: str | Path) -> Path:
+    """Path of a descriptor given a robot name (``robots/<name>.yaml``) or a path."""
+    p = Path(name_or_path)
+    if p.suffix in (".yaml", ".yml") or p.is_file():
+        return p
+    return ROBOTS_DIR / f"{name_or_path}.yaml"
+
+
+def known_robots() -> list[str]:
+    """Names of the robot descriptors shipped in ``robots/``."""
+    return sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
+
+
+class _Fields:
+    """Typed field access on a YAML mapping that records problems with file and line."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.problems: list[Problem] = []
+
+    def fail(self, line: int | None, message: str) -> None:
+        self.problems.append(Problem(str(self.path), line, message))
+
+    def section(self, d: LineDict, key: str, allowed: set[str], required: bool = True) -> LineDict:
+        value = d.get(key)
+        if value is None and not required:
+            return _empty(d.line_of(key))
+        if not isinstance(value, LineDict):
+            self.fail(d.line_of(key), f"'{key}' must be a mapping")
+            return _empty(d.line_of(key))
+        self.unknown(value, allowed, key)
+        return value
+
+    def unknown(self, d: LineDict, allowed: set[str], where: str) -> None:
+        for key in d:
+            if key not in allowed:
+                self.fail(d.line_of(key), f"unknown key '{key}' in {where}; allowed: "
+                          f"{', '.join(sorted(allowed))}")
+
+    def text(self, d: LineDict, key: str, where: str, default: str | None = None) -> str:
+        value = d.get(key, default)
+        if not isinstance(value, str) or not value:
+            self.fail(d.line_of(key), f"{where}.{key} must be a name (text)")
+            return ""
+        return value
+
+    def number(self, d: LineDict, key: str, where: str, default: float | None = None,
+               minimum: float | None = None, positive: bool = False) -> float:
+        if key not in d and default is None:
+            self.fail(d.line, f"{where} is missing '{key}'")
+            return 0.0
+        value = d.get(key, default)
+        if (isinstance(value, bool) or not isinstance(value, int | float)
+                or not math.isfinite(value)):
+            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
+            return 0.0
+        if positive and value <= 0:
+            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
+        if minimum is not None and value < minimum:
+            self.fail(d.line_of(key), f"{where}.{key} must be >= {minimum}, got {value}")
+        return float(value)
+
+    def names(self, d: LineDict, key: str, where: str, required: bool = True) -> tuple[str, ...]:
+        value = d.get(key)
+        if value is None and not required:
+            return ()
+        if not isinstance(value, list) or not value or not all(
+                isinstance(v, str) and v for v in value):
+            self.fail(d.line_of(key), f"{where}.{key} must be a non-empty list of names")
+            return ()
+        return tuple(value)
+
+    def numbers(self, value: object, n: int, line: int, where: str) -> tuple[float, ...] | None:
+        ok = isinstance(value, list) and len(value) == n and all(
+            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+            for v in value)
+        if not ok:
+            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
+            return None
+        return tuple(float(v) for v in value)
+
+
+def _empty(line: int) -> LineDict:
+    out = LineDict()
+    out.line = line
+    out.key_lines = {}
+    return out
+
+
+def load_description(name_or_path: str | Path) -> RobotDescription:
+    """Read and check a robot descriptor; see :meth:`RobotDescription.load`."""
+    path = find_description(name_or_path)
+    if not path.is_file():
+        known = ", ".join(known_robots()) or "none"
+        raise InputError.single(str(path), None,
+                                f"no robot descriptor '{name_or_path}'; known robots: {known}")
+    data = load_yaml(path)
+    f = _Fields(path)
+    if not isinstance(data, LineDict):
+        raise InputError.single(str(path), 1, "a robot descriptor must be a YAML mapping")
+    f.unknown(data, TOP_KEYS, "the descriptor")
+    name = f.text(data, "name", "descriptor", default=path.stem)
+    urdf = _parse_urdf_source(f, data, path)
+
+    b = f.section(data, "base", BASE_KEYS)
+    base_type = b.get("type", "fixed")
+    if base_type not in BASE_TYPES:
+        f.fail(b.line_of("type"), f"base.type must be one of {', '.join(BASE_TYPES)}, "
+               f"got {base_type!r}")
+    if base_type == "skid_steer":
+        base = BaseSpec(
+            "skid_steer", f.names(b, "left_wheels", "base"), f.names(b, "right_wheels", "base"),
+            f.number(b, "wheel_radius", "base", positive=True),
+            f.number(b, "track_width", "base", positive=True),
+            f.number(b, "max_wheel_speed", "base", positive=True),
+            f.number(b, "wheel_max_torque", "base", positive=True),
+            f.number(b, "wheel_friction", "base", 1.0, minimum=0.0),
+            f.number(b, "wheel_spinning_friction", "base", 0.0, minimum=0.0),
+            f.number(b, "wheel_rolling_friction", "base", 0.0, minimum=0.0),
+            f.number(b, "wheel_axle_friction_scale", "base", 1.0, positive=True))
+    else:
+        base = BaseSpec("fixed")
+
+    a = f.section(data, "arm", ARM_KEYS)
+    joints = f.names(a, "joints", "arm")
+    vel = f.numbers(a.get("velocity_limits"), len(joints), a.line_of("velocity_limits"),
+                    "arm.velocity_limits") or ()
+    if any(v <= 0 for v in vel):
+        f.fail(a.line_of("velocity_limits"), "arm.velocity_limits must all be > 0")
+    efforts: tuple[float | None, ...] = (None,) * len(joints)
+    if "efforts" in a:
+        efforts = f.numbers(a["efforts"], len(joints), a.line_of("efforts"), "arm.efforts") or ()
+    arm_base = f.text(a, "base_link", "arm")
+    gain = f.number(a, "position_gain", "arm", 0.3, positive=True)
+
+    g = f.section(data, "gripper", GRIPPER_KEYS)
+    gripper = GripperSpec(
+        f.names(g, "joints", "gripper"), f.names(g, "finger_links", "gripper"),
+        f.number(g, "open", "gripper"), f.number(g, "closed", "gripper"),
+        f.number(g, "max_force", "gripper", positive=True),
+        f.number(g, "max_speed", "gripper", 0.1, positive=True),
+        f.number(g, "pad_friction", "gripper", 1.5, minimum=0.0))
+
+    raw_states = data.get("states")
+    s = f.section(data, "states", set(raw_states) if isinstance(raw_states, dict) else set())
+    states: dict[str, tuple[float, ...]] = {}
+    for key in ("home", "tuck"):
+        if key not in s:
+            f.fail(s.line, f"states is missing '{key}' (arm positions in rad)")
+    for key, value in s.items():
+        q = f.numbers(value, len(joints), s.line_of(key), f"states.{key}")
+        if q is not None:
+            states[key] = q
+
+    fp = f.section(data, "footprint", FOOTPRINT_KEYS)
+    if "radius" in fp:
+        footprint = Footprint(radius=f.number(fp, "radius", "footprint", positive=True))
+    else:
+        footprint = Footprint(f.number(fp, "length", "footprint", positive=True),
+                              f.number(fp, "width", "footprint", positive=True),
+                              f.number(fp, "x_offset", "footprint", 0.0))
+    end_effector = f.text(data, "end_effector", "descriptor")
+    grasp_frame = f.text(data, "grasp_frame", "descriptor")
+    spawn_height = f.number(data, "spawn_height", "descriptor", 0.0)
+    if f.problems:
+        raise InputError(f.problems)
+
+    desc = RobotDescription(name, path, urdf, base, ArmSpec(arm_base, joints, vel, efforts,
+                            position_gain=gain), gripper, end_effector, grasp_frame, states,
+                            footprint, spawn_height)
+    return _check_against_urdf(desc, data, f)
+
+
+def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:
+    value = data.get("urdf")
+    if isinstance(value, str):
+        urdf = (path.parent / value).resolve()
+        if not urdf.is_file():
+            f.fail(data.line_of("urdf"), f"urdf: file '{value}' not found (at {urdf})")
+        return urdf
+    if isinstance(value, LineDict):
+        try:
+            return parse_recipe(value, path, data.get("name", path.stem))
+        except InputError as exc:
+            f.problems.extend(exc.problems)
+            return path
+    f.fail(data.line_of("urdf"), "urdf must be a file path or a composition recipe (mapping)")
+    return path
+
+
+def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> RobotDescription:
+    """Check every joint and link name of ``desc`` in its URDF; fill the arm's joint limits."""
+    root = SafeET.parse(str(composed_urdf(desc))).getroot()
+    links = {el.get("name") for el in root.findall("link")}
+    joints = {el.get("name"): el for el in root.findall("joint")}
+
+    def need(names: tuple[str, ...], kind: set | dict, section: str, key: str) -> None:
+        sec = data.get(section) if section else data
+        line = sec.line_of(key) if isinstance(sec, LineDict) else None
+        for n in names:
+            if n not in kind:
+                what = "joint" if kind is joints else "link"
+                f.fail(line, f"{section + '.' if section else ''}{key}: no {what} '{n}' in the "
+                       f"URDF")
+
+    need(desc.base.left_wheels + desc.base.right_wheels, joints, "base", "left_wheels")
+    need(desc.arm.joints, joints, "arm", "joints")
+    need((desc.arm.base_link,), links, "arm", "base_link")
+    need(desc.gripper.joints, joints, "gripper", "joints")
+    need(desc.gripper.finger_links, links, "gripper", "finger_links")
+    need((desc.end_effector,), links, "", "end_effector")
+    need((desc.grasp_frame,), links, "", "grasp_frame")
+    if f.problems:
+        raise InputError(f.problems)
+    lower, upper = [], []
+    for n in desc.arm.joints:
+        limit = joints[n].find("limit")
+        lo = float(limit.get("lower", -math.inf)) if limit is not None else -math.inf
+        hi = float(limit.get("upper", math.inf)) if limit is not None else math.inf
+        lower.append(lo)
+        upper.append(hi)
+    states = data["states"]
+    for key, q in desc.states.items():
+        bad = [desc.arm.joints[i] for i, v in enumerate(q) if not lower[i] <= v <= upper[i]]
+        if bad:
+            f.fail(states.line_of(key), f"states.{key}: outside the joint limits of {bad}")
+    if f.problems:
+        raise InputError(f.problems)
+    arm = dataclasses.replace(desc.arm, lower=tuple(lower), upper=tuple(upper))
+    return dataclasses.replace(desc, arm=arm)
+
+
+
+@dataclass(frozen=True)
+class ContactPoint:
+    """One contact between a robot link and another body, from ``getContactPoints``."""
+
+    link: str
+    other_body: int
+    other_link: int
+    position: tuple[float, float, float]
+    normal_force: float
+
+
+class Robot:
+    """A robot spawned in a PyBullet world, driven through its descriptor's names.
+
+    Build it with :meth:`spawn`. Link and joint names are the URDF's; :meth:`link_pose` returns
+    the URDF link frame (not the centre of mass).
+    """
+
+    def __init__(self, client: int, body: int, description: RobotDescription) -> None:
+        self.client = client
+        self.body = body
+        self.description = description
+        self._joints: dict[str, int] = {}
+        self._links: dict[str, int] = {}
+        self._joint_info: dict[int, tuple] = {}
+        root = pb.getBodyInfo(body, physicsClientId=client)[0].decode()
+        dynamics = pb.getDynamicsInfo(body, -1, physicsClientId=client)
+        self._root_inertial = (dynamics[3], dynamics[4])
+        self._links[root] = -1
+        for j in range(pb.getNumJoints(body, physicsClientId=client)):
+            info = pb.getJointInfo(body, j, physicsClientId=client)
+            self._joints[info[1].decode()] = j
+            self._links[info[12].decode()] = j
+            self._joint_info[j] = info
+        self.arm_joint_ids = [self.joint_index(n) for n in description.arm.joints]
+        self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
+        self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
+        self.wheel_ids_left = [self.joint_index(n) for n in description.base.left_wheels]
+        self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
+        arm = description.arm
+        self._arm_velocity = [
+            v if v is not None else float(self._joint_info[j][11])
+            for v, j in zip(arm.velocity_limits, self.arm_joint_ids, strict=True)
+        ]
+        self._arm_effort = [
+            e if e is not None else float(self._joint_info[j][10])
+            for e, j in zip(arm.efforts, self.arm_joint_ids, strict=True)
+        ]
+        self._gripper_target = self.gripper_opening()
+
+    # -- construction -------------------------------------------------------------------------
+    @classmethod
+    def spawn(cls, client: int, description: RobotDescription | str | Path, x: float, y: float,
+              yaw: float, z: float | None = None) -> Robot:
+        """Load the robot as one multibody at (x, y, yaw) and hold it still.
+
+        ``z`` defaults to the descriptor's ``spawn_height`` (wheels touching z=0). Fixed-base
+        robots are welded to the world. Arm and gripper then hold their initial positions and the
+        wheels are braked, so the robot stays at rest until commanded.
+        """
+        if not isinstance(description, RobotDescription):
+            description = RobotDescription.load(description)
+        path = composed_urdf(description)
+        z = description.spawn_height if z is None else z
+        flags = pb.URDF_USE_INERTIA_FROM_FILE
+        body = pb.loadURDF(
+            str(path),
+            basePosition=(x, y, z),
+            baseOrientation=pb.getQuaternionFromEuler((0.0, 0.0, yaw)),
+            useFixedBase=description.base.type == "fixed",
+            flags=flags,
+            physicsClientId=client,
+        )
+        robot = cls(client, body, description)
+        robot._apply_friction()
+        robot._couple_fingers()
+        robot.hold_arm()
+        robot.set_gripper(robot.gripper_opening())
+        if robot.has_wheels:
+            robot.stop_base()
+        return robot
+
+    def _apply_friction(self) -> None:
+        base = self.description.base
+        for j in self.wheel_ids_left + self.wheel_ids_right:
+            axle = np.abs(np.asarray(self._joint_info[j][13], dtype=float))
+            anisotropic = 1.0 - (1.0 - base.wheel_axle_friction_scale) * axle
+            pb.changeDynamics(self.body, j, lateralFriction=base.wheel_friction,
+                              spinningFriction=base.wheel_spinning_friction,
+                              rollingFriction=base.wheel_rolling_friction,
+                              anisotropicFriction=anisotropic.tolist(), frictionAnchor=1,
+                              physicsClientId=self.client)
+        gripper = self.description.gripper
+        for link in self.finger_link_ids:
+            pb.changeDynamics(self.body, link, lateralFriction=gripper.pad_friction,
+                              frictionAnchor=1, physicsClientId=self.client)
+
+    def _couple_fingers(self) -> None:
+        """Make two fingers move as mirror images (a gear constraint: equal joint positions).
+
+        Without it, each finger's motor saturates on its own when squeezing and a held object
+        can be walked sideways by the pair.
+        """
+        if len(self.gripper_joint_ids) != 2:
+            return
+        a, b = self.gripper_joint_ids
+        gear = pb.createConstraint(self.body, a, self.body, b, pb.JOINT_GEAR, [0, 1, 0],
+                                   [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
+        pb.changeConstraint(gear, gearRatio=-1, maxForce=10 * self.description.gripper.max_force,
+                            erp=0.2, physicsClientId=self.client)
+
+    # -- names --------------------------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        return self.description.name
+
+    @property
+    def has_wheels(self) -> bool:
+        return bool(self.wheel_ids_left)
+
+    def joint_index(self, name: str) -> int:
+        """PyBullet joint index of the joint called ``name`` (KeyError names the choices)."""
+        try:
+            return self._joints[name]
+        except KeyError:
+            raise KeyError(f"{self.name} has no joint '{name}'; joints: "
+                           f"{', '.join(self._joints)}") from None
+
+    def link_index(self, name: str) -> int:
+        """PyBullet link index of the URDF link ``name`` (-1 for the root link)."""
+        try:
+            return self._links[name]
+        except KeyError:
+            raise KeyError(f"{self.name} has no link '{name}'; links: "
+                           f"{', '.join(self._links)}") from None
+
+    def link_name(self, index: int) -> str:
+        """URDF name of the link with PyBullet index ``index``."""
+        for name, i in self._links.items():
+            if i == index:
+                return name
+        raise KeyError(f"{self.name} has no link index {index}")
+
+    # -- poses --------------------------------------------------------------------------------
+    def link_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """World pose of URDF link ``name``: position (3,) and quaternion (x, y, z, w)."""
+        index = self.link_index(name)
+        if index == -1:
+            pos, quat = self._root_pose()
+            return np.array(pos), np.array(quat)
+        state = pb.getLinkState(self.body, index, computeForwardKinematics=1,
+                                physicsClientId=self.client)
+        return np.array(state[4]), np.array(state[5])
+
+    def link_transform(self, name: str) -> np.ndarray:
+        """World pose of URDF link ``name`` as a 4x4 homogeneous matrix."""
+        pos, quat = self.link_pose(name)
+        out = np.eye(4)
+        out[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        out[:3, 3] = pos
+        return out
+
+    def _root_pose(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
+        """URDF frame of the root link (PyBullet reports the root's centre-of-mass frame)."""
+        com_pos, com_quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        inv_pos, inv_quat = pb.invertTransform(self._root_inertial[0], self._root_inertial[1])
+        return pb.multiplyTransforms(com_pos, com_quat, inv_pos, inv_quat)
+
+    def base_pose2d(self) -> tuple[float, float, float]:
+        """Planar pose (x, y, yaw) of the root link frame in the world."""
+        pos, quat = self._root_pose()
+        yaw = pb.getEulerFromQuaternion(quat)[2]
+        return float(pos[0]), float(pos[1]), float(yaw)
+
+    def base_velocity(self) -> tuple[float, float, float]:
+        """Forward and sideways speed (m/s, in the base heading frame) and yaw rate (rad/s)."""
+        lin, ang = pb.getBaseVelocity(self.body, physicsClientId=self.client)
+        _, _, yaw = self.base_pose2d()
+        c, s = math.cos(yaw), math.sin(yaw)
+        return c * lin[0] + s * lin[1], -s * lin[0] + c * lin[1], float(ang[2])
+
+    # -- arm ----------------------------------------------------------------------------------
+    def _positions(self, ids: Sequence[int]) -> np.ndarray:
+        states = pb.getJointStates(self.body, list(ids), physicsClientId=self.client)
+        return np.array([s[0] for s in states])
+
+    def arm_positions(self) -> np.ndarray:
+        """Arm joint positions (rad) in descriptor order."""
+        return self._positions(self.arm_joint_ids)
+
+    def arm_velocities(self) -> np.ndarray:
+        """Arm joint velocities (rad/s) in descriptor order."""
+        states = pb.getJointStates(self.body, self.arm_joint_ids, physicsClientId=self.client)
+        return np.array([s[1] for s in states])
+
+    def set_arm_targets(self, q: Sequence[float], max_velocity: float | None = None) -> None:
+        """Drive the arm joints toward ``q`` (rad, descriptor order) under position control.
+
+        Each joint moves at most at its velocity limit (or ``max_velocity`` if lower) and pushes
+        with at most its effort limit. Targets outside the joint limits are clipped.
+        """
+        q = np.asarray(q, dtype=float)
+        arm = self.description.arm
+        if q.shape != (len(self.arm_joint_ids),):
+            raise ValueError(f"{self.name}: expected {len(self.arm_joint_ids)} arm targets, "
+                             f"got {q.shape}")
+        q = np.clip(q, arm.lower, arm.upper)
+        for j, target, vmax, effort in zip(self.arm_joint_ids, q, self._arm_velocity,
+                                           self._arm_effort, strict=True):
+            speed = vmax if max_velocity is None else min(vmax, max_velocity)
+            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL,
+                                     targetPosition=float(target), targetVelocity=0.0,
+                                     force=effort, maxVelocity=speed,
+                                     positionGain=arm.position_gain, velocityGain=1.0,
+                                     physicsClientId=self.client)
+
+    def hold_arm(self) -> None:
+        """Hold every arm joint at its current position."""
+        self.set_arm_targets(self.arm_positions())
+
+    def reset_arm(self, q: Sequence[float] | str) -> None:
+        """Teleport the arm to ``q`` (rad, or a named state such as ``"home"``) and hold it there.
+
+        For setting a scene up only: it ignores dynamics and contacts.
+        """
+        if isinstance(q, str):
+            q = self.description.state(q)
+        for j, value in zip(self.arm_joint_ids, q, strict=True):
+            pb.resetJointState(self.body, j, float(value), 0.0, physicsClientId=self.client)
+        self.hold_arm()
+
+    # -- gripper ------------------------------------------------------------------------------
+    def set_gripper(self, opening: float) -> None:
+        """Command the distance between the finger pads (m), clipped to the gripper's stroke."""
+        g = self.description.gripper
+        finger = float(np.clip(opening / len(self.gripper_joint_ids),
+                               min(g.closed, g.open), max(g.closed, g.open)))
+        self._gripper_target = finger * len(self.gripper_joint_ids)
+        for j in self.gripper_joint_ids:
+            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL, targetPosition=finger,
+                                     targetVelocity=0.0, force=g.max_force,
+                                     maxVelocity=g.max_speed, physicsClientId=self.client)
+
+    def open_gripper(self) -> None:
+        """Open the fingers fully."""
+        self.set_gripper(self.description.gripper.max_opening)
+
+    def close_gripper(self) -> None:
+        """Close the fingers; on an object they squeeze it with the gripper's max force."""
+        self.set_gripper(self.description.gripper.min_opening)
+
+    def gripper_opening(self) -> float:
+        """Current distance between the finger pads (m)."""
+        return float(self._positions(self.gripper_joint_ids).sum())
+
+    @property
+    def gripper_target(self) -> float:
+        """Last commanded opening (m)."""
+        return self._gripper_target
+
+    def contacts(self, other_body: int | None = None,
+                 links: Sequence[int] | None = None) -> list[ContactPoint]:
+        """Contacts of this robot's links (all, or ``links``) with ``other_body`` (or any body)."""
+        kwargs = {"bodyA": self.body, "physicsClientId": self.client}
+        if other_body is not None:
+            kwargs["bodyB"] = other_body
+        wanted = None if links is None else set(links)
+        out = []
+        for c in pb.getContactPoints(**kwargs):
+            if c[2] == self.body or (wanted is not None and c[3] not in wanted):
+                continue
+            out.append(ContactPoint(self.link_name(c[3]), c[2], c[4], tuple(c[5]), float(c[9])))
+        return out
+
+    def finger_contacts(self, other_body: int | None = None) -> list[ContactPoint]:
+        """Contacts of the finger links with ``other_body`` (or any body)."""
+        return self.contacts(other_body, self.finger_link_ids)
+
+    def is_grasping(self, other_body: int) -> bool:
+        """True when every finger touches ``other_body``."""
+        touching = {c.link for c in self.finger_contacts(other_body)}
+        return len(touching) == len(self.finger_link_ids)
+
+    # -- base ---------------------------------------------------------------------------------
+    def set_wheel_velocities(self, left: float, right: float) -> None:
+        """Spin the left and right wheels at these speeds (rad/s), clipped to the max speed."""
+        base = self.description.base
+        if not self.has_wheels:
+            raise RuntimeError(f"{self.name} has a fixed base")
+        limit = base.max_wheel_speed
+        for ids, speed in ((self.wheel_ids_left, left), (self.wheel_ids_right, right)):
+            speed = float(np.clip(speed, -limit, limit))
+            for j in ids:
+                pb.setJointMotorControl2(self.body, j, pb.VELOCITY_CONTROL, targetVelocity=speed,
+                                         force=base.wheel_max_torque, physicsClientId=self.client)
+
+    def set_base_twist(self, v: float, w: float) -> None:
+        """Drive the base at forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s), skid-steer.
+
+        If a wheel would exceed the max wheel speed, both sides are scaled down together so the
+        path curvature is kept.
+        """
+        base = self.description.base
+        left = (v - w * base.track_width / 2.0) / base.wheel_radius
+        right = (v + w * base.track_width / 2.0) / base.wheel_radius
+        peak = max(abs(left), abs(right))
+        if peak > base.max_wheel_speed:
+            left, right = (left * base.max_wheel_speed / peak, right * base.max_wheel_speed / peak)
+        self.set_wheel_velocities(left, right)
+
+    def stop_base(self) -> None:
+        """Brake: hold every wheel at its current angle with full torque (no creep).
+
+        Does nothing on a fixed base.
+        """
+        if not self.has_wheels:
+            return
+        base = self.description.base
+        ids = self.wheel_ids_left + self.wheel_ids_right
+        for j, angle in zip(ids, self._positions(ids), strict=True):
+            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL,
+                                     targetPosition=float(angle), targetVelocity=0.0,
+                                     force=base.wheel_max_torque,
+                                     positionGain=0.5, velocityGain=1.0,
+                                     physicsClientId=self.client)
+
+    def halt(self) -> None:
+        """Leave the robot safe: base braked, arm holding its position, gripper unchanged."""
+        self.stop_base()
+        self.hold_arm()
+
