@@ -6,8 +6,10 @@ clock unless pacing is asked for (``realtime``), so a headless run goes as fast 
 allows. Without a world the tree runs on the monotonic clock and the loop paces itself at the
 tick rate, as BehaviorTree.CPP's ``tickWhileRunning`` does.
 
-Exit codes (:data:`EXIT_CODES`): 0 root SUCCESS, 1 root FAILURE or budget spent, 2 bad input,
-130 interrupted (the tree is halted first).
+Exit codes (:data:`EXIT_CODES`): 0 root SUCCESS, 1 root FAILURE or budget spent, 2 bad input
+(including a tree that breaks while running: a script error, a port without a value), 130
+interrupted. In every case but SUCCESS and FAILURE the tree is halted first and the robots are
+left stopped.
 """
 
 from __future__ import annotations
@@ -22,6 +24,8 @@ from typing import Any, Protocol
 
 import py_trees
 
+from bt_manip.bt.node import TreeRuntimeError
+
 EXIT_SUCCESS = 0
 EXIT_FAILURE = 1
 EXIT_BAD_INPUT = 2
@@ -30,6 +34,7 @@ EXIT_CODES = {
     "SUCCESS": EXIT_SUCCESS,
     "FAILURE": EXIT_FAILURE,
     "BUDGET": EXIT_FAILURE,
+    "ERROR": EXIT_BAD_INPUT,
     "INTERRUPTED": EXIT_INTERRUPTED,
 }
 
@@ -57,12 +62,14 @@ class RunOptions:
 
 @dataclass
 class NodeRecord:
-    """A node's final state for the report."""
+    """A node's final state for the report: ``status`` now (finished nodes are IDLE again, as
+    in BehaviorTree.CPP) and ``last_status``, what it last returned."""
 
     path: str
     node: str
     status: str
     reason: str = ""
+    last_status: str = ""
 
 
 @dataclass
@@ -108,7 +115,7 @@ class RunReport:
             f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
             f"({rtf_text}), {self.ticks} ticks",
         ]
-        failed = [n for n in self.nodes if n.status == "FAILURE" and n.reason]
+        failed = [n for n in self.nodes if "FAILURE" in (n.status, n.last_status) and n.reason]
         for n in failed[:10]:
             lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}")
         return "\n".join(lines)
@@ -121,7 +128,8 @@ def node_records(root: py_trees.behaviour.Behaviour) -> list[NodeRecord]:
     def walk(node: py_trees.behaviour.Behaviour, prefix: str) -> None:
         path = f"{prefix}/{node.name}" if prefix else node.name
         node_id = getattr(node, "node_id", type(node).__name__)
-        out.append(NodeRecord(path, node_id, node.status.name, node.feedback_message or ""))
+        status = node.status.name
+        out.append(NodeRecord(path, node_id, status, node.feedback_message or "", status))
         for child in node.children:
             walk(child, path)
 
@@ -195,7 +203,9 @@ class Runner:
                 self._advance(wall0)
         except KeyboardInterrupt:
             status, reason = "INTERRUPTED", "interrupted by the user"
-        if status in ("BUDGET", "INTERRUPTED"):
+        except TreeRuntimeError as exc:
+            status, reason = "ERROR", str(exc)
+        if status in ("BUDGET", "INTERRUPTED", "ERROR"):
             self.tree.halt()
             self._make_safe()
         wall = time.perf_counter() - wall0
@@ -222,12 +232,17 @@ class Runner:
     def _records(self) -> list[NodeRecord]:
         records = getattr(self.tree, "node_records", None)
         if callable(records):
-            return [NodeRecord(r.path, r.node, r.status, r.reason) for r in records()]
+            return [
+                NodeRecord(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
+                for r in records()
+            ]
         return node_records(self.tree.root)
 
     def _failure_reason(self) -> str:
         """The deepest failed node's reason: what the user needs to read first."""
-        failed = [r for r in self._records() if r.status == "FAILURE" and r.reason]
+        failed = [
+            r for r in self._records() if "FAILURE" in (r.status, r.last_status) and r.reason
+        ]
         if not failed:
             return ""
         deepest = max(failed, key=lambda r: r.path.count("/"))

@@ -18,8 +18,18 @@ from bt_manip.runner import NodeRecord, Runner, node_records
 def _records(tree: Any) -> list[NodeRecord]:
     fn = getattr(tree, "node_records", None)
     if callable(fn):
-        return [NodeRecord(r.path, r.node, r.status, r.reason) for r in fn()]
+        return [
+            NodeRecord(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
+            for r in fn()
+        ]
     return node_records(tree.root)
+
+
+def _shown(rec: NodeRecord) -> str:
+    """RUNNING while running; once finished, what the node returned (not IDLE)."""
+    if rec.status == "IDLE" and rec.last_status:
+        return rec.last_status
+    return rec.status
 
 
 class StatusLog:
@@ -32,14 +42,15 @@ class StatusLog:
 
     def __call__(self, runner: Runner) -> None:
         for rec in _records(self.tree):
-            before = self._last.get(rec.path, "INVALID")
-            if rec.status != before:
-                why = f" ({rec.reason})" if rec.reason and rec.status == "FAILURE" else ""
+            before = self._last.get(rec.path, "IDLE")
+            now = _shown(rec)
+            if now != before:
+                why = f" ({rec.reason})" if rec.reason and now == "FAILURE" else ""
                 print(
-                    f"[{runner.sim_time:9.3f} s] {rec.path}: {before} -> {rec.status}{why}",
+                    f"[{runner.sim_time:9.3f} s] {rec.path}: {before} -> {now}{why}",
                     file=self.stream,
                 )
-                self._last[rec.path] = rec.status
+                self._last[rec.path] = now
 
     def close(self) -> None:
         self.stream.flush()

@@ -1,0 +1,119 @@
+"""`bt-manip run`: exit codes, run report, blackboard output, sim clock, Ctrl-C."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from bt_manip.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+TABLE = ROOT / "worlds" / "sawyer_table.yaml"
+
+
+def _tree(tmp_path: Path, body: str, name: str = "t.xml") -> Path:
+    path = tmp_path / name
+    path.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+        f'  <BehaviorTree ID="Main">\n{body}\n  </BehaviorTree>\n</root>\n'
+    )
+    return path
+
+
+def test_builtins_demo_succeeds_and_writes_report_and_blackboard(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    report, bb = tmp_path / "report.json", tmp_path / "bb.json"
+    code = main(
+        [
+            "run",
+            str(ROOT / "trees" / "builtins_demo.xml"),
+            "--report",
+            str(report),
+            "--bb-out",
+            str(bb),
+        ]
+    )
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "result: SUCCESS" in out
+    data = json.loads(report.read_text())
+    assert data["status"] == "SUCCESS" and data["exit_code"] == 0
+    assert data["ticks"] >= 2
+    nodes = {n["path"]: n for n in data["nodes"]}
+    assert nodes["demo/Fallback/plan_a"]["last_status"] == "FAILURE"
+    assert json.loads(bb.read_text())["summary"] == "plan b, total 12"
+
+
+def test_failing_tree_exits_1_with_the_failing_node(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _tree(tmp_path, '<Sequence><AlwaysSuccess/><AlwaysFailure name="nope"/></Sequence>')
+    assert main(["run", str(tree)]) == 1
+    assert "result: FAILURE" in capsys.readouterr().out
+
+
+def test_tick_budget_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tree = _tree(tmp_path, '<Sleep msec="100000"/>')
+    assert main(["run", str(tree), "--max-ticks", "3", "--tick-hz", "200"]) == 1
+    assert "tick budget of 3 spent" in capsys.readouterr().out
+
+
+def test_runtime_script_error_exits_2_naming_the_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _tree(tmp_path, '<Sequence>\n<Script code="x := missing + 1"/>\n</Sequence>')
+    assert main(["run", str(tree), "--quiet"]) == 2
+    out = capsys.readouterr().out
+    assert "result: ERROR" in out
+    assert "line 4" in out and "missing" in out
+
+
+def test_bad_tree_exits_2_without_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    tree = _tree(tmp_path, "<Sequence><AlwaysSucces/></Sequence>")
+    assert main(["run", str(tree)]) == 2
+    err = capsys.readouterr().err
+    assert f"{tree}:3:" in err and "AlwaysSuccess" in err and "Traceback" not in err
+
+
+def test_durations_run_on_the_sim_clock(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    tree = _tree(tmp_path, '<Sleep msec="30000"/>')
+    report = tmp_path / "r.json"
+    t0 = time.perf_counter()
+    assert main(["run", str(tree), "--world", str(TABLE), "--quiet", "--report", str(report)]) == 0
+    wall = time.perf_counter() - t0
+    data = json.loads(report.read_text())
+    assert data["sim_time"] == pytest.approx(30.0, abs=0.051)
+    assert data["ticks"] == 601
+    assert wall < data["sim_time"]  # 30 s of sim, not of waiting
+    assert data["seed"] == 0 and data["world"] == str(TABLE)
+
+
+def test_ctrl_c_halts_and_exits_130(tmp_path: Path) -> None:
+    tree = _tree(tmp_path, '<Sleep msec="600000"/>')
+    report = tmp_path / "r.json"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "bt_manip.cli", "run", str(tree), "--report", str(report)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+    )
+    assert proc.stdout is not None
+    first = proc.stdout.readline()  # the first status line: the tree is running
+    assert "RUNNING" in first
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=30)
+    assert proc.returncode == 130, err
+    assert "result: INTERRUPTED" in out
+    assert "Traceback" not in err
+    assert json.loads(report.read_text())["status"] == "INTERRUPTED"
