@@ -116,21 +116,22 @@ class JointMove(RobotAction):
                 raise ActionFailed(self._where() + ": " + "; ".join(hits))
         if self.stage >= len(self.stages):
             return Status.SUCCESS
-        joints = self.stages[self.stage]
+        # every joint, not only the moving ones, must be where it was told to be: a load can
+        # push a holding joint away, and the move is not done until it is back
         q = robot.arm_positions()
         qd = robot.arm_velocities()
-        err = np.abs(q[joints] - self.targets[joints])
-        if np.all(err < self.tol) and np.all(np.abs(qd[joints]) < SETTLE_SPEED):
+        err = np.abs(q - self.command)
+        if np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED):
             self._next_stage(robot)
             if self.stage >= len(self.stages):
                 return Status.SUCCESS
             return Status.RUNNING
         if self.now() - self.stage_started > self.timeout:
-            worst = joints[int(np.argmax(err))]
+            worst = int(np.argmax(err))
             robot.hold_arm()
             raise ActionFailed(
                 f"{self._where()}: joint {worst} stopped at {_fmt(q[worst], self.units)}, "
-                f"{_fmt(err.max(), self.units)} from its target after {self.timeout:g} s"
+                f"{_fmt(err[worst], self.units)} from its target after {self.timeout:g} s"
             )
         return Status.RUNNING
 

@@ -58,12 +58,11 @@ def arm_collisions(world: Any, robot: Any) -> list[str]:
 
 
 def carried_collisions(world: Any, robot: Any, robot_name: str | None = None) -> list[str]:
-    """Contacts between objects attached to ``robot`` and the static world."""
-    static = _static_ids(world)
+    """Contacts between objects attached to ``robot`` and the static world (the supports an
+    object rested on when it was attached do not count until it has left them)."""
     name = robot_name or next((n for n, r in world.robots.items() if r is robot), "")
     found = []
     for held in world.attachments.held_by(name):
-        for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=world.client):
-            if pt[2] in static:
-                found.append(f"carried '{held.object_name}' touched '{static[pt[2]]}'")
-    return sorted(set(found))
+        for other in world.attachments.static_contacts(held.object_name):
+            found.append(f"carried '{held.object_name}' touched '{other}'")
+    return found

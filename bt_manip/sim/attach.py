@@ -62,6 +62,7 @@ class Attachments:
         self.world = world
         self._by_object: dict[str, Attachment] = {}
         self._touched: dict[str, set[str]] = {}
+        self._supports: dict[str, set[int]] = {}
 
     @property
     def client(self) -> int:
@@ -135,6 +136,11 @@ class Attachments:
             object_name, body, robot_name, robot.body, link_index, link_name, cid
         )
         self._touched[object_name] = set()
+        self._supports[object_name] = {
+            pt[2]
+            for pt in pb.getContactPoints(bodyA=body, physicsClientId=self.client)
+            if pt[2] != robot.body
+        }
         return AttachResult(True, "", distance)
 
     def detach(self, object_name: str) -> AttachResult:
@@ -142,25 +148,41 @@ class Attachments:
         held = self._by_object.pop(object_name, None)
         if held is None:
             return AttachResult(False, f"'{object_name}' is not attached")
+        self._supports.pop(object_name, None)
         pb.removeConstraint(held.constraint_id, physicsClientId=self.client)
         return AttachResult(True)
 
-    def record_contacts(self) -> None:
-        """Note every static body (wall, furniture, floor) an attached object touches now.
-
-        The World calls this after each step while anything is attached.
-        """
-        if not self._by_object:
-            return
-        static = {
+    def _static_names(self) -> dict[int, str]:
+        return {
             i.body_id: i.name
             for i in self.world.infos.values()
             if i.kind in ("wall", "furniture", "ground")
         }
-        for held in self._by_object.values():
-            for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=self.client):
-                if pt[2] in static:
-                    self._touched[held.object_name].add(static[pt[2]])
+
+    def static_contacts(self, object_name: str) -> list[str]:
+        """Static bodies (walls, furniture, floor) the attached object touches now.
+
+        What supported the object when it was attached (the floor, a rack) does not count until
+        the object has left it: lifting an object off its support is not a collision.
+        """
+        held = self._by_object.get(object_name)
+        if held is None:
+            return []
+        static = self._static_names()
+        supports = self._supports.get(object_name, set())
+        touching = {
+            pt[2] for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=self.client)
+        }
+        supports &= touching  # a support left once is a support no more
+        return sorted(static[b] for b in touching if b in static and b not in supports)
+
+    def record_contacts(self) -> None:
+        """Note every static body an attached object touches now (see :meth:`static_contacts`).
+
+        The World calls this after each step while anything is attached.
+        """
+        for name in self._by_object:
+            self._touched[name].update(self.static_contacts(name))
 
     def touched(self, object_name: str) -> list[str]:
         """Static bodies ``object_name`` has touched since it was last attached."""
