@@ -95,17 +95,21 @@ class JointMove(RobotAction):
         # joints moved together arrive together: scale each speed to the slowest travel time
         travel = np.abs(self.targets[joints] - q[joints])
         t = float(np.max(travel / vmax[joints])) if len(joints) else 0.0
-        self.stage_speed = float(np.max(travel / t)) if t > 1e-9 else float(np.min(vmax[joints]))
         self._send(joints, travel, t)
 
     def _send(self, joints: list[int], travel: np.ndarray, t: float) -> None:
+        """Command the stage. The moving joints get speeds that make them arrive together;
+        every joint may correct at no less than a fifth of its allowed speed, so a joint that
+        a load pushes away can come back."""
         robot = self.robot()
-        if len(joints) == 1 or t < 1e-9:
-            robot.set_arm_targets(self.command, max_velocity=self.stage_speed)
+        vmax = np.asarray(robot.description.arm.velocity_limits, dtype=float) * self.speed
+        floor = 0.2 * vmax
+        speeds = floor.copy()
+        if t > 1e-9:
+            speeds[joints] = np.maximum(travel / t, floor[joints])
         else:
-            # per-joint speeds: give each joint the speed that makes it take time t
-            speeds = np.maximum(travel / t, 1e-3)
-            robot.set_arm_targets(self.command, max_velocity=speeds)
+            speeds[joints] = vmax[joints]
+        robot.set_arm_targets(self.command, max_velocity=speeds)
 
     def step(self) -> Status:
         robot = self.robot()

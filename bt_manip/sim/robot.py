@@ -600,24 +600,29 @@ class Robot:
         states = pb.getJointStates(self.body, self.arm_joint_ids, physicsClientId=self.client)
         return np.array([s[1] for s in states])
 
-    def set_arm_targets(self, q: Sequence[float], max_velocity: float | None = None) -> None:
+    def set_arm_targets(
+        self, q: Sequence[float], max_velocity: float | Sequence[float] | None = None
+    ) -> None:
         """Drive the arm joints toward ``q`` (rad, descriptor order) under position control.
 
-        Each joint moves at most at its velocity limit (or ``max_velocity`` if lower) and pushes
-        with at most its effort limit. Targets outside the joint limits are clipped.
+        Each joint moves at most at its velocity limit (or ``max_velocity``, one value for all
+        joints or one per joint, if lower) and pushes with at most its effort limit. Targets
+        outside the joint limits are clipped.
         """
         q = np.asarray(q, dtype=float)
         arm = self.description.arm
-        if q.shape != (len(self.arm_joint_ids),):
-            raise ValueError(f"{self.name}: expected {len(self.arm_joint_ids)} arm targets, "
-                             f"got {q.shape}")
+        n = len(self.arm_joint_ids)
+        if q.shape != (n,):
+            raise ValueError(f"{self.name}: expected {n} arm targets, got {q.shape}")
+        limits = np.asarray(self._arm_velocity, dtype=float)
+        if max_velocity is not None:
+            limits = np.minimum(limits, np.broadcast_to(np.asarray(max_velocity, float), (n,)))
         q = np.clip(q, arm.lower, arm.upper)
-        for j, target, vmax, effort in zip(self.arm_joint_ids, q, self._arm_velocity,
-                                           self._arm_effort, strict=True):
-            speed = vmax if max_velocity is None else min(vmax, max_velocity)
+        for j, target, speed, effort in zip(self.arm_joint_ids, q, limits, self._arm_effort,
+                                            strict=True):
             pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL,
                                      targetPosition=float(target), targetVelocity=0.0,
-                                     force=effort, maxVelocity=speed,
+                                     force=effort, maxVelocity=float(speed),
                                      positionGain=arm.position_gain, velocityGain=1.0,
                                      physicsClientId=self.client)
 

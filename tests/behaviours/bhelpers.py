@@ -1,0 +1,51 @@
+"""Helpers and fixtures of the behaviour tests: worlds with the robot placed (placing is test
+setup, not an action), and a way to run a snippet of tree XML against a world."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pybullet as pb
+import pytest
+
+import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
+from bt_manip.bt import Tree, TreeContext, load_tree_string
+from bt_manip.runner import Runner, RunOptions, RunReport
+from bt_manip.sim.world import World
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def place_robot(world: World, name: str, x: float, y: float, yaw: float) -> None:
+    robot = world.robots[name]
+    z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
+    pb.resetBasePositionAndOrientation(
+        robot.body, [x, y, z], pb.getQuaternionFromEuler([0, 0, yaw]),
+        physicsClientId=world.client,
+    )
+    world.step(24)
+
+
+def run_xml(world: World, body: str, max_sim_time: float = 60.0) -> tuple[RunReport, Tree]:
+    xml = (f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>')
+    tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+    return Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run(), tree
+
+
+def reasons(report: RunReport) -> dict[str, str]:
+    return {n.path.split("/")[-1]: n.reason for n in report.nodes if n.reason}
+
+
+@pytest.fixture
+def house_at_pregrasp() -> Iterator[World]:
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        p = world.poses["pregrasp_panel"]
+        place_robot(world, "husky", p.x, p.y, p.yaw)
+        yield world
+
+
+@pytest.fixture
+def table() -> Iterator[World]:
+    with World(ROOT / "worlds" / "sawyer_table.yaml", seed=0) as world:
+        yield world

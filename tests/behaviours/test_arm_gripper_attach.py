@@ -1,0 +1,99 @@
+"""Arm, gripper and attach behaviours on the real robots, outcomes checked in the world."""
+
+from __future__ import annotations
+
+import numpy as np
+import pybullet as pb
+import pytest
+from bhelpers import place_robot, reasons, run_xml
+
+from bt_manip.sim.world import World
+
+PICK = """<Sequence>
+  <OpenGripper/>
+  <MoveJointsSequentially name="pregrasp" targets="70;11;78;-56;85;4" order="0;2;3;5;4;1"/>
+  <CloseGripper name="close" holding="{holding}" object="{held}"/>
+  <Attach name="attach" object="panel"/>
+  <Lift name="lift" deltas="0;-50;-30;0;0;0" speed="0.3"/>
+  <IsAttached object="panel"/>
+  <ObjectAbove object="panel" height="0.1"/>
+  <CarriedClear object="panel"/>
+</Sequence>"""
+
+
+def test_scenario_a_pick_and_lift(house_at_pregrasp: World) -> None:
+    world = house_at_pregrasp
+    report, tree = run_xml(world, PICK)
+    assert report.status == "SUCCESS", report.reason
+    robot = world.robots["husky"]
+    q = np.degrees(robot.arm_positions())
+    assert q == pytest.approx([70, -39, 48, -56, 85, 4], abs=0.6)
+    lo, hi = pb.getAABB(world.movable["panel"], physicsClientId=world.client)
+    assert lo[2] > 0.5 and hi[2] > 1.5  # carried upright, well off the floor
+    assert tree.blackboard.as_dict()["holding"] is True
+    assert tree.blackboard.as_dict()["held"] == "panel"
+    # the panel moves with the hand: drive the arm and watch the panel follow
+    before = np.asarray(pb.getBasePositionAndOrientation(world.movable["panel"],
+                                                         physicsClientId=world.client)[0])
+    report, _ = run_xml(world, '<MoveJoints targets="90;-39;48;-56;85;4" speed="0.3"/>')
+    assert report.status == "SUCCESS", report.reason
+    after = np.asarray(pb.getBasePositionAndOrientation(world.movable["panel"],
+                                                        physicsClientId=world.client)[0])
+    assert np.linalg.norm(after - before) > 0.2
+
+
+def test_attach_refuses_an_object_out_of_reach(house_at_pregrasp: World) -> None:
+    world = house_at_pregrasp
+    report, _ = run_xml(world, '<Sequence><MoveJoints state="tuck"/><Attach object="panel"/>'
+                               '</Sequence>')
+    assert report.status == "FAILURE"
+    why = reasons(report)["Attach"]
+    assert "'panel' is" in why and "from the fingers (must touch or be within 1.0 cm)" in why
+    assert not world.attachments.is_attached("panel")
+    panel = world.movable["panel"]
+    z = pb.getBasePositionAndOrientation(panel, physicsClientId=world.client)[0][2]
+    assert z == pytest.approx(0.075, abs=0.002)
+
+
+def test_target_outside_joint_limits_fails_before_moving(house_at_pregrasp: World) -> None:
+    world = house_at_pregrasp
+    q0 = world.robots["husky"].arm_positions()
+    report, _ = run_xml(world, '<MoveJointsSequentially targets="0;0;200;0;0;0" order="2"/>')
+    assert report.status == "FAILURE"
+    assert "joint 2 (elbow_joint) target 200.0 deg is outside its limits" in reasons(report)[
+        "MoveJointsSequentially"]
+    assert np.allclose(world.robots["husky"].arm_positions(), q0, atol=1e-3)
+
+
+def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
+    from bhelpers import ROOT
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        # facing the west wall of the workshop, 25 cm from it, arm unfolding towards it
+        place_robot(world, "husky", -2.25, -2.0, np.pi)
+        report, _ = run_xml(world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3"/>')
+        assert report.status == "FAILURE"
+        why = reasons(report)["MoveJoints"]
+        assert "touched 'wall_x_m3'" in why
+        # it stopped there instead of pushing on
+        q = world.robots["husky"].arm_positions()
+        world.step(240)
+        assert np.allclose(world.robots["husky"].arm_positions(), q, atol=0.02)
+
+
+def test_close_on_nothing_reports_not_holding(table: World) -> None:
+    report, tree = run_xml(table, '<Sequence><OpenGripper/>'
+                                  '<CloseGripper holding="{h}" object="{o}"/></Sequence>')
+    assert report.status == "SUCCESS"
+    assert tree.blackboard.as_dict()["h"] is False
+    assert table.robots["sawyer"].gripper_opening() == pytest.approx(0.0, abs=2e-3)
+    report, _ = run_xml(table, '<CloseGripper require_object="true"/>')
+    assert report.status == "FAILURE"
+    assert "closed on nothing" in reasons(report)["CloseGripper"]
+
+
+def test_unknown_object_and_robot_give_reasons(table: World) -> None:
+    report, _ = run_xml(table, '<Attach object="teapot"/>')
+    assert "no movable object named 'teapot'" in reasons(report)["Attach"]
+    report, _ = run_xml(table, '<OpenGripper robot="r2d2"/>')
+    assert "no robot named 'r2d2'; robots: sawyer" in reasons(report)["OpenGripper"]
