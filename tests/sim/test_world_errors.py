@@ -28,8 +28,9 @@ CASES = [
 
 
 @pytest.mark.parametrize(("name", "line", "text"), CASES, ids=[c[0] for c in CASES])
-def test_bad_world_exits_2_with_one_line(name: str, line: int, text: str,
-                                          capsys: pytest.CaptureFixture[str]) -> None:
+def test_bad_world_exits_2_with_one_line(
+    name: str, line: int, text: str, capsys: pytest.CaptureFixture[str]
+) -> None:
     path = BAD / name
     code = main(["world", str(path)])
     out, err = capsys.readouterr()
@@ -41,8 +42,9 @@ def test_bad_world_exits_2_with_one_line(name: str, line: int, text: str,
     assert "Traceback" not in out + err
 
 
-def test_every_problem_is_reported_in_one_run(tmp_path: Path,
-                                              capsys: pytest.CaptureFixture[str]) -> None:
+def test_every_problem_is_reported_in_one_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     world = tmp_path / "many.yaml"
     world.write_text(
         "name: many\n"
@@ -55,5 +57,9 @@ def test_every_problem_is_reported_in_one_run(tmp_path: Path,
     )
     assert main(["world", str(world)]) == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert [e.split(": ", 1)[0] for e in err] == [f"{world}:2", f"{world}:4", f"{world}:5",
-                                                  f"{world}:7"]
+    assert [e.split(": ", 1)[0] for e in err] == [
+        f"{world}:2",
+        f"{world}:4",
+        f"{world}:5",
+        f"{world}:7",
+    ]
