@@ -9,6 +9,7 @@ end the move with FAILURE and a reason; the arm then holds where it is.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import ClassVar
 
 import numpy as np
@@ -26,6 +27,18 @@ TIMEOUT = PortInformation(float, False, "sim seconds allowed per joint move", 10
 CHECK = PortInformation(bool, False, "fail when the arm touches walls, furniture or floor", True)
 SETTLE_SPEED = 0.05
 """A joint counts as arrived when within tolerance and slower than this (rad/s)."""
+VIA_TOLERANCE = 0.05
+"""A pass-through waypoint counts as reached within this (rad), without stopping there."""
+
+
+@dataclass
+class Stage:
+    """One step of a move: the full arm command (rad), the joints it moves, and whether it is
+    a pass-through waypoint (reached loosely, without stopping) or a point to stop at."""
+
+    command: np.ndarray
+    joints: list[int]
+    via: bool = False
 
 
 def to_radians(values: list[float], units: str) -> np.ndarray:
@@ -51,8 +64,8 @@ class JointMove(RobotAction):
         "check_collisions": CHECK,
     }
 
-    def plan(self, q_now: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
-        """Final targets (rad, all arm joints) and the stages: lists of joints moved together."""
+    def plan(self, q_now: np.ndarray) -> list[Stage]:
+        """The stages of the move."""
         raise NotImplementedError
 
     def start(self) -> None:
@@ -67,33 +80,37 @@ class JointMove(RobotAction):
         self.check = bool(self.get_input("check_collisions"))
         arm = robot.description.arm
         q_now = robot.arm_positions()
-        targets, stages = self.plan(q_now)
+        stages = [st for st in self.plan(q_now) if st.joints]
         lower = np.asarray(arm.lower, dtype=float)
         upper = np.asarray(arm.upper, dtype=float)
-        for j in sorted({j for stage in stages for j in stage}):
-            if not lower[j] - 1e-9 <= targets[j] <= upper[j] + 1e-9:
-                raise ActionFailed(
-                    f"joint {j} ({arm.joints[j]}) target {_fmt(targets[j], self.units)} is "
-                    f"outside its limits [{_fmt(lower[j], self.units)}, "
-                    f"{_fmt(upper[j], self.units)}]"
-                )
-        self.targets = targets
-        self.stages = [s for s in stages if s]
+        for st in stages:
+            command = st.command
+            for j in st.joints:
+                if not lower[j] - 1e-9 <= command[j] <= upper[j] + 1e-9:
+                    raise ActionFailed(
+                        f"joint {j} ({arm.joints[j]}) target {_fmt(command[j], self.units)} is "
+                        f"outside its limits [{_fmt(lower[j], self.units)}, "
+                        f"{_fmt(upper[j], self.units)}]"
+                    )
+        self.stages = stages
         self.command = q_now.copy()
         self.stage = -1
-        self._next_stage(robot)
+        # contacts the arm already has may stay (it can then move away from them); only new
+        # ones end the move
+        self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
+        self._next_stage()
 
-    def _next_stage(self, robot: object) -> None:
+    def _next_stage(self) -> None:
         self.stage += 1
         self.stage_started = self.now()
         if self.stage >= len(self.stages):
             return
-        joints = self.stages[self.stage]
+        target, joints = self.stages[self.stage].command, self.stages[self.stage].joints
         q = self.robot().arm_positions()
         vmax = np.asarray(self.robot().description.arm.velocity_limits, dtype=float) * self.speed
-        self.command[joints] = self.targets[joints]
+        self.command = target.copy()
         # joints moved together arrive together: scale each speed to the slowest travel time
-        travel = np.abs(self.targets[joints] - q[joints])
+        travel = np.abs(target[joints] - q[joints])
         t = float(np.max(travel / vmax[joints])) if len(joints) else 0.0
         self._send(joints, travel, t)
 
@@ -114,7 +131,7 @@ class JointMove(RobotAction):
     def step(self) -> Status:
         robot = self.robot()
         if self.check:
-            hits = arm_collisions(self.world, robot)
+            hits = sorted(set(arm_collisions(self.world, robot)) - self.initial_contacts)
             if hits:
                 robot.hold_arm()
                 raise ActionFailed(self._where() + ": " + "; ".join(hits))
@@ -125,8 +142,12 @@ class JointMove(RobotAction):
         q = robot.arm_positions()
         qd = robot.arm_velocities()
         err = np.abs(q - self.command)
-        if np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED):
-            self._next_stage(robot)
+        if self.stages[self.stage].via:
+            arrived = bool(np.all(err < VIA_TOLERANCE))
+        else:
+            arrived = bool(np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED))
+        if arrived:
+            self._next_stage()
             if self.stage >= len(self.stages):
                 return Status.SUCCESS
             return Status.RUNNING
@@ -140,7 +161,7 @@ class JointMove(RobotAction):
         return Status.RUNNING
 
     def _where(self) -> str:
-        joints = self.stages[self.stage] if 0 <= self.stage < len(self.stages) else []
+        joints = self.stages[self.stage].joints if 0 <= self.stage < len(self.stages) else []
         return f"moving joint {joints[0]}" if len(joints) == 1 else "moving the arm"
 
 
@@ -151,7 +172,8 @@ class MoveJointsSequentially(JointMove):
     - RUNNING while a joint moves (the others hold their positions);
     - SUCCESS when every joint named in ``order`` has reached its target within ``tolerance``;
     - FAILURE when a target is outside its joint limits, a joint does not arrive within
-      ``joint_timeout`` s, or the arm (or what it carries) touches a wall, furniture or the floor.
+      ``joint_timeout`` s, or the arm (or what it carries) comes into contact with a wall,
+      furniture or the floor (contacts it already had when it started do not count).
     Halted: the arm holds where it is.
     """
 
@@ -163,7 +185,7 @@ class MoveJointsSequentially(JointMove):
         ),
     }
 
-    def plan(self, q_now: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
+    def plan(self, q_now: np.ndarray) -> list[Stage]:
         targets = to_radians(self.get_input("targets"), self.get_input("units"))
         n = len(q_now)
         if len(targets) != n:
@@ -172,9 +194,13 @@ class MoveJointsSequentially(JointMove):
         bad = [j for j in order if not 0 <= j < n]
         if bad or len(set(order)) != len(order):
             raise ActionFailed(f"order must list distinct joint indices 0..{n - 1}, got {order}")
-        full = q_now.copy()
-        full[order] = targets[order]
-        return full, [[j] for j in order]
+        stages = []
+        command = q_now.copy()
+        for j in order:
+            command = command.copy()
+            command[j] = targets[j]
+            stages.append(Stage(command, [j]))
+        return stages
 
 
 @registry.register
@@ -193,7 +219,7 @@ class MoveJoints(JointMove):
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
     }
 
-    def plan(self, q_now: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
+    def plan(self, q_now: np.ndarray) -> list[Stage]:
         state = self.get_input("state")
         values = self.get_input("targets")
         if bool(state) == bool(values):
@@ -207,34 +233,163 @@ class MoveJoints(JointMove):
             targets = to_radians(values, self.get_input("units"))
         if len(targets) != len(q_now):
             raise ActionFailed(f"targets has {len(targets)} values; the arm has {len(q_now)}")
-        return targets, [list(range(len(q_now)))]
+        return [Stage(targets, list(range(len(q_now))))]
 
 
 @registry.register
 class Lift(JointMove):
-    """Lifts by changing joints by ``deltas`` from where they are, one joint at a time.
+    """Lifts what the gripper holds: by joint ``deltas`` (one joint at a time), or straight up
+    by ``height`` metres (a vertical line of IK waypoints, orientation kept).
 
     Scenario A's lift is ``deltas="0;-50;-30;0;0;0"`` (deg): joint 1 up by 50 deg, then joint 2
     by 30 deg. ``order`` picks the sequence (default: joints with a non-zero delta, in index
     order).
 
-    - RUNNING while moving; SUCCESS when every changed joint is within ``tolerance``;
-    - FAILURE when a new target is outside the limits, on a time-out, or on a collision.
+    - RUNNING while moving; SUCCESS when the arm is at the last target within ``tolerance``;
+    - FAILURE when a target is outside the limits or unreachable, on a time-out, or on a
+      collision.
     Halted: the arm holds where it is.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **JointMove.INPUT_PORTS,
-        "deltas": PortInformation(list[float], True, "change of each arm joint"),
+        "deltas": PortInformation(list[float], False, "change of each arm joint", []),
         "order": PortInformation(list[int], False, "joints in the order to move them", []),
+        "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
     }
 
-    def plan(self, q_now: np.ndarray) -> tuple[np.ndarray, list[list[int]]]:
-        deltas = to_radians(self.get_input("deltas"), self.get_input("units"))
+    def plan(self, q_now: np.ndarray) -> list[Stage]:
+        values = self.get_input("deltas")
+        height = float(self.get_input("height"))
+        if bool(values) == (height != 0.0):
+            raise ActionFailed('give exactly one of deltas="..." or height="..."')
         n = len(q_now)
+        if height:
+            from bt_manip.behaviours import cartesian
+
+            robot = self.robot()
+            tip = robot.description.grasp_frame
+            start = robot.link_transform(tip)
+            goal = start.copy()
+            goal[2, 3] += height
+            path = cartesian.line(robot, tip, start, goal, q_now)
+            return _through(path, n)
+        deltas = to_radians(values, self.get_input("units"))
         if len(deltas) != n:
             raise ActionFailed(f"deltas has {len(deltas)} values; the arm has {n} joints")
         order = list(self.get_input("order")) or [j for j in range(n) if deltas[j] != 0.0]
         if any(not 0 <= j < n for j in order):
             raise ActionFailed(f"order must list joint indices 0..{n - 1}, got {order}")
-        return q_now + deltas, [[j] for j in order]
+        stages = []
+        command = q_now.copy()
+        for j in order:
+            command = command.copy()
+            command[j] = q_now[j] + deltas[j]
+            stages.append(Stage(command, [j]))
+        return stages
+
+
+@registry.register
+class MoveToPose(JointMove):
+    """Moves the gripper (or ``frame``) to a pose in the world, found by inverse kinematics.
+
+    The target position is ``position`` (x;y;z) or the centre of ``object``, plus ``offset``
+    (x;y;z, world frame). The orientation is ``orientation`` (quaternion x;y;z;w, world frame;
+    default ``0;1;0;0``: the tool pointing straight down). With ``match_object_yaw`` the
+    orientation is turned about the vertical to the object's yaw (modulo 90 deg, the turn
+    nearest the current wrist), so a parallel gripper closes on two faces of a box; with
+    ``free_yaw`` the rotation about the tool axis is left to the solver. ``path="line"`` moves
+    the tool on a straight line from where it is (orientation turning evenly); the default
+    ``joint`` interpolates the joints. With ``approach`` > 0 the last ``approach`` metres are a
+    straight line along the tool axis.
+
+    - RUNNING while the arm moves through the joint waypoints;
+    - SUCCESS when the last waypoint is reached within ``tolerance``;
+    - FAILURE when no configuration reaches the pose (the reason says why: beyond reach, joint
+      limits, not converged), on a time-out, or on a collision with walls, furniture or floor.
+    Halted: the arm holds where it is.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **JointMove.INPUT_PORTS,
+        "position": PortInformation(list[float], False, "target x;y;z (world)", []),
+        "object": PortInformation(str, False, "target the centre of this object", ""),
+        "offset": PortInformation(list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0]),
+        "orientation": PortInformation(
+            list[float], False, "quaternion x;y;z;w (world)", [0.0, 1.0, 0.0, 0.0]
+        ),
+        "match_object_yaw": PortInformation(bool, False, "turn with the object's yaw", False),
+        "free_yaw": PortInformation(
+            bool, False, "leave the rotation about the tool axis free", False
+        ),
+        "approach": PortInformation(float, False, "straight-line approach length (m)", 0.0),
+        "frame": PortInformation(str, False, "robot link to place (default: grasp frame)", ""),
+        "path": PortInformation(
+            str, False, "joint: interpolate joints; line: straight line from where it is", "joint"
+        ),
+    }
+
+    def plan(self, q_now: np.ndarray) -> list[Stage]:
+        import pybullet as pb
+
+        from bt_manip.behaviours import cartesian
+
+        robot = self.robot()
+        tip = self.get_input("frame") or robot.description.grasp_frame
+        position = list(self.get_input("position"))
+        name = self.get_input("object")
+        if bool(position) == bool(name):
+            raise ActionFailed('give exactly one of position="x;y;z" or object="name"')
+        yaw = None
+        if name:
+            pos, quat = pb.getBasePositionAndOrientation(
+                self.object_body(name), physicsClientId=self.world.client
+            )
+            position = list(pos)
+            yaw = pb.getEulerFromQuaternion(quat)[2]
+        offset = self.get_input("offset")
+        if len(position) != 3 or len(offset) != 3:
+            raise ActionFailed("position and offset take three numbers x;y;z")
+        target = cartesian.pose_matrix(np.add(position, offset), self.get_input("orientation"))
+        if self.get_input("match_object_yaw") and yaw is not None:
+            target = self._turned_to(robot, tip, target, yaw)
+        free = bool(self.get_input("free_yaw"))
+        n = len(q_now)
+        approach = float(self.get_input("approach"))
+        first = target.copy()
+        if approach > 0:
+            first[:3, 3] -= approach * target[:3, 2]
+        if self.get_input("path") == "line":
+            here = robot.link_transform(tip)
+            stages = _through(cartesian.line(robot, tip, here, first, q_now, free), n)
+            q_first = stages[-1].command
+        elif self.get_input("path") == "joint":
+            q_first = cartesian.solve(robot, tip, first, q_now, free)
+            stages = [Stage(q_first, list(range(n)))]
+        else:
+            raise ActionFailed(f"path must be 'joint' or 'line', got '{self.get_input('path')}'")
+        if approach > 0:
+            stages += _through(cartesian.line(robot, tip, first, target, q_first, free), n)
+        return stages
+
+    @staticmethod
+    def _turned_to(robot: object, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
+        """``target`` turned about the world vertical by the object's yaw plus k x 90 deg,
+        choosing k so the tool turns least from where it points now."""
+        now = robot.link_transform(tip)[:3, :3]  # type: ignore[attr-defined]
+        best, best_angle = target, np.inf
+        for k in range(4):
+            a = yaw + k * np.pi / 2
+            rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+            cand = target.copy()
+            cand[:3, :3] = rz @ target[:3, :3]
+            turn = np.arccos(np.clip((np.trace(now.T @ cand[:3, :3]) - 1) / 2, -1, 1))
+            if turn < best_angle:
+                best, best_angle = cand, turn
+        return best
+
+
+def _through(path: list[np.ndarray], n: int) -> list[Stage]:
+    """Stages along a waypoint path: pass through every waypoint, stop at the last."""
+    joints = list(range(n))
+    return [Stage(q, joints, via=i < len(path) - 1) for i, q in enumerate(path)]

@@ -1,0 +1,139 @@
+"""Cartesian targets for arm behaviours: IK on the robot's own model, straight-line paths.
+
+Each robot gets one :class:`~bt_manip.kinematics.ArmModel` and solver per tip frame, built from
+the same URDF PyBullet loaded and kept on the robot handle. Solves are deterministic (no
+wall-clock budget, a bounded number of seeded restarts), so the same run gives the same joints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from bt_manip.behaviours.base import ActionFailed
+from bt_manip.kinematics import ArmModel, IKOptions, IKSolver
+
+STEP = 0.02
+"""Spacing (m) of the waypoints of a straight-line move."""
+
+TOLERANCE = 1e-4
+"""Position (m) and rotation (rad) tolerance of the IK targets of behaviours."""
+
+
+@dataclass
+class ArmIK:
+    """The kinematic model of a robot's arm to one tip frame, with its solvers."""
+
+    model: ArmModel
+    full: IKSolver
+    free_yaw: IKSolver
+
+
+def arm_ik(robot: Any, tip: str) -> ArmIK:
+    """The cached model and solvers of ``robot``'s arm from its base link to ``tip``."""
+    cache: dict[str, ArmIK] = robot.__dict__.setdefault("_arm_ik", {})
+    if tip not in cache:
+        desc = robot.description
+        try:
+            model = ArmModel.from_urdf(desc.urdf_path, desc.arm.base_link, tip)
+        except Exception as exc:  # the URDF was loaded by PyBullet already: a bad tip name
+            raise ActionFailed(f"no kinematic chain {desc.arm.base_link} -> {tip}: {exc}") from None
+        common = {
+            "position_tolerance": TOLERANCE,
+            "rotation_tolerance": TOLERANCE,
+            "time_budget": None,
+            "max_restarts": 200,
+            "posture_weight": 0.05,
+        }
+        cache[tip] = ArmIK(
+            model,
+            IKSolver(model, IKOptions(**common)),
+            IKSolver(model, IKOptions(**common, free_axis="z")),
+        )
+    return cache[tip]
+
+
+def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
+    """A world pose (4x4) expressed in the arm's base link frame."""
+    base = robot.link_transform(robot.description.arm.base_link)
+    return np.linalg.inv(base) @ pose_world
+
+
+def solve(
+    robot: Any, tip: str, pose_world: np.ndarray, seed: np.ndarray, free_yaw: bool = False
+) -> np.ndarray:
+    """Joint values putting ``tip`` at ``pose_world``; ActionFailed with IK's reason if none."""
+    ik = arm_ik(robot, tip)
+    solver = ik.free_yaw if free_yaw else ik.full
+    result = solver.solve(to_arm_base(robot, pose_world), q_seed=seed)
+    if not result.success:
+        where = ", ".join(f"{v:.3f}" for v in pose_world[:3, 3])
+        raise ActionFailed(f"no arm configuration reaches ({where}): {result.reason}")
+    return np.asarray(result.q, dtype=float)
+
+
+def line(
+    robot: Any,
+    tip: str,
+    start_world: np.ndarray,
+    goal_world: np.ndarray,
+    seed: np.ndarray,
+    free_yaw: bool = False,
+) -> list[np.ndarray]:
+    """Joint waypoints moving ``tip`` on a straight line from ``start_world`` to
+    ``goal_world``, one every :data:`STEP` metres (orientation turning evenly from the start's
+    to the goal's), each seeded by the one before so the arm does not flip between
+    solutions."""
+    a, b = start_world[:3, 3], goal_world[:3, 3]
+    turn = _angle(start_world[:3, :3], goal_world[:3, :3])
+    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / 0.1))))
+    out = []
+    q = seed
+    for i in range(1, n + 1):
+        s = i / n
+        pose = np.eye(4)
+        pose[:3, :3] = _slerp(start_world[:3, :3], goal_world[:3, :3], s)
+        pose[:3, 3] = a + (b - a) * s
+        q = solve(robot, tip, pose, q, free_yaw)
+        out.append(q)
+    return out
+
+
+def _angle(ra: np.ndarray, rb: np.ndarray) -> float:
+    return float(np.arccos(np.clip((np.trace(ra.T @ rb) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def _slerp(ra: np.ndarray, rb: np.ndarray, s: float) -> np.ndarray:
+    """Rotation a fraction ``s`` of the way from ``ra`` to ``rb`` (about one fixed axis)."""
+    rel = ra.T @ rb
+    angle = _angle(ra, rb)
+    if angle < 1e-9:
+        return rb.copy()
+    if np.pi - angle < 1e-6:  # half a turn: the axis is the eigenvector of eigenvalue 1
+        w, v = np.linalg.eigh((rel + rel.T) / 2.0)
+        axis = v[:, int(np.argmax(w))]
+    else:
+        axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+        axis /= 2.0 * np.sin(angle)
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    a = angle * s
+    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
+    return ra @ step
+
+
+def pose_matrix(position: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
+    """4x4 pose from a position and a quaternion (x, y, z, w)."""
+    x, y, z, w = np.asarray(quat_xyzw, dtype=float) / np.linalg.norm(quat_xyzw)
+    rot = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    out = np.eye(4)
+    out[:3, :3] = rot
+    out[:3, 3] = position
+    return out
