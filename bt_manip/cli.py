@@ -131,6 +131,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="pace the run to FACTOR x real time (default 1)",
     )
     run.add_argument("--quiet", action="store_true", help="print only the summary")
+    run.add_argument(
+        "--viz",
+        action="store_true",
+        help="live 3D view (meshcat) and tree page; paces the run to real time",
+    )
+    run.add_argument(
+        "--zmq-url",
+        metavar="URL",
+        help="draw in the meshcat server already listening at URL (implies --viz)",
+    )
+    run.add_argument(
+        "--port",
+        type=int,
+        default=None,
+        help="localhost port of the tree page (default 7080; 0 picks a free one)",
+    )
+    run.add_argument(
+        "--record", metavar="FILE.html", help="write a self-contained replay page of the run"
+    )
     _add_inject(run)
     run.set_defaults(func=cmd_run)
 
@@ -228,6 +247,11 @@ def cmd_run(args: argparse.Namespace) -> int:
         if world is not None and not args.quiet:
             print(world.summary())
         hooks: list[Any] = [] if args.quiet else [_live_view(tree)]
+        from bt_manip.viz.hooks import setup_viz
+
+        viz = setup_viz(args, world, tree)
+        hooks += viz.hooks
+        episode.spec.options.realtime = viz.realtime
         try:
             report = episode.run(hooks)
         finally:

@@ -1,0 +1,362 @@
+"""A World as a meshcat scene: what to draw once, and which frames move.
+
+:func:`build_scene` turns a loaded :class:`~bt_manip.sim.world.World` into a :class:`Scene`:
+
+- every body gets a node ``/meshcat/bt_manip/<body name>`` placed at its base frame;
+- robots and URDF bodies get one child node per link (``.../<body>/<link>``) placed relative to
+  the body frame, holding that link's URDF visuals (meshes and primitives, URDF colours; a mesh
+  without a URDF material keeps the colours of its file);
+- walls, furniture and objects made of primitives draw their parts with the colours of the
+  world file.
+
+The live viewer sends :meth:`Scene.set_object_commands` once and then, after each tick, the
+poses of :attr:`Scene.tracks` read by :meth:`Scene.read_poses`; the replay recorder embeds the
+same objects (each mesh file once) and samples the same poses. Reading poses never changes the
+simulation: it evaluates forward kinematics of the current joint state (the tests check that a
+run gives bit-identical states with and without a viewer).
+"""
+
+from __future__ import annotations
+
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+from bt_manip.viz.urdf_visuals import Visual, read_visuals
+
+ROOT = "/meshcat/bt_manip"
+"""Scene path under which every bt-manip body is drawn."""
+
+DEFAULT_RGBA = (0.7, 0.7, 0.72, 1.0)
+MESH_FORMATS = {".dae": "dae", ".stl": "stl", ".obj": "obj"}
+_X_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1.0]])
+"""Turns three.js cylinders (axis along y) into URDF/PyBullet ones (axis along z)."""
+
+
+@dataclass
+class SceneObject:
+    """One drawable: a three.js object JSON at ``path``.
+
+    Mesh data is not inside ``json``; ``mesh`` names the file and :meth:`Scene.lowered` or the
+    replay page puts the content in. ``rgba`` is the colour the object is drawn with (None
+    when the mesh file's own colours are used).
+    """
+
+    path: str
+    json: dict[str, Any]
+    body: str
+    rgba: tuple[float, float, float, float] | None
+    mesh: Path | None = None
+    mesh_format: str = ""
+
+
+@dataclass
+class _BodyFrames:
+    """How to read the frames of one moving body from PyBullet."""
+
+    body_id: int
+    base_offset: np.ndarray  # URDF root frame in the base centre-of-mass frame (4x4)
+    link_ids: list[int]
+    first_track: int
+
+
+@dataclass
+class Scene:
+    """The drawable objects of a world and the frames that move."""
+
+    objects: list[SceneObject] = field(default_factory=list)
+    static: list[tuple[str, np.ndarray]] = field(default_factory=list)
+    """Paths placed once (walls, furniture, link frames of fixed bodies)."""
+    tracks: list[str] = field(default_factory=list)
+    """Paths whose pose changes; :meth:`read_poses` returns one row per track."""
+    body_objects: dict[str, list[int]] = field(default_factory=dict)
+    """Indices into :attr:`objects` by body name (to highlight a held object)."""
+    client: int = -1
+    _bodies: list[_BodyFrames] = field(default_factory=list)
+
+    def read_poses(self) -> np.ndarray:
+        """Current pose of every track: rows (x, y, z, qx, qy, qz, qw).
+
+        A body's track is its URDF root frame in the world; a link's track is the link frame
+        relative to its body's track.
+        """
+        out = np.empty((len(self.tracks), 7))
+        c = self.client
+        for body in self._bodies:
+            pos, quat = pb.getBasePositionAndOrientation(body.body_id, physicsClientId=c)
+            base = _matrix(pos, quat) @ body.base_offset
+            row = body.first_track
+            out[row] = _pose_row(base)
+            if not body.link_ids:
+                continue
+            states = pb.getLinkStates(
+                body.body_id, body.link_ids, computeForwardKinematics=1, physicsClientId=c
+            )
+            inv = _inverse(base)
+            for k, state in enumerate(states):
+                out[row + 1 + k] = _pose_row(inv @ _matrix(state[4], state[5]))
+        return out
+
+    def mesh_files(self) -> list[Path]:
+        """Every mesh file the scene uses, each once, in first-use order."""
+        seen: dict[Path, None] = {}
+        for obj in self.objects:
+            if obj.mesh is not None:
+                seen.setdefault(obj.mesh, None)
+        return list(seen)
+
+    def lowered(self, obj: SceneObject, mesh_data: dict[Path, bytes]) -> dict[str, Any]:
+        """The object JSON with its mesh content filled in, ready for msgpack."""
+        import umsgpack
+
+        if obj.mesh is None:
+            return obj.json
+        data = mesh_data[obj.mesh]
+        content: Any = umsgpack.Ext(0x12, data) if obj.mesh_format == "stl" else data.decode()
+        json = dict(obj.json)
+        if json["object"]["type"] == "_meshfile_object":
+            json["object"] = {**json["object"], "data": content}
+        else:
+            json["geometries"] = [{**json["geometries"][0], "data": content}]
+        return json
+
+
+def _matrix(pos: Any, quat: Any) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+    out[:3, 3] = pos
+    return out
+
+
+def _inverse(t: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = t[:3, :3].T
+    out[:3, 3] = -t[:3, :3].T @ t[:3, 3]
+    return out
+
+
+def quat_from_matrix(r: np.ndarray) -> np.ndarray:
+    """Unit quaternion (x, y, z, w) of a rotation matrix, w >= 0."""
+    m = r
+    trace = m[0, 0] + m[1, 1] + m[2, 2]
+    if trace > 0:
+        s = 2.0 * np.sqrt(trace + 1.0)
+        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4]
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+        q = [s / 4, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
+    elif m[1, 1] > m[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+        q = [(m[0, 1] + m[1, 0]) / s, s / 4, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
+    else:
+        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, s / 4, (m[1, 0] - m[0, 1]) / s]
+    quat = np.array(q)
+    quat /= np.linalg.norm(quat)
+    return -quat if quat[3] < 0 else quat
+
+
+def _pose_row(t: np.ndarray) -> np.ndarray:
+    return np.concatenate([t[:3, 3], quat_from_matrix(t[:3, :3])])
+
+
+def pose_matrix(row: np.ndarray) -> np.ndarray:
+    """The 4x4 transform of a pose row (x, y, z, qx, qy, qz, qw)."""
+    return _matrix(row[:3], row[3:7])
+
+
+def colour_int(rgba: tuple[float, ...]) -> int:
+    """0xRRGGBB of an RGBA colour in 0..1."""
+    r, g, b = (max(0, min(255, round(v * 255))) for v in rgba[:3])
+    return (r << 16) | (g << 8) | b
+
+
+def column_major(t: np.ndarray) -> list[float]:
+    """A 4x4 matrix as three.js and meshcat expect it (column-major)."""
+    return [float(v) for v in np.asarray(t).T.flatten()]
+
+
+def _material(rgba: tuple[float, ...]) -> dict[str, Any]:
+    return {
+        "uuid": str(uuid.uuid4()),
+        "type": "MeshPhongMaterial",
+        "color": colour_int(rgba),
+        "reflectivity": 0.5,
+        "side": 2,
+        "transparent": bool(rgba[3] < 1.0),
+        "opacity": float(rgba[3]),
+    }
+
+
+def primitive_json(kind: str, size: tuple[float, ...], rgba: tuple[float, ...],
+                   matrix: np.ndarray) -> dict[str, Any]:
+    """A three.js object JSON for a box (full extents), cylinder (radius, length, axis z) or
+    sphere (radius), placed by ``matrix`` in its node."""
+    geom: dict[str, Any] = {"uuid": str(uuid.uuid4())}
+    if kind == "box":
+        geom.update(type="BoxGeometry", width=size[0], height=size[1], depth=size[2])
+    elif kind == "cylinder":
+        geom.update(type="CylinderGeometry", radiusTop=size[0], radiusBottom=size[0],
+                    height=size[1], radialSegments=32)
+        matrix = matrix @ _X_TO_Z
+    else:
+        geom.update(type="SphereGeometry", radius=size[0], widthSegments=20, heightSegments=16)
+    material = _material(rgba)
+    return {
+        "metadata": {"version": 4.5, "type": "Object"},
+        "geometries": [geom],
+        "materials": [material],
+        "object": {
+            "uuid": str(uuid.uuid4()),
+            "type": "Mesh",
+            "geometry": geom["uuid"],
+            "material": material["uuid"],
+            "matrix": column_major(matrix),
+        },
+    }
+
+
+def _mesh_json(fmt: str, rgba: tuple[float, ...] | None, matrix: np.ndarray) -> dict[str, Any]:
+    if rgba is None and fmt in ("dae", "obj"):
+        # the mesh file's own materials
+        return {
+            "metadata": {"version": 4.5, "type": "Object"},
+            "geometries": [],
+            "materials": [],
+            "object": {
+                "uuid": str(uuid.uuid4()),
+                "type": "_meshfile_object",
+                "format": fmt,
+                "resources": {},
+                "matrix": column_major(matrix),
+            },
+        }
+    geom = {"uuid": str(uuid.uuid4()), "type": "_meshfile_geometry", "format": fmt}
+    material = _material(rgba or DEFAULT_RGBA)
+    return {
+        "metadata": {"version": 4.5, "type": "Object"},
+        "geometries": [geom],
+        "materials": [material],
+        "object": {
+            "uuid": str(uuid.uuid4()),
+            "type": "Mesh",
+            "geometry": geom["uuid"],
+            "material": material["uuid"],
+            "matrix": column_major(matrix),
+        },
+    }
+
+
+def _visual_object(path: str, body: str, visual: Visual, scale: float) -> SceneObject | None:
+    origin = visual.origin.copy()
+    origin[:3, 3] *= scale
+    if visual.kind == "mesh":
+        assert visual.mesh is not None
+        fmt = MESH_FORMATS.get(visual.mesh.suffix.lower())
+        if fmt is None:
+            return None
+        matrix = origin @ np.diag([*(s * scale for s in visual.scale), 1.0])
+        return SceneObject(path, _mesh_json(fmt, visual.rgba, matrix), body, visual.rgba,
+                           visual.mesh, fmt)
+    size = tuple(v * scale for v in visual.size)
+    rgba = visual.rgba or DEFAULT_RGBA
+    return SceneObject(path, primitive_json(visual.kind, size, rgba, origin), body, rgba)
+
+
+def build_scene(world: Any) -> Scene:
+    """The scene of a loaded world (see the module docstring)."""
+    scene = Scene(client=world.client)
+    for info in world.infos.values():
+        if info.kind == "ground":
+            continue
+        urdf = _urdf_of(info, world)
+        movable = info.kind in ("robot", "object")
+        if urdf is not None:
+            scale = float(getattr(info.spec, "scale", 1.0) or 1.0)
+            _add_urdf_body(scene, world, info.name, info.body_id, urdf, scale, movable)
+        else:
+            _add_primitive_body(scene, world, info, movable)
+    return scene
+
+
+def _urdf_of(info: Any, world: Any) -> Path | None:
+    if info.kind == "robot":
+        robot = world.robots[info.name]
+        from bt_manip.sim.compose import composed_urdf
+
+        return Path(composed_urdf(robot.description))
+    urdf = getattr(info.spec, "urdf", None)
+    return Path(urdf) if urdf is not None else None
+
+
+def _add_urdf_body(scene: Scene, world: Any, name: str, body_id: int, urdf: Path, scale: float,
+                   movable: bool) -> None:
+    c = world.client
+    root_link = pb.getBodyInfo(body_id, physicsClientId=c)[0].decode()
+    links = {root_link: -1}
+    for j in range(pb.getNumJoints(body_id, physicsClientId=c)):
+        links[pb.getJointInfo(body_id, j, physicsClientId=c)[12].decode()] = j
+    dyn = pb.getDynamicsInfo(body_id, -1, physicsClientId=c)
+    base_offset = _inverse(_matrix(dyn[3], dyn[4]))
+    body_path = f"{ROOT}/{name}"
+    visuals = [v for v in read_visuals(urdf) if v.link in links]
+    drawn_links = sorted({links[v.link] for v in visuals if links[v.link] >= 0})
+    indices = scene.body_objects.setdefault(name, [])
+    counts: dict[str, int] = {}
+    for visual in visuals:
+        k = counts.get(visual.link, 0)
+        counts[visual.link] = k + 1
+        obj = _visual_object(f"{body_path}/{visual.link}/v{k}", name, visual, scale)
+        if obj is not None:
+            indices.append(len(scene.objects))
+            scene.objects.append(obj)
+    link_names = {j: n for n, j in links.items()}
+    frames = _BodyFrames(body_id, base_offset, drawn_links, len(scene.tracks))
+    scene.tracks.append(body_path)
+    scene.tracks += [f"{body_path}/{link_names[j]}" for j in drawn_links]
+    scene._bodies.append(frames)
+    if not movable:
+        # fixed bodies: read once, then place statically
+        rows = scene.read_poses()[frames.first_track : frames.first_track + 1 + len(drawn_links)]
+        paths = scene.tracks[frames.first_track :]
+        scene.static += [(p, pose_matrix(r)) for p, r in zip(paths, rows, strict=True)]
+        del scene.tracks[frames.first_track :]
+        scene._bodies.pop()
+
+
+def _add_primitive_body(scene: Scene, world: Any, info: Any, movable: bool) -> None:
+    c = world.client
+    body_path = f"{ROOT}/{info.name}"
+    spec = info.spec
+    parts = list(getattr(spec, "parts", None) or [])
+    default_rgba = tuple(getattr(spec, "colour", None) or DEFAULT_RGBA)
+    indices = scene.body_objects.setdefault(info.name, [])
+    shapes = pb.getVisualShapeData(info.body_id, physicsClientId=c)
+    for k, shape in enumerate(s for s in shapes if s[1] == -1):
+        geom_type, dims = shape[2], shape[3]
+        local = _matrix(shape[5], shape[6])
+        part_rgba = parts[k].colour if k < len(parts) and parts[k].colour else None
+        rgba = tuple(part_rgba or default_rgba)
+        if geom_type == pb.GEOM_BOX:
+            kind, size = "box", (dims[0], dims[1], dims[2])
+        elif geom_type == pb.GEOM_CYLINDER:
+            kind, size = "cylinder", (dims[1], dims[0])
+        elif geom_type == pb.GEOM_SPHERE:
+            kind, size = "sphere", (dims[0],)
+        else:
+            continue
+        indices.append(len(scene.objects))
+        scene.objects.append(
+            SceneObject(f"{body_path}/v{k}", primitive_json(kind, size, rgba, local), info.name,
+                        rgba)  # type: ignore[arg-type]
+        )
+    if movable:
+        scene._bodies.append(_BodyFrames(info.body_id, np.eye(4), [], len(scene.tracks)))
+        scene.tracks.append(body_path)
+    else:
+        pos, quat = pb.getBasePositionAndOrientation(info.body_id, physicsClientId=c)
+        scene.static.append((body_path, _matrix(pos, quat)))

@@ -1,0 +1,92 @@
+"""The behaviour tree as the pages show it: its nodes once, then their statuses tick by tick.
+
+:class:`TreeWatcher` walks a tree's py_trees root in depth-first order (the order of
+``Tree.node_records()``), keeps each node's name, node ID, depth and parent, and after every
+tick reports which nodes changed status or reason. Statuses use BehaviorTree.CPP's names:
+IDLE (py_trees' INVALID), RUNNING, SUCCESS, FAILURE.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
+"""Status codes used on the pages: the index of the name."""
+
+
+@dataclass(frozen=True)
+class TreeNodeInfo:
+    """A node's place in the tree."""
+
+    index: int
+    name: str
+    node_id: str
+    depth: int
+    parent: int
+
+
+@dataclass
+class TreeWatcher:
+    """Structure and current statuses of one tree (anything with a py_trees ``root``)."""
+
+    tree: Any
+    nodes: list[TreeNodeInfo] = field(default_factory=list)
+    statuses: list[int] = field(default_factory=list)
+    reasons: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self._behaviours: list[Any] = []
+        self.nodes = []
+
+        def walk(node: Any, depth: int, parent: int) -> None:
+            index = len(self.nodes)
+            node_id = getattr(node, "node_id", None) or type(node).__name__
+            self.nodes.append(TreeNodeInfo(index, str(node.name), str(node_id), depth, parent))
+            self._behaviours.append(node)
+            for child in getattr(node, "children", []) or []:
+                walk(child, depth + 1, index)
+
+        walk(self.tree.root, 0, -1)
+        self.statuses = [0] * len(self.nodes)
+        self.reasons = [""] * len(self.nodes)
+
+    def structure(self) -> list[dict[str, Any]]:
+        """The nodes as JSON-ready dicts (index, name, id, depth, parent)."""
+        return [
+            {"i": n.index, "name": n.name, "id": n.node_id, "depth": n.depth, "parent": n.parent}
+            for n in self.nodes
+        ]
+
+    def _current(self) -> list[tuple[int, str]]:
+        records = getattr(self.tree, "node_records", None)
+        if callable(records):
+            recs = list(records())
+            if len(recs) == len(self.nodes):
+                return [(status_code(r.status), str(r.reason or "")) for r in recs]
+        return [
+            (status_code(b.status.name), str(getattr(b, "feedback_message", "") or ""))
+            for b in self._behaviours
+        ]
+
+    def update(self) -> list[tuple[int, int, str]]:
+        """Read the statuses now; return the changes as (node index, status code, reason)."""
+        changes = []
+        for i, (code, reason) in enumerate(self._current()):
+            if code != self.statuses[i] or reason != self.reasons[i]:
+                self.statuses[i] = code
+                self.reasons[i] = reason
+                changes.append((i, code, reason))
+        return changes
+
+
+def status_code(name: Any) -> int:
+    """The page's code of a status name (py_trees or BehaviorTree.CPP spelling)."""
+    text = getattr(name, "name", name)
+    text = str(text).upper()
+    if text in ("INVALID", "IDLE"):
+        return 0
+    try:
+        return STATUS_NAMES.index(text)
+    except ValueError:
+        return 0

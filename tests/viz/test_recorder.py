@@ -1,0 +1,127 @@
+"""Recording a run into a replay page: poses, statuses, overlays, highlights, same outcome."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from types import SimpleNamespace
+from typing import Any
+
+import numpy as np
+import pytest
+from drive_tree import ROOM, DriveTree
+
+from bt_manip.runner import Runner, RunOptions
+from bt_manip.sim.world import World
+from bt_manip.viz.recorder import Recorder, RecordOptions
+from bt_manip.viz.replay_page import read_replay, track_samples
+from bt_manip.viz.scene import ROOT
+
+STATUS = {"IDLE": 0, "RUNNING": 1, "SUCCESS": 2, "FAILURE": 3}
+
+
+def _record(path: Path, hooks: list[Any] = (), **kw: Any) -> tuple[Any, dict, bytes, World]:
+    world = World(ROOM, seed=3)
+    tree = DriveTree(world)
+    recorder = Recorder(path, world, tree, RecordOptions(**kw), info={"tree": "drive_tree"})
+    report = Runner(tree, world, RunOptions(), on_tick=[*hooks, recorder]).run()
+    recorder.close()
+    header, blobs = read_replay(path)
+    return report, header, blobs, world
+
+
+def test_replay_holds_the_run(tmp_path: Path) -> None:
+    page = tmp_path / "run.html"
+    report, header, blobs, world = _record(page)
+    try:
+        assert report.status == "SUCCESS"
+        # samples at 20 Hz of sim time, first and last included
+        assert header["frames"]["count"] == pytest.approx(report.sim_time * 20 + 1, abs=2)
+        assert header["duration"] == pytest.approx(report.sim_time, abs=1e-6)
+        base = track_samples(header, blobs, f"{ROOT}/husky")
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert base[-1, :2] == pytest.approx([x, y], abs=1e-4)  # last frame = final pose
+        assert np.linalg.norm(base[-1, :2] - base[0, :2]) > 1.0  # the robot drove > 1 m
+        # the top plate does not move relative to the base: stored once
+        tracks = {t["path"]: t for t in header["scene"]["tracks"]}
+        assert tracks[f"{ROOT}/husky/top_plate_link"]["const"]
+        assert not tracks[f"{ROOT}/husky/front_left_wheel_link"]["const"]
+        # every mesh stored once; the four wheels share one
+        names = [m["name"] for m in header["scene"]["meshes"]]
+        assert names.count("wheel.stl") == 1
+    finally:
+        world.close()
+
+
+def test_replay_holds_status_changes_with_reasons(tmp_path: Path) -> None:
+    _, header, _, world = _record(tmp_path / "run.html")
+    world.close()
+    tree = header["tree"]
+    names = [n["name"] for n in tree["nodes"]]
+    assert names[:3] == ["mission", "drive", "turn"]
+    assert tree["nodes"][names.index("plan_a")]["parent"] == names.index("recover")
+
+    def changes(name: str) -> list[tuple[float, int, str]]:
+        i = names.index(name)
+        return [(t, c, tree["reasons"][r]) for t, j, c, r in tree["events"] if j == i]
+
+    drive = changes("drive")
+    assert [c for _, c, _ in drive][:2] == [STATUS["RUNNING"], STATUS["SUCCESS"]]
+    assert drive[1][0] == pytest.approx(2.0, abs=0.06)  # drove for 2 s of sim
+    fail = changes("plan_a")
+    assert fail[0][1] == STATUS["FAILURE"]
+    assert "doorway is blocked" in fail[0][2]
+    assert changes("mission")[-1][1] == STATUS["SUCCESS"]
+    assert header["result"] == "SUCCESS"
+
+
+def test_replay_holds_overlays_and_highlights(tmp_path: Path) -> None:
+    held: list[str] = []
+
+    def grab_at_one_second(runner: Any) -> None:
+        # stand-in for an attach joint: report the crate as held from t = 1 s to 2 s
+        world = runner.world
+        held[:] = ["crate"] if 1.0 <= world.time < 2.0 else []
+        world.attachments.all = lambda: [SimpleNamespace(object_name=n) for n in held]
+
+    _, header, _, world = _record(tmp_path / "run.html", hooks=[grab_at_one_second])
+    world.close()
+    overlay = header["overlay"]
+    names = {name for _, name, _, _ in overlay}
+    assert {"drive_plan", "turn_plan", "target"} <= names
+    first_plan = next(o for o in overlay if o[1] == "drive_plan")
+    assert first_plan[2]["object"]["type"] == "Line"
+    moves = [o for o in overlay if o[1] == "target" and o[2] is None]
+    assert moves and len(moves[0][3]) == 16  # the triad moved: a new matrix only
+    highlights = header["highlights"]
+    assert [(name, on) for _, name, on in highlights] == [("crate", True), ("crate", False)]
+    assert highlights[0][0] == pytest.approx(1.0, abs=0.06)
+    assert header["scene"]["body_objects"]["crate"][0][1] == pytest.approx([0.2, 0.35, 0.85, 1])
+
+
+def test_recording_does_not_change_the_run(tmp_path: Path) -> None:
+    def run(record: bool) -> tuple[str, int, str]:
+        world = World(ROOM, seed=3)
+        tree = DriveTree(world)
+        hooks: list[Any] = []
+        if record:
+            hooks.append(Recorder(tmp_path / "r.html", world, tree, RecordOptions(sample_hz=50)))
+        report = Runner(tree, world, RunOptions(), on_tick=hooks).run()
+        for hook in hooks:
+            hook.close()
+        snapshot = repr(world.snapshot())
+        world.close()
+        return report.status, report.ticks, snapshot
+
+    assert run(False) == run(True)
+
+
+def test_replay_page_is_self_contained(tmp_path: Path) -> None:
+    page = tmp_path / "run.html"
+    _, _, _, world = _record(page)
+    world.close()
+    text = page.read_text()
+    assert page.stat().st_size < 25e6
+    # nothing is fetched: no external scripts, styles, images or frames
+    assert not re.search(r"<(script|link|img|iframe)[^>]+(src|href)=", text)
+    assert "MeshCat" in text and 'id="bt-replay"' in text
