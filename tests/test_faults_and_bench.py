@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import pytest
 
 from bt_manip.bench import EpisodeResult, summarise, wilson_interval
+from bt_manip.cli import main
 from bt_manip.episode import EpisodeSpec
 from bt_manip.errors import InputError
 from bt_manip.faults import FaultInjector, FaultSpec, parse_fault
@@ -75,3 +79,30 @@ def test_summary_counts_failures_by_node_and_reason() -> None:
     assert s.sim_time["median"] == pytest.approx(45.5)
     assert s.real_time_factor["median"] == pytest.approx(10.0)
     assert "success: 1/4 = 25.0 %" in s.text()
+
+
+def _retry_tree(tmp_path: Path) -> Path:
+    tree = tmp_path / "retry.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main">'
+        '<RetryUntilSuccessful num_attempts="4"><AlwaysSuccess name="step"/>'
+        "</RetryUntilSuccessful></BehaviorTree></root>"
+    )
+    return tree
+
+
+def test_injected_failures_reach_the_tree_and_the_report(tmp_path: Path) -> None:
+    tree = _retry_tree(tmp_path)
+    report = tmp_path / "r.json"
+    assert main(["run", str(tree), "--quiet", "--inject", "step:failure:1", "--report",
+                 str(report)]) == 1
+    data = json.loads(report.read_text())
+    assert data["extra"]["inject"] == ["step:failure:1"]
+    assert [e["target"] for e in data["extra"]["injected"]] == ["step"] * 4
+    steps = [n for n in data["nodes"] if n["path"].endswith("/step")]
+    assert steps[0]["reason"] == "injected failure (--inject)"
+    # by node ID too, and retries recover from occasional failures the same way every time
+    codes = [main(["run", str(tree), "--quiet", "--seed", "3", "--inject",
+                   "AlwaysSuccess:failure:0.5"]) for _ in range(2)]
+    assert codes[0] == codes[1]
+    assert main(["run", str(tree), "--quiet", "--inject", "step:failure:0"]) == 0
