@@ -2,9 +2,9 @@
 
 Arm: MoveJointsSequentially, MoveJoints, Lift. Gripper: OpenGripper, CloseGripper.
 Attach joints: Attach, Detach. Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove,
-CarriedClear.
+CarriedClear. World: SpawnModel, DeleteModel.
 """
 
-from bt_manip.behaviours import arm, attach, conditions, gripper
+from bt_manip.behaviours import arm, attach, conditions, gripper, world_ops
 
-__all__ = ["arm", "attach", "conditions", "gripper"]
+__all__ = ["arm", "attach", "conditions", "gripper", "world_ops"]

@@ -348,6 +348,40 @@ class World:
         """Sim time in seconds since the world was built."""
         return self.clock.now()
 
+    # -- changing the world while it runs --------------------------------------------------
+    def spawn(self, spec: BodySpec) -> int:
+        """Add a body while the world runs (movable if ``spec.movable``); returns its id.
+
+        Raises ValueError when the name is taken or the body would start inside another.
+        """
+        if spec.name in self.infos:
+            raise ValueError(f"a body named '{spec.name}' already exists")
+        kind = "object" if spec.movable else "furniture"
+        body = self._make_body(spec, (0.0, 0.0, 0.0))
+        self._add(spec.name, body, kind, spec, spec.line)
+        for info in list(self.infos.values()):
+            if info.kind == "ground" or info.name == spec.name:
+                continue
+            pts = pb.getClosestPoints(body, info.body_id, 0.0, physicsClientId=self.client)
+            depth = min((p[8] for p in pts), default=0.0)
+            if depth < -OVERLAP_TOLERANCE:
+                self.remove(spec.name)
+                raise ValueError(
+                    f"'{spec.name}' would start {-depth * 1000:.0f} mm inside '{info.name}'"
+                )
+        return body
+
+    def remove(self, name: str) -> None:
+        """Take a movable object or piece of furniture out of the world (and out of the hand)."""
+        info = self.infos.get(name)
+        if info is None or info.kind not in ("object", "furniture"):
+            known = sorted(i.name for i in self.infos.values() if i.kind in ("object", "furniture"))
+            raise KeyError(f"no object or furniture named '{name}'; known: {', '.join(known)}")
+        if self.attachments.is_attached(name):
+            self.attachments.detach(name)
+        pb.removeBody(info.body_id, physicsClientId=self.client)
+        del self.infos[name]
+
     # -- queries ------------------------------------------------------------------------------
     def body_id(self, name: str) -> int:
         """The PyBullet id of a named body; KeyError naming the known ones otherwise."""

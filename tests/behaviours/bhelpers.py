@@ -21,14 +21,16 @@ def place_robot(world: World, name: str, x: float, y: float, yaw: float) -> None
     robot = world.robots[name]
     z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
     pb.resetBasePositionAndOrientation(
-        robot.body, [x, y, z], pb.getQuaternionFromEuler([0, 0, yaw]),
+        robot.body,
+        [x, y, z],
+        pb.getQuaternionFromEuler([0, 0, yaw]),
         physicsClientId=world.client,
     )
     world.step(24)
 
 
 def run_xml(world: World, body: str, max_sim_time: float = 60.0) -> tuple[RunReport, Tree]:
-    xml = (f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>')
+    xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
     tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
     return Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run(), tree
 

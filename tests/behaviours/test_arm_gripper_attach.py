@@ -33,19 +33,22 @@ def test_scenario_a_pick_and_lift(house_at_pregrasp: World) -> None:
     assert tree.blackboard.as_dict()["holding"] is True
     assert tree.blackboard.as_dict()["held"] == "panel"
     # the panel moves with the hand: drive the arm and watch the panel follow
-    before = np.asarray(pb.getBasePositionAndOrientation(world.movable["panel"],
-                                                         physicsClientId=world.client)[0])
+    before = np.asarray(
+        pb.getBasePositionAndOrientation(world.movable["panel"], physicsClientId=world.client)[0]
+    )
     report, _ = run_xml(world, '<MoveJoints targets="90;-39;48;-56;85;4" speed="0.3"/>')
     assert report.status == "SUCCESS", report.reason
-    after = np.asarray(pb.getBasePositionAndOrientation(world.movable["panel"],
-                                                        physicsClientId=world.client)[0])
+    after = np.asarray(
+        pb.getBasePositionAndOrientation(world.movable["panel"], physicsClientId=world.client)[0]
+    )
     assert np.linalg.norm(after - before) > 0.2
 
 
 def test_attach_refuses_an_object_out_of_reach(house_at_pregrasp: World) -> None:
     world = house_at_pregrasp
-    report, _ = run_xml(world, '<Sequence><MoveJoints state="tuck"/><Attach object="panel"/>'
-                               '</Sequence>')
+    report, _ = run_xml(
+        world, '<Sequence><MoveJoints state="tuck"/><Attach object="panel"/></Sequence>'
+    )
     assert report.status == "FAILURE"
     why = reasons(report)["Attach"]
     assert "'panel' is" in why and "from the fingers (must touch or be within 1.0 cm)" in why
@@ -60,8 +63,10 @@ def test_target_outside_joint_limits_fails_before_moving(house_at_pregrasp: Worl
     q0 = world.robots["husky"].arm_positions()
     report, _ = run_xml(world, '<MoveJointsSequentially targets="0;0;200;0;0;0" order="2"/>')
     assert report.status == "FAILURE"
-    assert "joint 2 (elbow_joint) target 200.0 deg is outside its limits" in reasons(report)[
-        "MoveJointsSequentially"]
+    assert (
+        "joint 2 (elbow_joint) target 200.0 deg is outside its limits"
+        in reasons(report)["MoveJointsSequentially"]
+    )
     assert np.allclose(world.robots["husky"].arm_positions(), q0, atol=1e-3)
 
 
@@ -82,8 +87,9 @@ def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
 
 
 def test_close_on_nothing_reports_not_holding(table: World) -> None:
-    report, tree = run_xml(table, '<Sequence><OpenGripper/>'
-                                  '<CloseGripper holding="{h}" object="{o}"/></Sequence>')
+    report, tree = run_xml(
+        table, '<Sequence><OpenGripper/><CloseGripper holding="{h}" object="{o}"/></Sequence>'
+    )
     assert report.status == "SUCCESS"
     assert tree.blackboard.as_dict()["h"] is False
     assert table.robots["sawyer"].gripper_opening() == pytest.approx(0.0, abs=2e-3)
@@ -97,3 +103,28 @@ def test_unknown_object_and_robot_give_reasons(table: World) -> None:
     assert "no movable object named 'teapot'" in reasons(report)["Attach"]
     report, _ = run_xml(table, '<OpenGripper robot="r2d2"/>')
     assert "no robot named 'r2d2'; robots: sawyer" in reasons(report)["OpenGripper"]
+
+
+def test_spawn_and_delete_models(table: World) -> None:
+    report, _ = run_xml(
+        table,
+        "<Sequence>"
+        '<SpawnModel model="crate" size="0.1;0.1;0.1" pose="1.2;0.3;0.8;0.5"'
+        ' mass="0.5" colour="blue"/>'
+        '<Sleep msec="1000"/><DeleteModel model="block_0"/></Sequence>',
+    )
+    assert report.status == "SUCCESS", report.reason
+    assert "block_0" not in table.movable
+    crate = table.movable["crate"]
+    pos, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=table.client)
+    assert pos[2] == pytest.approx(0.7475 + 0.05, abs=0.003)  # fell onto the table top
+    report, _ = run_xml(
+        table, '<SpawnModel model="ghost" size="0.05;0.05;0.05" pose="0.7;0.1;0.7725;0"/>'
+    )
+    assert (
+        "'ghost' would start" in reasons(report)["SpawnModel"]
+        and "inside 'block_1'" in reasons(report)["SpawnModel"]
+    )
+    assert "ghost" not in table.movable
+    report, _ = run_xml(table, '<DeleteModel model="block_0"/>')
+    assert "no object or furniture named 'block_0'" in reasons(report)["DeleteModel"]
