@@ -55,6 +55,8 @@ def _fmt(q: float, units: str) -> str:
 class JointMove(RobotAction):
     """Shared machinery: a list of stages, each moving some joints to their targets."""
 
+    CARRIES = True
+
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
         "units": UNITS,

@@ -87,21 +87,53 @@ class RobotAction(WorldAccess, ActionNode):
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
+    CARRIES: ClassVar[bool] = False
+    """Moves what the robot holds: a ``slip`` fault may make it let go on the way."""
+    SLIP_AFTER: ClassVar[float] = 0.5
+    """Sim seconds into the move at which an injected slip happens."""
 
     def initialise(self) -> None:
         self.feedback_message = ""
         self._start_error: str | None = None
+        self._slip: tuple[float, str] | None = None
         self.started_at = self.now()
         try:
             self.start()
+            if self.CARRIES:
+                self._draw_slip()
         except ActionFailed as exc:
             self._start_error = str(exc)
+
+    def _draw_slip(self) -> None:
+        faults = self.faults()
+        if faults is None or not faults.specs:
+            return
+        from bt_manip.behaviours.gripper import held_object
+
+        robot = self.robot()
+        held = [a.object_name for a in self.world.attachments.held_by(self.robot_name())]
+        held += [held_object(self.world, robot)] if not held else []
+        held = [h for h in held if h]
+        if held and faults.slip(held[0]):
+            self._slip = (self.started_at + self.SLIP_AFTER, held[0])
+
+    def _apply_slip(self) -> None:
+        """The injected slip: the attach joint goes and the fingers open."""
+        assert self._slip is not None
+        _, name = self._slip
+        self._slip = None
+        if self.world.attachments.is_attached(name):
+            self.world.attachments.detach(name)
+        robot = self.robot()
+        robot.set_gripper(robot.description.gripper.max_opening)
 
     def update(self) -> Status:
         if self._start_error is not None:
             self.feedback_message = self._start_error
             return Status.FAILURE
         try:
+            if self._slip is not None and self.now() >= self._slip[0]:
+                self._apply_slip()
             return self.step()
         except ActionFailed as exc:
             self.feedback_message = str(exc)

@@ -128,3 +128,22 @@ def test_spawn_and_delete_models(table: World) -> None:
     assert "ghost" not in table.movable
     report, _ = run_xml(table, '<DeleteModel model="block_0"/>')
     assert "no object or furniture named 'block_0'" in reasons(report)["DeleteModel"]
+
+
+def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None:
+    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.faults import FaultInjector, FaultSpec
+    from bt_manip.runner import Runner, RunOptions
+
+    world = house_at_pregrasp
+    faults = FaultInjector([FaultSpec("slip", 1.0)], seed=0, clock=world.clock)
+    xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{PICK}</BehaviorTree></root>'
+    tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world,
+                                                     services={"faults": faults}))
+    report = Runner(tree, world, RunOptions(max_sim_time=60)).run()
+    assert report.status == "FAILURE"
+    assert [e.kind for e in faults.events][:1] == ["slip"]
+    assert not world.attachments.is_attached("panel")
+    world.step(480)
+    lo, _ = pb.getAABB(world.movable["panel"], physicsClientId=world.client)
+    assert lo[2] < 0.05  # it fell to the floor
