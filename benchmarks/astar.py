@@ -1,0 +1,221 @@
+"""Grid A* side by side: bt-manip's planner, pyastar2d (C++) and tcod.path, in one run.
+
+Run: ``.venv/bin/python benchmarks/astar.py [--repeat 5] [--queries 10] [--no-house]``
+
+Grids (1000 x 1000 unless named otherwise):
+
+- ``open``: every cell costs 1.
+- ``random20``: 20 % of the cells blocked at random, the rest cost 1.
+- ``maze``: a perfect maze with one-cell corridors and walls (random depth-first carving).
+- ``house``: the inflated cost grid of ``worlds/tb3_house.yaml`` for the Husky (323 x 223
+  cells of 5 cm), with the cost gradient near obstacles (costs 1 to 7).
+
+Each grid gets the same seeded start/goal pairs for every planner (free cells, joined by a
+path under bt-manip's rules). Every line printed is one JSON object: grid, planner, median
+time per query (ms), and the mean path cost recomputed with bt-manip's cost definition
+(``step_length x cost[entered cell]``, step_length 1 or sqrt 2), plus how many diagonal steps of
+each peer's paths cut a blocked corner (which bt-manip forbids). How the peers define cost:
+
+- pyastar2d: a move into cell b costs ``cost[b]`` whatever its direction (diagonals are not
+  longer than side moves) and diagonals may pass blocked corners; its paths are optimal for that
+  metric, so under ours they are longer.
+- tcod.path (SimpleGraph): integer costs; a move costs ``cost[b] x cardinal`` or
+  ``cost[b] x diagonal`` with (cardinal, diagonal) = (1000, 1414) here and costs scaled by 10
+  and rounded; diagonals may pass blocked corners.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import statistics
+import sys
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from bt_manip.navigation import astar
+
+Cell = tuple[int, int]
+
+
+def open_grid(n: int = 1000) -> np.ndarray:
+    return np.ones((n, n), np.float32)
+
+
+def random_grid(n: int = 1000, blocked: float = 0.2, seed: int = 1) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    g = np.ones((n, n), np.float32)
+    g[rng.random((n, n)) < blocked] = np.inf
+    return g
+
+
+def maze_grid(n: int = 1000, seed: int = 2) -> np.ndarray:
+    """Perfect maze: cells at odd coordinates, carved by randomised depth-first search."""
+    rng = np.random.default_rng(seed)
+    m = (n - 1) // 2
+    g = np.full((n, n), np.inf, np.float32)
+    seen = np.zeros((m, m), bool)
+    stack = [(0, 0)]
+    seen[0, 0] = True
+    g[1, 1] = 1.0
+    moves = ((0, 1), (1, 0), (0, -1), (-1, 0))
+    while stack:
+        r, c = stack[-1]
+        options = [
+            (r + dr, c + dc)
+            for dr, dc in moves
+            if 0 <= r + dr < m and 0 <= c + dc < m and not seen[r + dr, c + dc]
+        ]
+        if not options:
+            stack.pop()
+            continue
+        nr, nc = options[int(rng.integers(len(options)))]
+        seen[nr, nc] = True
+        g[2 * nr + 1, 2 * nc + 1] = 1.0
+        g[r + nr + 1, c + nc + 1] = 1.0
+        stack.append((nr, nc))
+    return g
+
+
+def house_grid() -> np.ndarray | None:
+    """The Husky's planning cost grid of worlds/tb3_house.yaml (0.05 m cells), if it loads."""
+    try:
+        from bt_manip.navigation.navigator import Navigator
+        from bt_manip.sim.world import World
+
+        with World("worlds/tb3_house.yaml", seed=0) as world:
+            nav = Navigator(world.robots["husky"], world.obstacle_body_ids(), world.movable)
+            return nav.cost.copy()
+    except Exception as exc:  # the world may not load on this checkout
+        print(json.dumps({"grid": "house", "skipped": repr(exc)}), file=sys.stderr)
+        return None
+
+
+def queries(grid: np.ndarray, k: int, seed: int = 3) -> list[tuple[Cell, Cell]]:
+    """k seeded start/goal pairs; the first joins two far corners' nearest free cells."""
+    rng = np.random.default_rng(seed)
+    free = np.argwhere(np.isfinite(grid))
+    out: list[tuple[Cell, Cell]] = []
+    first = free[np.argmin(free.sum(axis=1))], free[np.argmax(free.sum(axis=1))]
+    candidates = [first]
+    while len(out) < k:
+        if candidates:
+            a, b = candidates.pop()
+        else:
+            a, b = free[rng.integers(len(free))], free[rng.integers(len(free))]
+        s, t = (int(a[0]), int(a[1])), (int(b[0]), int(b[1]))
+        if s != t and astar.plan(grid, s, t) is not None:
+            out.append((s, t))
+    return out
+
+
+def run_ours(grid: np.ndarray, s: Cell, t: Cell) -> np.ndarray | None:
+    return astar.plan(grid, s, t, diagonal=True)
+
+
+def make_pyastar2d() -> Callable[[np.ndarray, Cell, Cell], np.ndarray | None] | None:
+    try:
+        import pyastar2d
+    except ImportError:
+        return None
+
+    def run(grid: np.ndarray, s: Cell, t: Cell) -> np.ndarray | None:
+        return pyastar2d.astar_path(grid, s, t, allow_diagonal=True)
+
+    return run
+
+
+def make_tcod() -> Callable[[np.ndarray, Cell, Cell], np.ndarray | None] | None:
+    try:
+        import tcod.path
+    except ImportError:
+        return None
+
+    def run(grid: np.ndarray, s: Cell, t: Cell) -> np.ndarray | None:
+        icost = np.where(np.isfinite(grid), np.rint(grid * 10), 0).astype(np.int32)
+        graph = tcod.path.SimpleGraph(cost=icost, cardinal=1000, diagonal=1414)
+        pf = tcod.path.Pathfinder(graph)
+        pf.add_root(s)
+        p = pf.path_to(t)
+        return None if len(p) == 0 or tuple(p[-1]) != t else np.asarray(p)
+
+    return run
+
+
+def measure(
+    name: str,
+    grid: np.ndarray,
+    pairs: list[tuple[Cell, Cell]],
+    planner: str,
+    fn: Callable[[np.ndarray, Cell, Cell], np.ndarray | None],
+    repeat: int,
+) -> dict[str, object]:
+    times: list[float] = []
+    costs: list[float] = []
+    cuts = 0
+    failed = 0
+    for s, t in pairs:
+        best = math.inf
+        path = None
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            path = fn(grid, s, t)
+            best = min(best, time.perf_counter() - t0)
+        times.append(best)
+        if path is None:
+            failed += 1
+            continue
+        costs.append(astar.path_cost(grid, path))
+        cuts += astar.corner_cuts(grid, path)
+    return {
+        "grid": name,
+        "shape": list(grid.shape),
+        "planner": planner,
+        "queries": len(pairs),
+        "median_ms": round(statistics.median(times) * 1e3, 3),
+        "max_ms": round(max(times) * 1e3, 3),
+        "mean_cost": round(statistics.fmean(costs), 4) if costs else None,
+        "corner_cuts": cuts,
+        "failed": failed,
+    }
+
+
+def main(argv: list[str] | None = None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3, help="runs per query (best is kept)")
+    ap.add_argument("--queries", type=int, default=10, help="start/goal pairs per grid")
+    ap.add_argument("--no-house", action="store_true")
+    args = ap.parse_args(argv)
+
+    t0 = time.perf_counter()
+    astar.warm_up()
+    print(json.dumps({"event": "first_call_s", "value": round(time.perf_counter() - t0, 3)}))
+
+    grids: dict[str, np.ndarray] = {
+        "open": open_grid(),
+        "random20": random_grid(),
+        "maze": maze_grid(),
+    }
+    if not args.no_house:
+        house = house_grid()
+        if house is not None:
+            grids["house"] = house
+    planners = {"bt_manip": run_ours}
+    for label, maker in (("pyastar2d", make_pyastar2d), ("tcod", make_tcod)):
+        fn = maker()
+        if fn is not None:
+            planners[label] = fn
+    for name, grid in grids.items():
+        pairs = queries(grid, args.queries)
+        rows = [measure(name, grid, pairs, p, fn, args.repeat) for p, fn in planners.items()]
+        ours = rows[0]["median_ms"]
+        for row in rows:
+            row["time_vs_bt_manip"] = round(float(row["median_ms"]) / float(ours), 3)
+            print(json.dumps(row), flush=True)
+
+
+if __name__ == "__main__":
+    main()

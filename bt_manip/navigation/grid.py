@@ -1,0 +1,270 @@
+"""Occupancy grids rasterised from the collision geometry of a PyBullet world.
+
+An :class:`OccupancyGrid` covers a rectangle of the ground plane with square cells of side
+``resolution`` (default 0.05 m). Cell ``(row, col)`` spans
+``x in [x0 + col * res, x0 + (col + 1) * res)`` and ``y in [y0 + row * res, y0 + (row + 1) * res)``
+where ``(x0, y0)`` is the grid's ``origin``: rows grow with y, columns with x.
+
+:func:`rasterise` marks every cell whose square overlaps (with positive area) the outline of a
+collision shape inside the height band the robot sweeps (see :mod:`bt_manip.navigation.shapes`).
+Cells only touched along an edge or corner stay free, so a wall face lying on a cell border
+does not spill into the next cell.
+
+:meth:`OccupancyGrid.save_png` writes the grid as an image for a person to look at (north up,
+occupied black); :func:`save_cost_png` does the same for a cost grid.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+import zlib
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+
+from bt_manip.navigation.shapes import Disc, Outline, Polygon, ZBand, body_outlines
+
+DEFAULT_RESOLUTION = 0.05
+"""Cell side (m)."""
+
+DEFAULT_BAND: ZBand = (0.02, 2.0)
+"""Height band (m) looked at when none is given: from just above the floor to 2 m."""
+
+_EPS = 1e-9
+
+
+@dataclass
+class OccupancyGrid:
+    """Occupied cells of a rectangle of the ground plane (row = y, column = x)."""
+
+    origin: tuple[float, float]
+    resolution: float
+    occupied: np.ndarray  # bool (rows, cols)
+    band: ZBand = DEFAULT_BAND
+    sources: dict[int, np.ndarray] = field(default_factory=dict, repr=False)
+    """Per body id, the flat indices of the cells it occupies (for layers that move)."""
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.occupied.shape  # type: ignore[return-value]
+
+    @property
+    def extent(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax) of the covered rectangle."""
+        rows, cols = self.shape
+        x0, y0 = self.origin
+        return x0, y0, x0 + cols * self.resolution, y0 + rows * self.resolution
+
+    @classmethod
+    def empty(
+        cls,
+        extent: tuple[float, float, float, float],
+        resolution: float = DEFAULT_RESOLUTION,
+        band: ZBand = DEFAULT_BAND,
+    ) -> OccupancyGrid:
+        """A free grid covering ``(xmin, ymin, xmax, ymax)`` (rounded out to whole cells)."""
+        xmin, ymin, xmax, ymax = extent
+        cols = max(1, math.ceil((xmax - xmin) / resolution - 1e-9))
+        rows = max(1, math.ceil((ymax - ymin) / resolution - 1e-9))
+        return cls(
+            (float(xmin), float(ymin)), float(resolution), np.zeros((rows, cols), bool), band
+        )
+
+    def copy(self) -> OccupancyGrid:
+        return OccupancyGrid(
+            self.origin,
+            self.resolution,
+            self.occupied.copy(),
+            self.band,
+            {k: v.copy() for k, v in self.sources.items()},
+        )
+
+    # -- coordinates ---------------------------------------------------------------------------
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]:
+        """The (row, col) of the cell containing world point (x, y) (may be outside the grid)."""
+        return (
+            math.floor((y - self.origin[1]) / self.resolution),
+            math.floor((x - self.origin[0]) / self.resolution),
+        )
+
+    def cell_to_world(self, row: float, col: float) -> tuple[float, float]:
+        """World (x, y) of a cell's centre."""
+        return (
+            self.origin[0] + (col + 0.5) * self.resolution,
+            self.origin[1] + (row + 0.5) * self.resolution,
+        )
+
+    def cells_to_world(self, cells: np.ndarray) -> np.ndarray:
+        """World (x, y) of the centres of ``cells`` (n, 2) as an (n, 2) float array."""
+        c = np.asarray(cells, dtype=float)
+        return np.column_stack(
+            [
+                self.origin[0] + (c[:, 1] + 0.5) * self.resolution,
+                self.origin[1] + (c[:, 0] + 0.5) * self.resolution,
+            ]
+        )
+
+    def inside(self, cell: tuple[int, int]) -> bool:
+        rows, cols = self.shape
+        return 0 <= cell[0] < rows and 0 <= cell[1] < cols
+
+    # -- drawing ---------------------------------------------------------------------------------
+    def cells_of(self, outline: Outline) -> np.ndarray:
+        """Flat indices of the cells whose squares overlap ``outline`` with positive area."""
+        rows, cols = self.shape
+        res = self.resolution
+        x0, y0 = self.origin
+        xmin, ymin, xmax, ymax = outline.extent()
+        c0 = max(0, math.floor((xmin - x0) / res))
+        c1 = min(cols - 1, math.floor((xmax - x0) / res))
+        r0 = max(0, math.floor((ymin - y0) / res))
+        r1 = min(rows - 1, math.floor((ymax - y0) / res))
+        if c0 > c1 or r0 > r1:
+            return np.zeros(0, np.int64)
+        cc, rr = np.meshgrid(np.arange(c0, c1 + 1), np.arange(r0, r1 + 1))
+        lx = x0 + cc * res
+        ly = y0 + rr * res
+        if isinstance(outline, Disc):
+            hit = _disc_hits(outline, lx, ly, res)
+        else:
+            hit = _polygon_hits(outline, lx, ly, res)
+        return (rr[hit] * cols + cc[hit]).astype(np.int64)
+
+    def mark(self, outlines: Iterable[Outline], source: int | None = None) -> None:
+        """Mark the cells of ``outlines`` occupied (remembered under ``source`` if given)."""
+        idx = [self.cells_of(o) for o in outlines]
+        flat = np.unique(np.concatenate(idx)) if idx else np.zeros(0, np.int64)
+        self.occupied.reshape(-1)[flat] = True
+        if source is not None:
+            self.sources[source] = flat
+
+    def occupied_by(self, body: int) -> np.ndarray:
+        """(n, 2) cells marked for ``body`` (empty if it was not drawn as a source)."""
+        flat = self.sources.get(body, np.zeros(0, np.int64))
+        return np.column_stack(np.unravel_index(flat, self.shape))
+
+    # -- output ----------------------------------------------------------------------------------
+    def save_png(self, path: str | Path, path_cells: np.ndarray | None = None) -> None:
+        """Write the grid as a PNG, north up: occupied black, free white, a path in red."""
+        img = np.where(self.occupied[..., None], 0, 255).astype(np.uint8).repeat(3, axis=2)
+        if path_cells is not None and len(path_cells):
+            p = np.asarray(path_cells)
+            img[p[:, 0], p[:, 1]] = (220, 30, 30)
+        write_png(path, img[::-1])
+
+
+def _disc_hits(d: Disc, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
+    """Cells (lower-left corners lx, ly) whose square overlaps the disc's interior."""
+    nx = np.clip(d.cx, lx, lx + res)
+    ny = np.clip(d.cy, ly, ly + res)
+    return (nx - d.cx) ** 2 + (ny - d.cy) ** 2 < (d.radius - _EPS) ** 2
+
+
+def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
+    """Separating-axis test of each cell square against a convex polygon (strict overlap)."""
+    v = p.vertices
+    xmin, ymin, xmax, ymax = p.extent()
+    hit = (
+        (lx < xmax - _EPS)
+        & (lx + res > xmin + _EPS)
+        & (ly < ymax - _EPS)
+        & (ly + res > ymin + _EPS)
+    )
+    n = len(v)
+    for i in range(n):
+        a = v[i]
+        b = v[(i + 1) % n]
+        nx, ny = b[1] - a[1], -(b[0] - a[0])  # outward normal of a counter-clockwise edge
+        norm = math.hypot(nx, ny)
+        if norm < 1e-12:
+            continue
+        nx, ny = nx / norm, ny / norm
+        edge = nx * a[0] + ny * a[1]
+        # smallest projection of the square's corners on the normal
+        low = nx * lx + ny * ly + min(0.0, nx * res) + min(0.0, ny * res)
+        hit &= low < edge - _EPS
+    return hit
+
+
+def write_png(path: str | Path, rgb: np.ndarray) -> None:
+    """Write an (h, w, 3) uint8 image as PNG with numpy and zlib only."""
+    h, w, _ = rgb.shape
+    raw = b"".join(b"\x00" + rgb[i].tobytes() for i in range(h))
+
+    def chunk(tag: bytes, data: bytes) -> bytes:
+        body = tag + data
+        return (
+            struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+        )
+
+    png = b"\x89PNG\r\n\x1a\n"
+    png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+    png += chunk(b"IDAT", zlib.compress(raw, 6))
+    png += chunk(b"IEND", b"")
+    Path(path).write_bytes(png)
+
+
+def save_cost_png(
+    path: str | Path,
+    cost: np.ndarray,
+    path_cells: np.ndarray | None = None,
+) -> None:
+    """Write a cost grid as a PNG, north up: blocked black, cost 1 white, higher costs darker
+    blue, a path in red."""
+    finite = np.isfinite(cost)
+    top = float(cost[finite].max()) if finite.any() else 1.0
+    shade = np.zeros(cost.shape)
+    if top > 1.0:
+        shade[finite] = (cost[finite] - 1.0) / (top - 1.0)
+    img = np.empty((*cost.shape, 3), np.uint8)
+    img[..., 0] = (255 * (1.0 - 0.8 * shade)).astype(np.uint8)
+    img[..., 1] = (255 * (1.0 - 0.6 * shade)).astype(np.uint8)
+    img[..., 2] = 255
+    img[~finite] = 0
+    if path_cells is not None and len(path_cells):
+        p = np.asarray(path_cells)
+        img[p[:, 0], p[:, 1]] = (220, 30, 30)
+    write_png(path, img[::-1])
+
+
+def bodies_extent(
+    client: int, bodies: Sequence[int], pad: float = 0.0
+) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) around the AABBs of ``bodies`` (all their links), padded."""
+    lo = np.full(2, np.inf)
+    hi = np.full(2, -np.inf)
+    for b in bodies:
+        for link in range(-1, pb.getNumJoints(b, physicsClientId=client)):
+            a, c = pb.getAABB(b, link, physicsClientId=client)
+            lo = np.minimum(lo, a[:2])
+            hi = np.maximum(hi, c[:2])
+    if not np.isfinite(lo).all():
+        raise ValueError("no bodies to take the extent of")
+    return float(lo[0] - pad), float(lo[1] - pad), float(hi[0] + pad), float(hi[1] + pad)
+
+
+def rasterise(
+    client: int,
+    obstacles: Sequence[int],
+    *,
+    resolution: float = DEFAULT_RESOLUTION,
+    band: ZBand = DEFAULT_BAND,
+    extent: tuple[float, float, float, float] | None = None,
+    movable: Sequence[int] = (),
+    pad: float = 0.5,
+) -> OccupancyGrid:
+    """Occupancy grid of the collision shapes of ``obstacles`` (and ``movable``) in ``band``.
+
+    ``extent`` defaults to the bounding rectangle of the obstacles, padded by ``pad``. Each
+    body's cells are remembered (:attr:`OccupancyGrid.sources`).
+    """
+    if extent is None:
+        extent = bodies_extent(client, list(obstacles) + list(movable), pad)
+    grid = OccupancyGrid.empty(extent, resolution, band)
+    for body in list(obstacles) + list(movable):
+        grid.mark(body_outlines(client, body, band), source=body)
+    return grid

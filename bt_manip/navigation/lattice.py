@@ -1,0 +1,472 @@
+"""Planning in (x, y, heading) for footprints that are long or lopsided.
+
+The grid planner (:mod:`bt_manip.navigation.planner`) treats the robot as a disc of its half
+width, which is right for a base that drives along its path but not for a base that carries a
+1.2 m panel ahead of it: turning that base sweeps the panel over two metres. :func:`plan_poses`
+searches over poses instead (a hybrid A*): from each pose it tries short moves -- forward or
+backward, straight or along an arc, or a turn on the spot about the base's pivot point --
+checks the whole footprint along each move against the clearance grid, and keeps the cheapest
+pose per (x, y, heading) bin. Backing up costs double, and turning on the spot costs
+``turn_cost`` metres per radian, so the result drives forward where it can.
+
+The moves are checked every few centimetres of footprint travel: every outline point must keep
+``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a
+cell's centre, so the point's own offset in its cell is subtracted too). The heuristic is the
+obstacle-aware distance to the goal on the grid of cells with enough clearance for the
+footprint's half width, so the search heads through the right doorways.
+
+The result is a list of poses with the move that reaches each (:class:`PosePlan`), which
+:class:`bt_manip.navigation.segments.SegmentFollower` executes.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from bt_manip.navigation.footprint import PlanarFootprint
+from bt_manip.navigation.grid import OccupancyGrid
+
+FORWARD, BACKWARD, TURN = 0, 1, 2
+"""Move kinds in :attr:`PosePlan.moves`."""
+
+
+@dataclass(frozen=True)
+class LatticeOptions:
+    """Options of :func:`plan_poses` (SI units)."""
+
+    step: float = 0.2
+    """Length (m) of a straight or arc move."""
+    turn_radius: float = 1.0
+    """Radius (m) of the arc moves."""
+    heading_bins: int = 32
+    xy_bin: float = 0.1
+    turn_step: float = math.pi / 16
+    """Angle (rad) of one turn on the spot."""
+    turn_cost: float = 0.6
+    """Cost (m) of turning on the spot by one radian."""
+    reverse_factor: float = 2.0
+    min_clearance: float = 0.05
+    goal_xy: float = 0.15
+    goal_yaw: float = 0.2
+    max_expansions: int = 400_000
+    check_spacing: float = 0.05
+    """Largest travel (m) of any footprint point between two collision checks."""
+
+
+@dataclass(frozen=True)
+class PosePlan:
+    """Poses (n, 3) from start to (near) goal and the move reaching each (n - 1,) or a reason."""
+
+    ok: bool
+    reason: str
+    poses: np.ndarray | None = None
+    moves: np.ndarray | None = None
+    length: float = math.inf
+    expanded: int = 0
+
+
+def outline_samples(footprint: PlanarFootprint, spacing: float = 0.05) -> np.ndarray:
+    """Points every ``spacing`` metres along the boundary of every outline (robot frame)."""
+    pts = []
+    for o in footprint.outlines:
+        ring = o.points(48)
+        for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True):
+            n = max(1, math.ceil(float(np.hypot(*(b - a))) / spacing))
+            t = np.arange(n)[:, None] / n
+            pts.append(a + t * (b - a))
+    return np.concatenate(pts)
+
+
+@numba.njit(cache=True)
+def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
+    """Shortest 8-connected distance (cells, no corner cutting) from every free cell to goal."""
+    rows, cols = free.shape
+    dist = np.full((rows, cols), np.inf)
+    if not free[goal_r, goal_c]:
+        return dist
+    heap_d = np.empty(rows * cols * 4 + 8)
+    heap_i = np.empty(rows * cols * 4 + 8, np.int64)
+    size = 0
+    dist[goal_r, goal_c] = 0.0
+    heap_d[0] = 0.0
+    heap_i[0] = goal_r * cols + goal_c
+    size = 1
+    dr = (-1, 1, 0, 0, -1, -1, 1, 1)
+    dc = (0, 0, -1, 1, -1, 1, -1, 1)
+    sq2 = math.sqrt(2.0)
+    while size > 0:
+        d = heap_d[0]
+        node = heap_i[0]
+        size -= 1
+        # sift the last entry down from the root
+        ld = heap_d[size]
+        li = heap_i[size]
+        i = 0
+        while True:
+            ch = 2 * i + 1
+            if ch >= size:
+                break
+            if ch + 1 < size and heap_d[ch + 1] < heap_d[ch]:
+                ch += 1
+            if heap_d[ch] >= ld:
+                break
+            heap_d[i] = heap_d[ch]
+            heap_i[i] = heap_i[ch]
+            i = ch
+        heap_d[i] = ld
+        heap_i[i] = li
+        r = node // cols
+        c = node % cols
+        if d > dist[r, c]:
+            continue
+        for k in range(8):
+            nr = r + dr[k]
+            nc = c + dc[k]
+            if nr < 0 or nr >= rows or nc < 0 or nc >= cols or not free[nr, nc]:
+                continue
+            if k >= 4 and not (free[nr, c] and free[r, nc]):
+                continue
+            nd = d + (sq2 if k >= 4 else 1.0)
+            if nd < dist[nr, nc] and size < heap_d.shape[0]:
+                dist[nr, nc] = nd
+                j = size
+                size += 1
+                while j > 0:
+                    p = (j - 1) >> 1
+                    if heap_d[p] <= nd:
+                        break
+                    heap_d[j] = heap_d[p]
+                    heap_i[j] = heap_i[p]
+                    j = p
+                heap_d[j] = nd
+                heap_i[j] = nr * cols + nc
+    return dist
+
+
+@numba.njit(cache=True)
+def _points_free(
+    clear: np.ndarray,
+    x0: float,
+    y0: float,
+    res: float,
+    pts: np.ndarray,
+    x: float,
+    y: float,
+    th: float,
+    need: float,
+) -> bool:
+    rows, cols = clear.shape
+    c = math.cos(th)
+    s = math.sin(th)
+    for k in range(pts.shape[0]):
+        px = x + c * pts[k, 0] - s * pts[k, 1]
+        py = y + s * pts[k, 0] + c * pts[k, 1]
+        col = math.floor((px - x0) / res)
+        row = math.floor((py - y0) / res)
+        if row < 0 or row >= rows or col < 0 or col >= cols:
+            return False
+        if clear[row, col] < need:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def _pose_free(
+    clear: np.ndarray,
+    clear_high: np.ndarray,
+    x0: float,
+    y0: float,
+    res: float,
+    pts: np.ndarray,
+    pts_high: np.ndarray,
+    x: float,
+    y: float,
+    th: float,
+    need: float,
+) -> bool:
+    """Footprint points clear of everything, carried-object points clear of tall obstacles."""
+    return _points_free(clear, x0, y0, res, pts, x, y, th, need) and _points_free(
+        clear_high, x0, y0, res, pts_high, x, y, th, need
+    )
+
+
+@numba.njit(cache=True)
+def _move(
+    x: float, y: float, th: float, kind: int, curv: float, length: float, pivot: float, t: float
+) -> tuple[float, float, float]:
+    """Pose after the fraction ``t`` of a move (kind 0/1 drive with curvature, 2 turn)."""
+    if kind == 2:  # turn on the spot about the pivot by ``length`` rad
+        px = x + pivot * math.cos(th)
+        py = y + pivot * math.sin(th)
+        nth = th + t * length
+        return px - pivot * math.cos(nth), py - pivot * math.sin(nth), nth
+    d = t * length * (1.0 if kind == 0 else -1.0)
+    if abs(curv) < 1e-9:
+        return x + d * math.cos(th), y + d * math.sin(th), th
+    nth = th + d * curv
+    return (
+        x + (math.sin(nth) - math.sin(th)) / curv,
+        y - (math.cos(nth) - math.cos(th)) / curv,
+        nth,
+    )
+
+
+@numba.njit(cache=True)
+def _search(
+    clear: np.ndarray,
+    clear_high: np.ndarray,
+    x0: float,
+    y0: float,
+    res: float,
+    pts: np.ndarray,
+    pts_high: np.ndarray,
+    reach: float,
+    need: float,
+    hfield: np.ndarray,
+    start: np.ndarray,
+    goal: np.ndarray,
+    params: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, int, int]:
+    step = params[0]
+    curv = params[1]
+    nh = int(params[2])
+    xyb = params[3]
+    tstep = params[4]
+    tcost = params[5]
+    rev = params[6]
+    gxy = params[7]
+    gyaw = params[8]
+    maxexp = int(params[9])
+    spacing = params[10]
+    pivot = params[11]
+    rows, cols = clear.shape
+    bx = math.ceil(cols * res / xyb) + 1
+    by = math.ceil(rows * res / xyb) + 1
+    nstates = bx * by * nh
+    best = np.full(nstates, np.inf)
+    parent = np.full(nstates, -1, np.int64)
+    move_of = np.full(nstates, -1, np.int64)
+    pose = np.zeros((nstates, 3))
+    cap = 1 << 16
+    hf = np.empty(cap)
+    hi = np.empty(cap, np.int64)
+    size = 0
+    two_pi = 2.0 * math.pi
+
+    def key(x: float, y: float, th: float) -> int:
+        ix = math.floor((x - x0) / xyb)
+        iy = math.floor((y - y0) / xyb)
+        ih = math.floor(((th % two_pi) / two_pi) * nh + 0.5) % nh
+        return (iy * bx + ix) * nh + ih
+
+    def heur(x: float, y: float) -> float:
+        col = math.floor((x - x0) / res)
+        row = math.floor((y - y0) / res)
+        if row < 0 or row >= rows or col < 0 or col >= cols:
+            return np.inf
+        d = hfield[row, col]
+        return d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
+
+    k0 = key(start[0], start[1], start[2])
+    best[k0] = 0.0
+    pose[k0, 0] = start[0]
+    pose[k0, 1] = start[1]
+    pose[k0, 2] = start[2]
+    hf[0] = heur(start[0], start[1])
+    hi[0] = k0
+    size = 1
+    expanded = 0
+    # moves: (kind, curvature, length)
+    kinds = np.array([0, 0, 0, 1, 1, 1, 2, 2])
+    curvs = np.array([0.0, curv, -curv, 0.0, curv, -curv, 0.0, 0.0])
+    lens = np.array([step, step, step, step, step, step, tstep, -tstep])
+    costs = np.array(
+        [
+            step,
+            step * 1.05,
+            step * 1.05,
+            rev * step,
+            rev * step * 1.05,
+            rev * step * 1.05,
+            tcost * tstep,
+            tcost * tstep,
+        ]
+    )
+    while size > 0:
+        f = hf[0]
+        k = hi[0]
+        size -= 1
+        lf = hf[size]
+        lk = hi[size]
+        i = 0
+        while True:
+            ch = 2 * i + 1
+            if ch >= size:
+                break
+            if ch + 1 < size and hf[ch + 1] < hf[ch]:
+                ch += 1
+            if hf[ch] >= lf:
+                break
+            hf[i] = hf[ch]
+            hi[i] = hi[ch]
+            i = ch
+        hf[i] = lf
+        hi[i] = lk
+        x = pose[k, 0]
+        y = pose[k, 1]
+        th = pose[k, 2]
+        g = best[k]
+        if f > g + heur(x, y) + 1e-9:
+            continue  # stale
+        dyaw = (th - goal[2] + math.pi) % two_pi - math.pi
+        if math.hypot(x - goal[0], y - goal[1]) <= gxy and abs(dyaw) <= gyaw:
+            return parent, move_of, pose, k, expanded
+        expanded += 1
+        if expanded > maxexp:
+            break
+        for m in range(8):
+            kind = kinds[m]
+            length = lens[m]
+            travel = abs(length) * (reach if kind == 2 else 1.0) + (
+                reach * abs(length * curvs[m]) if kind != 2 else 0.0
+            )
+            nsub = max(1, math.ceil(travel / spacing))
+            ok = True
+            nx = x
+            ny = y
+            nt = th
+            for j in range(1, nsub + 1):
+                nx, ny, nt = _move(x, y, th, kind, curvs[m], length, pivot, j / nsub)
+                if not _pose_free(clear, clear_high, x0, y0, res, pts, pts_high, nx, ny, nt, need):
+                    ok = False
+                    break
+            if not ok:
+                continue
+            nk = key(nx, ny, nt)
+            ng = g + costs[m]
+            if ng >= best[nk]:
+                continue
+            best[nk] = ng
+            parent[nk] = k
+            move_of[nk] = m
+            pose[nk, 0] = nx
+            pose[nk, 1] = ny
+            pose[nk, 2] = nt
+            if size == hf.shape[0]:
+                nhf = np.empty(size * 2)
+                nhi = np.empty(size * 2, np.int64)
+                nhf[:size] = hf
+                nhi[:size] = hi
+                hf = nhf
+                hi = nhi
+            nf = ng + heur(nx, ny)
+            j = size
+            size += 1
+            while j > 0:
+                p = (j - 1) >> 1
+                if hf[p] <= nf:
+                    break
+                hf[j] = hf[p]
+                hi[j] = hi[p]
+                j = p
+            hf[j] = nf
+            hi[j] = nk
+    return parent, move_of, pose, -1, expanded
+
+
+def plan_poses(
+    grid: OccupancyGrid,
+    clear: np.ndarray,
+    footprint: PlanarFootprint,
+    start: tuple[float, float, float],
+    goal: tuple[float, float, float],
+    pivot: float = 0.0,
+    options: LatticeOptions = LatticeOptions(),
+    carried: PlanarFootprint | None = None,
+    clear_high: np.ndarray | None = None,
+) -> PosePlan:
+    """Poses from ``start`` to within the goal tolerances of ``goal``.
+
+    ``footprint`` (the robot) is checked against ``clear``; ``carried`` (objects held above
+    the floor) against ``clear_high``, the clearance of the obstacles tall enough to reach
+    them, so a panel may pass over a low stand the wheels must avoid.
+    """
+    o = options
+    pts = outline_samples(footprint, 0.05)
+    if carried is not None and clear_high is not None:
+        pts_high = outline_samples(carried, 0.05)
+        high = clear_high
+    else:
+        pts_high = np.zeros((0, 2))
+        high = clear
+    both = np.vstack([pts, pts_high])
+    whole = (
+        footprint.describe()
+        if carried is None
+        else (
+            f"{footprint.label} + {carried.label}: reaching {float(np.hypot(*both.T).max()):.2f} m"
+        )
+    )
+    reach = float(np.hypot(both[:, 0] - pivot, both[:, 1]).max()) + abs(pivot)
+    need = o.min_clearance + grid.resolution / math.sqrt(2.0)
+    x0, y0 = grid.origin
+    res = grid.resolution
+    if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *goal, need):
+        return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
+    if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *start, need):
+        return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
+    free = clear >= footprint.half_width + o.min_clearance
+    gc = grid.world_to_cell(goal[0], goal[1])
+    hfield = (
+        _distance_field(free, gc[0], gc[1]) if grid.inside(gc) else np.full(clear.shape, np.inf)
+    )
+    params = np.array(
+        [
+            o.step,
+            1.0 / o.turn_radius,
+            o.heading_bins,
+            o.xy_bin,
+            o.turn_step,
+            o.turn_cost,
+            o.reverse_factor,
+            o.goal_xy,
+            o.goal_yaw,
+            o.max_expansions,
+            o.check_spacing,
+            pivot,
+        ]
+    )
+    parent, move_of, pose, end, expanded = _search(
+        clear,
+        high,
+        x0,
+        y0,
+        res,
+        pts,
+        pts_high,
+        reach,
+        need,
+        hfield,
+        np.asarray(start, float),
+        np.asarray(goal, float),
+        params,
+    )
+    if end < 0:
+        return PosePlan(
+            False,
+            f"no sequence of moves fits the footprint ({whole}) from the start to the goal",
+            expanded=expanded,
+        )
+    chain = [end]
+    while parent[chain[-1]] >= 0:
+        chain.append(int(parent[chain[-1]]))
+    chain.reverse()
+    poses = pose[chain].copy()
+    kinds = np.array([FORWARD] * 3 + [BACKWARD] * 3 + [TURN] * 2)
+    moves = kinds[move_of[chain[1:]]]
+    length = float(np.hypot(*np.diff(poses[:, :2], axis=0).T).sum())
+    return PosePlan(True, "ok", poses, moves, length, expanded)

@@ -1,0 +1,305 @@
+"""Navigation of one robot in one PyBullet world: map, footprint, planner and follower.
+
+A :class:`Navigator` rasterises the static obstacles once, redraws the movable objects when
+asked (they may have moved), keeps the robot's planning footprint (which grows while it holds
+an object, see :meth:`Navigator.attach`) and drives a follower.
+
+It never commands the robot itself. Per tick the caller does::
+
+    status = nav.update(robot.base_pose2d(), world.clock.now())
+    robot.set_base_twist(*status.cmd)
+
+and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says why).
+
+- Bare robot: grid A* for the footprint's half width, line-of-sight shortcuts, and a
+  :class:`PathFollower`. While the robot drives, the follower asks every ``replan_period``
+  seconds whether a movable object now blocks the rest of the path; if so the navigator plans
+  again from where the robot is.
+- Carrying something: the grid plan first tells whether any way is wide enough (if not, the
+  plan fails with the footprint as the reason); then a search over poses
+  (:mod:`bt_manip.navigation.lattice`) finds moves, backing up where needed, that keep the whole
+  robot and its load clear, and a :class:`SegmentFollower` drives them. No replanning is done
+  in this mode yet.
+
+Where a skid-steer base turns on the spot (``pivot``) matters for ending on the goal; see
+:mod:`bt_manip.navigation.controller`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+from bt_manip.navigation.controller import (
+    FollowerOptions,
+    FollowState,
+    FollowStatus,
+    PathFollower,
+    Pose2D,
+)
+from bt_manip.navigation.costmap import CostMap, InflationOptions, clearance
+from bt_manip.navigation.footprint import PlanarFootprint
+from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
+from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
+from bt_manip.navigation.planner import NavPlan, PlannerOptions, PlanOutcome, plan_path
+from bt_manip.navigation.segments import SegmentFollower
+from bt_manip.navigation.shapes import ZBand, body_outlines, planar_frame
+from bt_manip.navigation.smoothing import densify, path_length
+
+
+@dataclass(frozen=True)
+class NavigatorOptions:
+    """Grid, inflation, planning and following options."""
+
+    resolution: float = DEFAULT_RESOLUTION
+    band: ZBand | None = None
+    """Height band (m) of the obstacles that matter; default from 2 cm to 5 cm above the
+    robot's highest point at construction."""
+    inflation: InflationOptions = field(default_factory=InflationOptions)
+    planner: PlannerOptions = field(default_factory=PlannerOptions)
+    follower: FollowerOptions = field(default_factory=FollowerOptions)
+    lattice: LatticeOptions = field(default_factory=LatticeOptions)
+    pivot: float | None = None
+    """Where the base turns about on the spot (m ahead of the base frame); ``None`` takes the
+    descriptor's ``base.pivot_offset`` if it has one, else 0."""
+
+
+def robot_top(robot: Any) -> float:
+    """Highest point (m) of the robot's collision geometry now."""
+    top = 0.0
+    for link in range(-1, pb.getNumJoints(robot.body, physicsClientId=robot.client)):
+        top = max(top, pb.getAABB(robot.body, link, physicsClientId=robot.client)[1][2])
+    return float(top)
+
+
+class Navigator:
+    """Map, footprint and path following for ``robot`` among ``obstacles`` and ``movable``.
+
+    Args:
+        robot: a :class:`bt_manip.sim.robot.Robot` (its client, body and descriptor are used).
+        obstacles: body ids of the static structure and furniture.
+        movable: body ids (or name -> id) of objects that may move; redrawn on refresh.
+    """
+
+    def __init__(
+        self,
+        robot: Any,
+        obstacles: Sequence[int],
+        movable: Mapping[str, int] | Sequence[int] = (),
+        options: NavigatorOptions = NavigatorOptions(),
+    ) -> None:
+        self.robot = robot
+        self.client = robot.client
+        self.options = options
+        self.movable: dict[int, str] = (
+            {b: n for n, b in movable.items()}
+            if isinstance(movable, Mapping)
+            else {b: f"body {b}" for b in movable}
+        )
+        self.band: ZBand = options.band or (0.02, robot_top(robot) + 0.05)
+        self.static: OccupancyGrid = rasterise(
+            self.client, list(obstacles), resolution=options.resolution, band=self.band
+        )
+        self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
+        self.footprint = self.base_footprint
+        self.attached: dict[int, str] = {}
+        self.costmap = CostMap(self._compose(), options.inflation)
+        self.follower: PathFollower | SegmentFollower | None = None
+        self.poses: PosePlan | None = None
+        self._obstacles = list(obstacles)
+        self._carry: tuple | None = None
+        self.plan: NavPlan | None = None
+        self._goal: Pose2D | None = None
+        self._plan_cost: np.ndarray | None = None
+        self._align = True
+        self.pivot = (
+            options.pivot
+            if options.pivot is not None
+            else float(getattr(robot.description.base, "pivot_offset", 0.0))
+        )
+        """Where the base turns about on the spot (m ahead of its frame)."""
+
+    # -- map --------------------------------------------------------------------------------
+    def _compose(self) -> OccupancyGrid:
+        grid = self.static.copy()
+        for body in self.movable:
+            if body not in self.attached:
+                grid.mark(body_outlines(self.client, body, self.band), source=body)
+        return grid
+
+    def refresh(self) -> bool:
+        """Redraw the movable objects; True if the occupied cells changed."""
+        grid = self._compose()
+        if np.array_equal(grid.occupied, self.costmap.grid.occupied):
+            return False
+        self.costmap = self.costmap.with_grid(grid)
+        return True
+
+    @property
+    def cost(self) -> np.ndarray:
+        """The cost grid the planner searches for the current footprint."""
+        return self.costmap.cost_for(self.footprint)
+
+    # -- what the robot carries --------------------------------------------------------------
+    def attach(self, body: int, name: str | None = None) -> PlanarFootprint:
+        """Count ``body`` (held by the robot) as part of the footprint, where it sits now.
+
+        While something is carried, goals are planned over poses (:mod:`.lattice`) with the
+        robot and the load checked in two height slabs: below the load's bottom (wheels and
+        base against every obstacle) and above it (arm and load against the obstacles that
+        reach that high).
+        """
+        label = name or self.movable.get(body, f"body {body}")
+        self.attached[body] = label
+        self.footprint = self.footprint.with_body(self.robot, body, label, band=self.band)
+        self.refresh()
+        self._build_carry_layers()
+        return self.footprint
+
+    def detach(self, body: int) -> PlanarFootprint:
+        """Stop counting ``body`` as carried; it becomes an obstacle again if movable."""
+        self.attached.pop(body, None)
+        fp = self.base_footprint
+        for b, label in self.attached.items():
+            fp = fp.with_body(self.robot, b, label, band=self.band)
+        self.footprint = fp
+        self.refresh()
+        self._build_carry_layers()
+        return fp
+
+    def _build_carry_layers(self) -> None:
+        self._carry = None
+        if not self.attached:
+            return
+        c = self.client
+        split = min(pb.getAABB(b, physicsClientId=c)[0][2] for b in self.attached) - 0.03
+        top = max(self.band[1], *(pb.getAABB(b, physicsClientId=c)[1][2] for b in self.attached))
+        frame = planar_frame(*self.robot.base_pose2d())
+        low_fp = PlanarFootprint.of_robot(self.robot, band=(self.band[0], split))
+        high_parts = body_outlines(c, self.robot.body, (split, top + 0.05), reference=frame)
+        for b in self.attached:
+            high_parts += body_outlines(c, b, (split, top + 0.05), reference=frame)
+        labels = " + ".join([self.base_footprint.label, *self.attached.values()])
+        high_fp = PlanarFootprint(tuple(high_parts), labels)
+        movers = [b for b in self.movable if b not in self.attached]
+        bodies = list(self._obstacles) + movers
+        ext = self.static.extent
+        res = self.options.resolution
+        low = rasterise(c, bodies, resolution=res, band=(self.band[0], split), extent=ext)
+        high = rasterise(c, bodies, resolution=res, band=(split, top + 0.05), extent=ext)
+        self._carry = (low_fp, high_fp, low, clearance(low), clearance(high))
+
+    # -- planning and following ---------------------------------------------------------------
+    def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
+        """A plan from ``start`` to ``goal`` for the current footprint and map."""
+        return plan_path(self.costmap, self.footprint, start[:2], goal[:2], self.options.planner)
+
+    def start(self, pose: Pose2D, goal: Pose2D, align: bool = True) -> NavPlan:
+        """Plan from ``pose`` to ``goal`` (x, y, yaw) and get ready to follow the path.
+
+        Returns the plan; when it is not ``ok`` there is nothing to follow and
+        :meth:`update` answers FAILED with the plan's reason.
+        """
+        self.refresh()
+        self._goal = goal
+        self._align = align
+        self.follower = None
+        self.plan = self.plan_to(self._pivot(pose), self._pivot_goal())
+        if not self.plan.ok:
+            self.plan = self.plan_to(pose, goal)  # the reason, in the caller's coordinates
+            if not self.plan.ok:
+                return self.plan
+        if self._carry is not None:
+            return self._start_carrying(pose, goal)
+        self._plan_cost = self.cost
+        self.follower = PathFollower(
+            self.plan.polyline,
+            goal if align else goal[:2],
+            dataclasses.replace(self.options.follower, pivot=self.pivot),
+            path_blocked=self._path_blocked,
+            replan=self._replan,
+        )
+        return self.plan
+
+    def _start_carrying(self, pose: Pose2D, goal: Pose2D) -> NavPlan:
+        """Plan over poses for the robot with its load; the grid plan said a way may exist."""
+        assert self._carry is not None
+        low_fp, high_fp, low, clear_low, clear_high = self._carry
+        poses = plan_poses(
+            low,
+            clear_low,
+            low_fp,
+            pose,
+            goal,
+            self.pivot,
+            self.options.lattice,
+            carried=high_fp,
+            clear_high=clear_high,
+        )
+        if not poses.ok:
+            self.plan = NavPlan(PlanOutcome.FOOTPRINT, poses.reason)
+            return self.plan
+        assert poses.poses is not None
+        p = self.pivot
+        pts = poses.poses
+        poly = densify(
+            np.column_stack([pts[:, 0] + p * np.cos(pts[:, 2]), pts[:, 1] + p * np.sin(pts[:, 2])]),
+            self.options.planner.spacing,
+        )
+        self.plan = NavPlan(PlanOutcome.OK, "ok", poly, None, path_length(poly))
+        self.poses = poses
+        self.follower = SegmentFollower(
+            poses, goal, dataclasses.replace(self.options.follower, pivot=self.pivot)
+        )
+        return self.plan
+
+    def update(self, pose: Pose2D, now: float) -> FollowStatus:
+        """One tick: the twist to apply, or SUCCEEDED / FAILED with the reason."""
+        if self.follower is None:
+            reason = self.plan.reason if self.plan is not None else "no goal given"
+            return FollowStatus(FollowState.FAILED, reason, (0.0, 0.0))
+        return self.follower.update(pose, now)
+
+    def _cells(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        grid = self.costmap.grid
+        rows = np.floor((points[:, 1] - grid.origin[1]) / grid.resolution).astype(int)
+        cols = np.floor((points[:, 0] - grid.origin[0]) / grid.resolution).astype(int)
+        r, c = grid.shape
+        return np.clip(rows, 0, r - 1), np.clip(cols, 0, c - 1)
+
+    def _path_blocked(self, ahead: np.ndarray) -> bool:
+        if not self.movable or not self.refresh():
+            return False
+        rows, cols = self._cells(ahead)
+        now = self.cost[rows, cols]
+        before = (
+            self._plan_cost[rows, cols]
+            if self._plan_cost is not None and self._plan_cost.shape == self.cost.shape
+            else np.ones_like(now)
+        )
+        return bool(np.any(np.isinf(now) & np.isfinite(before)))
+
+    def _pivot(self, pose: Pose2D) -> Pose2D:
+        """Where the base's pivot point is for a base pose (the heading is kept)."""
+        p = self.pivot
+        return (pose[0] + p * math.cos(pose[2]), pose[1] + p * math.sin(pose[2]), pose[2])
+
+    def _pivot_goal(self) -> Pose2D:
+        """Where the pivot must end: ahead of the goal along its heading when aligning."""
+        assert self._goal is not None
+        return self._pivot(self._goal) if self._align else self._goal
+
+    def _replan(self, pose: Pose2D) -> np.ndarray | str:
+        assert self._goal is not None
+        plan = self.plan_to(self._pivot(pose), self._pivot_goal())
+        if not plan.ok:
+            return plan.reason
+        self.plan = plan
+        self._plan_cost = self.cost
+        return plan.polyline

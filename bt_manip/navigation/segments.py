@@ -1,0 +1,108 @@
+"""Following a pose plan: runs of forward, backward and on-the-spot moves, one after another.
+
+A :class:`~bt_manip.navigation.lattice.PosePlan` is cut into runs of the same kind of move.
+Each run is handed to a :class:`~bt_manip.navigation.controller.PathFollower`: forward and
+backward runs follow the pivot point's path through the run's poses, a turn on the spot turns
+to the run's last heading, and a last run brings the base exactly onto the goal with the
+follower's tolerances. Intermediate runs end within ``waypoint_tolerance`` without settling.
+
+:meth:`SegmentFollower.update` has the same contract as :meth:`PathFollower.update`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from bt_manip.navigation.controller import (
+    FollowerOptions,
+    FollowState,
+    FollowStatus,
+    PathFollower,
+    Pose2D,
+)
+from bt_manip.navigation.lattice import BACKWARD, TURN, PosePlan
+from bt_manip.navigation.smoothing import densify
+
+
+def _runs(moves: np.ndarray) -> list[tuple[int, int, int]]:
+    """(kind, first pose index, last pose index) of each run of equal moves."""
+    out: list[tuple[int, int, int]] = []
+    start = 0
+    for i in range(1, len(moves) + 1):
+        if i == len(moves) or moves[i] != moves[start]:
+            out.append((int(moves[start]), start, i))
+            start = i
+    return out
+
+
+class SegmentFollower:
+    """Drives through the runs of ``plan`` and ends on ``goal`` (x, y, yaw)."""
+
+    def __init__(
+        self,
+        plan: PosePlan,
+        goal: Pose2D,
+        options: FollowerOptions | None = None,
+        waypoint_tolerance: float = 0.15,
+    ) -> None:
+        options = options or FollowerOptions()
+        if not plan.ok or plan.poses is None or plan.moves is None:
+            raise ValueError("a pose plan that found a way is needed")
+        self.options = options
+        self.goal = goal
+        self.pivot = options.pivot
+        self._loose = dataclasses.replace(
+            options, xy_tolerance=waypoint_tolerance, yaw_tolerance=0.2, settle_time=0.0
+        )
+        self._queue: list[tuple[int, np.ndarray]] = []
+        poses = plan.poses
+        for kind, a, b in _runs(plan.moves):
+            self._queue.append((kind, poses[a : b + 1]))
+        self._current: PathFollower | None = None
+        self._final = False
+        self._done: FollowStatus | None = None
+        self.runs = len(self._queue)
+
+    def _pivot_path(self, poses: np.ndarray) -> np.ndarray:
+        p = self.pivot
+        pts = np.column_stack(
+            [poses[:, 0] + p * np.cos(poses[:, 2]), poses[:, 1] + p * np.sin(poses[:, 2])]
+        )
+        return densify(pts, 0.05)
+
+    def _next(self, pose: Pose2D) -> PathFollower:
+        if not self._queue:
+            self._final = True
+            x, y, yaw = pose
+            here = (x + self.pivot * math.cos(yaw), y + self.pivot * math.sin(yaw))
+            gx, gy, gyaw = self.goal
+            there = (gx + self.pivot * math.cos(gyaw), gy + self.pivot * math.sin(gyaw))
+            return PathFollower(densify(np.array([here, there]), 0.05), self.goal, self.options)
+        kind, poses = self._queue.pop(0)
+        end = poses[-1]
+        if kind == TURN:
+            here = self._pivot_path(poses[-1:])
+            return PathFollower(here, (end[0], end[1], end[2]), self._loose)
+        return PathFollower(
+            self._pivot_path(poses), (end[0], end[1]), self._loose, reverse=kind == BACKWARD
+        )
+
+    def update(self, pose: Pose2D, now: float) -> FollowStatus:
+        """One tick; see :meth:`PathFollower.update`."""
+        if self._done is not None:
+            return self._done
+        for _ in range(self.runs + 2):
+            if self._current is None:
+                self._current = self._next(pose)
+            status = self._current.update(pose, now)
+            if status.state is FollowState.RUNNING:
+                return status
+            if status.state is FollowState.FAILED or self._final:
+                self._done = status
+                return status
+            self._current = None  # this run is done: start the next one in the same tick
+        self._done = FollowStatus(FollowState.FAILED, "pose plan could not be followed", (0, 0))
+        return self._done

@@ -1,0 +1,275 @@
+"""Planar outlines of PyBullet collision shapes, sliced to a height band.
+
+Navigation works in the ground plane: every collision shape of a body that reaches into the
+height band the robot sweeps is reduced to its outline seen from above, as a :class:`Disc` or a
+convex :class:`Polygon`, in the world frame or in another frame (a robot's base, to build its
+footprint).
+
+- Boxes: the part of the box inside the band, exactly (the box is clipped by the two band
+  planes, then projected).
+- Spheres: the widest circle inside the band, exactly.
+- Upright cylinders and capsules: their circle. Tilted ones: a polygon circumscribing the
+  projection of the whole solid.
+- Meshes: the projection of their collision vertices (``getMeshData``, convex hull); when
+  PyBullet gives no vertices, the link's axis-aligned bounding box.
+- Planes are ignored (the floor is not an obstacle); anything else uses its bounding box.
+
+Collision frames are taken from ``getCollisionShapeData``, which reports them relative to the
+link's centre-of-mass frame (``getBasePositionAndOrientation`` / ``getLinkState``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as pb
+
+ZBand = tuple[float, float]
+Frame = tuple[np.ndarray, np.ndarray]  # position (3,), rotation matrix (3, 3)
+
+
+@dataclass(frozen=True)
+class Disc:
+    """A filled circle in the plane."""
+
+    cx: float
+    cy: float
+    radius: float
+
+    def extent(self) -> tuple[float, float, float, float]:
+        """(xmin, ymin, xmax, ymax)."""
+        r = self.radius
+        return self.cx - r, self.cy - r, self.cx + r, self.cy + r
+
+    def points(self, n: int = 32) -> np.ndarray:
+        """``n`` points on a polygon that circumscribes the circle."""
+        a = np.arange(n) * (2.0 * math.pi / n)
+        r = self.radius / math.cos(math.pi / n)
+        return np.column_stack([self.cx + r * np.cos(a), self.cy + r * np.sin(a)])
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A filled convex polygon in the plane; ``vertices`` (n, 2) counter-clockwise."""
+
+    vertices: np.ndarray
+
+    def extent(self) -> tuple[float, float, float, float]:
+        lo = self.vertices.min(axis=0)
+        hi = self.vertices.max(axis=0)
+        return float(lo[0]), float(lo[1]), float(hi[0]), float(hi[1])
+
+    def points(self, n: int = 0) -> np.ndarray:
+        return self.vertices
+
+
+Outline = Disc | Polygon
+
+
+def convex_hull(points: np.ndarray) -> np.ndarray:
+    """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
+    pts = np.unique(np.round(np.asarray(points, dtype=float), 12), axis=0)
+    if len(pts) <= 2:
+        return pts
+
+    def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
+
+    lower: list[np.ndarray] = []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    upper: list[np.ndarray] = []
+    for p in pts[::-1]:
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return np.array(lower[:-1] + upper[:-1])
+
+
+def frame_of(position: tuple[float, ...], quaternion: tuple[float, ...]) -> Frame:
+    rot = np.array(pb.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
+    return np.asarray(position, dtype=float), rot
+
+
+def compose(a: Frame, b: Frame) -> Frame:
+    """Frame ``b`` (given in frame ``a``) expressed in ``a``'s parent."""
+    return a[0] + a[1] @ b[0], a[1] @ b[1]
+
+
+def inverse(a: Frame) -> Frame:
+    rt = a[1].T
+    return -rt @ a[0], rt
+
+
+def planar_frame(x: float, y: float, yaw: float) -> Frame:
+    """The frame at (x, y, 0) turned by ``yaw`` about z."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    return np.array([x, y, 0.0]), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _box_slice(frame: Frame, half: np.ndarray, band: ZBand) -> np.ndarray | None:
+    """Plane points of the part of a box inside the z band (None if it misses the band)."""
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    corners = frame[0] + (signs * half) @ frame[1].T
+    z = corners[:, 2]
+    lo, hi = band
+    if z.max() < lo or z.min() > hi:
+        return None
+    pts = [corners[(z >= lo) & (z <= hi), :2]]
+    for i in range(8):
+        for bit in (1, 2, 4):
+            j = i ^ bit
+            if j < i:
+                continue
+            za, zb = z[i], z[j]
+            for plane in (lo, hi):
+                if (za - plane) * (zb - plane) < 0.0:
+                    t = (plane - za) / (zb - za)
+                    pts.append((corners[i, :2] + t * (corners[j, :2] - corners[i, :2]))[None])
+    pts_all = np.concatenate(pts)
+    return pts_all if len(pts_all) else None
+
+
+def _sphere_slice(centre: np.ndarray, radius: float, band: ZBand) -> Disc | None:
+    lo, hi = band
+    cz = centre[2]
+    if cz + radius < lo or cz - radius > hi:
+        return None
+    d = 0.0 if lo <= cz <= hi else min(abs(cz - lo), abs(cz - hi))
+    r = math.sqrt(max(radius * radius - d * d, 0.0))
+    return Disc(float(centre[0]), float(centre[1]), r)
+
+
+def _round_solid(
+    frame: Frame, length: float, radius: float, capsule: bool, band: ZBand
+) -> Outline | None:
+    """Cylinder (or capsule) along the frame's z axis."""
+    axis = frame[1][:, 2]
+    centre = frame[0]
+    az = abs(float(axis[2]))
+    half_z = 0.5 * length * az + radius * (1.0 if capsule else math.sqrt(max(1.0 - az * az, 0.0)))
+    if centre[2] + half_z < band[0] or centre[2] - half_z > band[1]:
+        return None
+    if az > 1.0 - 1e-9:
+        return Disc(float(centre[0]), float(centre[1]), radius)
+    ends = [centre + axis * (0.5 * length), centre - axis * (0.5 * length)]
+    n = 24
+    a = np.arange(n) * (2.0 * math.pi / n)
+    r = radius / math.cos(math.pi / n)
+    pts = []
+    if capsule:  # each end sphere projects to a disc
+        for e in ends:
+            pts.append(np.column_stack([e[0] + r * np.cos(a), e[1] + r * np.sin(a)]))
+    else:  # rims of the two end faces
+        u = frame[1][:, 0]
+        v = frame[1][:, 1]
+        for e in ends:
+            rim = e + r * (np.outer(np.cos(a), u) + np.outer(np.sin(a), v))
+            pts.append(rim[:, :2])
+    return Polygon(convex_hull(np.concatenate(pts)))
+
+
+def link_frame(client: int, body: int, link: int) -> Frame:
+    """World frame of a link's centre of mass (the frame collision shapes are given in)."""
+    if link < 0:
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+    else:
+        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
+        pos, quat = state[0], state[1]
+    return frame_of(pos, quat)
+
+
+def _aabb_outline(client: int, body: int, link: int, ref: Frame, band: ZBand) -> Outline | None:
+    lo, hi = pb.getAABB(body, link, physicsClientId=client)
+    centre = (np.asarray(lo) + np.asarray(hi)) / 2.0
+    half = (np.asarray(hi) - np.asarray(lo)) / 2.0
+    return _points_outline(_box_slice(compose(ref, (centre, np.eye(3))), half, band))
+
+
+def _points_outline(points: np.ndarray | None) -> Outline | None:
+    if points is None or len(points) == 0:
+        return None
+    hull = convex_hull(points)
+    if len(hull) < 3:  # degenerate (a sliver): widen it a little so it still rasterises
+        lo = points.min(axis=0) - 1e-6
+        hi = points.max(axis=0) + 1e-6
+        hull = np.array([[lo[0], lo[1]], [hi[0], lo[1]], [hi[0], hi[1]], [lo[0], hi[1]]])
+    return Polygon(hull)
+
+
+def body_outlines(
+    client: int,
+    body: int,
+    band: ZBand,
+    reference: Frame | None = None,
+    links: list[int] | None = None,
+) -> list[Outline]:
+    """Outlines of a body's collision shapes inside the z band, in ``reference`` coordinates.
+
+    ``reference`` is the frame (position, rotation) the outlines are expressed in; the world
+    frame if ``None``. ``band`` is measured along the reference frame's z axis. ``links``
+    restricts the links looked at (all, base included, by default).
+    """
+    ref_inv = inverse(reference) if reference is not None else (np.zeros(3), np.eye(3))
+    if links is None:
+        links = list(range(-1, pb.getNumJoints(body, physicsClientId=client)))
+    out: list[Outline] = []
+    for link in links:
+        shapes = pb.getCollisionShapeData(body, link, physicsClientId=client)
+        if not shapes:
+            continue
+        com = compose(ref_inv, link_frame(client, body, link))
+        for index, shape in enumerate(shapes):
+            geom, dims = shape[2], shape[3]
+            local = frame_of(shape[5], shape[6])
+            frame = compose(com, local)
+            outline: Outline | None
+            if geom == pb.GEOM_BOX:
+                outline = _points_outline(_box_slice(frame, np.asarray(dims) / 2.0, band))
+            elif geom == pb.GEOM_SPHERE:
+                outline = _sphere_slice(frame[0], float(dims[0]), band)
+            elif geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
+                outline = _round_solid(
+                    frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE, band
+                )
+            elif geom == pb.GEOM_PLANE:
+                continue
+            elif geom == pb.GEOM_MESH:
+                outline = _mesh_outline(client, body, link, index, com, band)
+                if outline is None and not _has_mesh_vertices(client, body, link, index):
+                    outline = _aabb_outline(client, body, link, ref_inv, band)
+            else:
+                outline = _aabb_outline(client, body, link, ref_inv, band)
+            if outline is not None:
+                out.append(outline)
+    return out
+
+
+def _mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
+    try:
+        n, verts = pb.getMeshData(body, link, collisionShapeIndex=index, physicsClientId=client)
+    except pb.error:
+        return np.zeros((0, 3))
+    return np.asarray(verts, dtype=float).reshape(-1, 3) if n else np.zeros((0, 3))
+
+
+def _has_mesh_vertices(client: int, body: int, link: int, index: int) -> bool:
+    return len(_mesh_vertices(client, body, link, index)) > 0
+
+
+def _mesh_outline(
+    client: int, body: int, link: int, index: int, com: Frame, band: ZBand
+) -> Outline | None:
+    """Mesh vertices come in the link's centre-of-mass frame, the shape's offset applied."""
+    verts = _mesh_vertices(client, body, link, index)
+    if len(verts) == 0:
+        return None
+    pts = com[0] + verts @ com[1].T
+    z = pts[:, 2]
+    if z.max() < band[0] or z.min() > band[1]:
+        return None
+    return _points_outline(pts[:, :2])

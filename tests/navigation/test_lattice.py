@@ -1,0 +1,65 @@
+"""Pose planning for a long footprint: it must back away from a wall before it can turn."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from bt_manip.navigation.costmap import clearance
+from bt_manip.navigation.footprint import PlanarFootprint
+from bt_manip.navigation.grid import OccupancyGrid
+from bt_manip.navigation.lattice import BACKWARD, TURN, outline_samples, plan_poses
+
+
+def room(corridor: bool = False) -> OccupancyGrid:
+    """8 m x 4 m with 10 cm walls; with ``corridor`` the east half is a 1.2 m wide corridor."""
+    grid = OccupancyGrid.empty((0.0, 0.0, 8.0, 4.0), 0.05)
+    occ = grid.occupied
+    occ[:, :2] = occ[:, -2:] = occ[:2, :] = occ[-2:, :] = True
+    if corridor:
+        occ[:28, 80:] = occ[52:, 80:] = True  # y < 1.4 and y > 2.6 for x > 4
+    return grid
+
+
+def test_long_footprint_backs_up_before_turning() -> None:
+    grid = room(corridor=True)
+    clear = clearance(grid)
+    # a base carrying a load ahead of it: 2 m long, 0.5 m wide; it cannot turn in the corridor
+    fp = PlanarFootprint.rectangle(2.0, 0.5, x_offset=0.7, label="base + load")
+    start = (6.0, 2.0, 0.0)  # in the corridor, the load's front 0.2 m from the east wall
+    goal = (2.2, 2.0, math.pi)
+    plan = plan_poses(grid, clear, fp, start, goal)
+    assert plan.ok, plan.reason
+    assert plan.poses is not None and plan.moves is not None
+    assert BACKWARD in plan.moves.tolist()
+    first_turn = plan.moves.tolist().index(TURN) if TURN in plan.moves else len(plan.moves)
+    assert BACKWARD in plan.moves[:first_turn].tolist()  # it backs up before turning on the spot
+    end = plan.poses[-1]
+    assert math.hypot(end[0] - goal[0], end[1] - goal[1]) <= 0.15
+    assert abs((end[2] - goal[2] + math.pi) % (2 * math.pi) - math.pi) <= 0.2
+    # every pose keeps the whole outline off the walls
+    pts = outline_samples(fp)
+    for x, y, th in plan.poses:
+        c, s = math.cos(th), math.sin(th)
+        wx = x + c * pts[:, 0] - s * pts[:, 1]
+        wy = y + s * pts[:, 0] + c * pts[:, 1]
+        cells = np.floor(np.column_stack([wy, wx]) / 0.05).astype(int)
+        assert not grid.occupied[cells[:, 0], cells[:, 1]].any()
+
+
+def test_no_room_is_reported() -> None:
+    grid = room()
+    fp = PlanarFootprint.rectangle(4.5, 0.5, x_offset=1.5, label="base + beam")
+    plan = plan_poses(grid, clearance(grid), fp, (1.0, 2.0, 0.0), (1.0, 2.0, math.pi / 2))
+    assert not plan.ok
+    assert "base + beam" in plan.reason and "goal" in plan.reason
+
+
+def test_outline_samples_cover_the_boundary() -> None:
+    fp = PlanarFootprint.rectangle(1.0, 0.5)
+    pts = outline_samples(fp, 0.05)
+    assert np.isclose(np.abs(pts[:, 0]).max(), 0.5) and np.isclose(np.abs(pts[:, 1]).max(), 0.25)
+    # consecutive samples at most 5 cm apart around the outline
+    ring = np.vstack([pts, pts[:1]])
+    assert np.hypot(*np.diff(ring, axis=0).T).max() <= 0.05 + 1e-9
