@@ -1,10 +1,12 @@
 """Robot behaviours for trees: importing this package registers them with the node registry.
 
-Arm: MoveJointsSequentially, MoveJoints, Lift. Gripper: OpenGripper, CloseGripper.
-Attach joints: Attach, Detach. Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove,
-CarriedClear. World: SpawnModel, DeleteModel.
+- Base: Navigate.
+- Arm: MoveJointsSequentially, MoveJoints, MoveToPose, Lift.
+- Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.
+- Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear.
+- World: SpawnModel, DeleteModel.
 """
 
-from bt_manip.behaviours import arm, attach, conditions, gripper, world_ops
+from bt_manip.behaviours import arm, attach, conditions, gripper, navigate, world_ops
 
-__all__ = ["arm", "attach", "conditions", "gripper", "world_ops"]
+__all__ = ["arm", "attach", "conditions", "gripper", "navigate", "world_ops"]

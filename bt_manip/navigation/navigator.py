@@ -70,6 +70,22 @@ class NavigatorOptions:
     descriptor's ``base.pivot_offset`` if it has one, else 0."""
 
 
+def split_links(robot: Any) -> tuple[list[int], list[int]]:
+    """The robot's links the arm does not move (root included) and those it moves."""
+    c = robot.client
+    n = pb.getNumJoints(robot.body, physicsClientId=c)
+    parents = {j: pb.getJointInfo(robot.body, j, physicsClientId=c)[16] for j in range(n)}
+    arm = {robot.joint_index(robot.description.arm.joints[0])}
+    grew = True
+    while grew:
+        grew = False
+        for child, parent in parents.items():
+            if parent in arm and child not in arm:
+                arm.add(child)
+                grew = True
+    return [-1, *(j for j in range(n) if j not in arm)], sorted(arm)
+
+
 def robot_top(robot: Any) -> float:
     """Highest point (m) of the robot's collision geometry now."""
     top = 0.0
@@ -174,25 +190,40 @@ class Navigator:
         return fp
 
     def _build_carry_layers(self) -> None:
+        """The two layers a carrying robot is planned in: its chassis (wheels and body) against
+        every obstacle up to the chassis top, and its arm with the load against the obstacles
+        that reach above the lowest point of the arm or load (an arm held over a low obstacle
+        does not collide with it)."""
         self._carry = None
         if not self.attached:
             return
         c = self.client
-        split = min(pb.getAABB(b, physicsClientId=c)[0][2] for b in self.attached) - 0.03
+        robot = self.robot
+        chassis, arm = split_links(robot)
         top = max(self.band[1], *(pb.getAABB(b, physicsClientId=c)[1][2] for b in self.attached))
-        frame = planar_frame(*self.robot.base_pose2d())
-        low_fp = PlanarFootprint.of_robot(self.robot, band=(self.band[0], split))
-        high_parts = body_outlines(c, self.robot.body, (split, top + 0.05), reference=frame)
+        low_top = max(pb.getAABB(robot.body, link, physicsClientId=c)[1][2] for link in chassis)
+        low_top += 0.02
+        arm_bottom = min(
+            [pb.getAABB(robot.body, link, physicsClientId=c)[0][2] for link in arm]
+            + [pb.getAABB(b, physicsClientId=c)[0][2] for b in self.attached]
+        )
+        high_band = (max(self.band[0], arm_bottom - 0.03), top + 0.05)
+        frame = planar_frame(*robot.base_pose2d())
+        described = PlanarFootprint.from_description(robot.description.footprint, "")
+        low_parts = body_outlines(
+            c, robot.body, (self.band[0], low_top), reference=frame, links=chassis
+        )
+        low_fp = PlanarFootprint(described.outlines + tuple(low_parts), self.base_footprint.label)
+        high_parts = body_outlines(c, robot.body, high_band, reference=frame, links=arm)
         for b in self.attached:
-            high_parts += body_outlines(c, b, (split, top + 0.05), reference=frame)
-        labels = " + ".join([self.base_footprint.label, *self.attached.values()])
-        high_fp = PlanarFootprint(tuple(high_parts), labels)
+            high_parts += body_outlines(c, b, high_band, reference=frame)
+        high_fp = PlanarFootprint(tuple(high_parts), " + ".join(self.attached.values()))
         movers = [b for b in self.movable if b not in self.attached]
         bodies = list(self._obstacles) + movers
         ext = self.static.extent
         res = self.options.resolution
-        low = rasterise(c, bodies, resolution=res, band=(self.band[0], split), extent=ext)
-        high = rasterise(c, bodies, resolution=res, band=(split, top + 0.05), extent=ext)
+        low = rasterise(c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext)
+        high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext)
         self._carry = (low_fp, high_fp, low, clearance(low), clearance(high))
 
     # -- planning and following ---------------------------------------------------------------

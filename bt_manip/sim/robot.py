@@ -47,7 +47,7 @@ TOP_KEYS = {"name", "urdf", "spawn_height", "base", "arm", "end_effector", "gras
             "gripper", "states", "footprint"}
 BASE_KEYS = {"type", "left_wheels", "right_wheels", "wheel_radius", "track_width",
              "max_wheel_speed", "wheel_max_torque", "wheel_friction", "wheel_spinning_friction",
-             "wheel_rolling_friction", "wheel_axle_friction_scale"}
+             "wheel_rolling_friction", "wheel_axle_friction_scale", "pivot_offset"}
 ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
 GRIPPER_KEYS = {"joints", "finger_links", "open", "closed", "max_force", "max_speed",
                 "pad_friction"}
@@ -71,6 +71,8 @@ class BaseSpec:
     wheel_rolling_friction: float = 0.0
     wheel_axle_friction_scale: float = 1.0
     """Friction along the wheel axle relative to ``wheel_friction`` (< 1 lets a skid-steer turn)."""
+    pivot_offset: float = 0.0
+    """Where the base turns about when it turns on the spot (m ahead of its frame, measured)."""
 
 
 @dataclass(frozen=True)
@@ -291,7 +293,8 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             f.number(b, "wheel_friction", "base", 1.0, minimum=0.0),
             f.number(b, "wheel_spinning_friction", "base", 0.0, minimum=0.0),
             f.number(b, "wheel_rolling_friction", "base", 0.0, minimum=0.0),
-            f.number(b, "wheel_axle_friction_scale", "base", 1.0, positive=True))
+            f.number(b, "wheel_axle_friction_scale", "base", 1.0, positive=True),
+            f.number(b, "pivot_offset", "base", 0.0))
     else:
         base = BaseSpec("fixed")
 
