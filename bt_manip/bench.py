@@ -42,6 +42,8 @@ class EpisodeResult:
     ticks: int
     failed_node: str = ""
     injected: list[dict[str, Any]] = field(default_factory=list)
+    metrics: dict[str, float] = field(default_factory=dict)
+    """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
 
     @property
     def success(self) -> bool:
@@ -63,6 +65,11 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
     """Run one episode (in a worker process) and condense its report."""
     with Episode(spec) as episode:
         report = episode.run()
+        metrics = {
+            k: float(v)
+            for k, v in episode.tree.blackboard.as_dict().items()
+            if isinstance(v, int | float) and not isinstance(v, bool)
+        }
     failed = [n for n in report.nodes if n.status == "FAILURE"]
     deepest = max(failed, key=lambda n: n.path.count("/")) if failed else None
     return EpisodeResult(
@@ -74,6 +81,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         ticks=report.ticks,
         failed_node=deepest.node if deepest is not None and report.status != "SUCCESS" else "",
         injected=list(report.extra.get("injected", [])),
+        metrics=metrics,
     )
 
 
@@ -90,6 +98,7 @@ class BenchSummary:
     real_time_factor: dict[str, float]
     failures: list[dict[str, Any]]
     injected: dict[str, int]
+    metrics: dict[str, dict[str, float]] = field(default_factory=dict)
     tree: str = ""
     world: str = ""
     first_seed: int = 0
@@ -106,6 +115,10 @@ class BenchSummary:
             f"{self.wall_time['median']:.2f} s; real-time factor median "
             f"{self.real_time_factor['median']:.1f}x",
         ]
+        for name, st in sorted(self.metrics.items()):
+            lines.append(
+                f"blackboard {name}: mean {st['mean']:g}, min {st['min']:g}, max {st['max']:g}"
+            )
         if self.injected:
             lines.append(
                 "faults injected: "
@@ -135,6 +148,8 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
     failures = Counter((r.failed_node, r.reason) for r in results if not r.success)
     injected = Counter(e["kind"] for r in results for e in r.injected)
     rtf = [r.sim_time / r.wall_time for r in results if r.wall_time > 0]
+    names = sorted({k for r in results for k in r.metrics})
+    metrics = {k: _stats([r.metrics[k] for r in results if k in r.metrics]) for k in names}
     return BenchSummary(
         runs=n,
         successes=wins,
@@ -145,6 +160,7 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
         real_time_factor=_stats(rtf),
         failures=[{"node": k[0], "reason": k[1], "count": c} for k, c in failures.most_common()],
         injected=dict(injected),
+        metrics=metrics,
         tree=base.tree,
         world=base.world or "",
         first_seed=base.seed,
@@ -203,33 +219,15 @@ def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
     out.mkdir(parents=True, exist_ok=True)
     (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
+    names = sorted({k for r in results for k in r.metrics})
     with open(out / "episodes.csv", "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(
-            [
-                "seed",
-                "status",
-                "sim_time",
-                "wall_time",
-                "ticks",
-                "failed_node",
-                "reason",
-                "injected",
-            ]
-        )
+        head = ["seed", "status", "sim_time", "wall_time", "ticks", "failed_node", "reason"]
+        w.writerow([*head, "injected", *names])
         for r in results:
-            w.writerow(
-                [
-                    r.seed,
-                    r.status,
-                    f"{r.sim_time:.3f}",
-                    f"{r.wall_time:.3f}",
-                    r.ticks,
-                    r.failed_node,
-                    r.reason,
-                    len(r.injected),
-                ]
-            )
+            row = [r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}", r.ticks]
+            row += [r.failed_node, r.reason, len(r.injected)]
+            w.writerow(row + [r.metrics.get(k, "") for k in names])
     (out / "summary.json").write_text(json.dumps(asdict(summary), indent=2) + "\n")
     _plot(results, summary, out / "outcomes.png")
 

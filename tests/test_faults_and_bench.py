@@ -94,15 +94,64 @@ def _retry_tree(tmp_path: Path) -> Path:
 def test_injected_failures_reach_the_tree_and_the_report(tmp_path: Path) -> None:
     tree = _retry_tree(tmp_path)
     report = tmp_path / "r.json"
-    assert main(["run", str(tree), "--quiet", "--inject", "step:failure:1", "--report",
-                 str(report)]) == 1
+    assert (
+        main(["run", str(tree), "--quiet", "--inject", "step:failure:1", "--report", str(report)])
+        == 1
+    )
     data = json.loads(report.read_text())
     assert data["extra"]["inject"] == ["step:failure:1"]
     assert [e["target"] for e in data["extra"]["injected"]] == ["step"] * 4
     steps = [n for n in data["nodes"] if n["path"].endswith("/step")]
     assert steps[0]["reason"] == "injected failure (--inject)"
     # by node ID too, and retries recover from occasional failures the same way every time
-    codes = [main(["run", str(tree), "--quiet", "--seed", "3", "--inject",
-                   "AlwaysSuccess:failure:0.5"]) for _ in range(2)]
+    codes = [
+        main(["run", str(tree), "--quiet", "--seed", "3", "--inject", "AlwaysSuccess:failure:0.5"])
+        for _ in range(2)
+    ]
     assert codes[0] == codes[1]
     assert main(["run", str(tree), "--quiet", "--inject", "step:failure:0"]) == 0
+
+
+def test_bench_runs_episodes_in_processes_and_writes_outputs(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    root = Path(__file__).resolve().parents[1]
+    tree = tmp_path / "t.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
+        '<Script code="blocks := 3"/><Sleep msec="500"/>'
+        '<AlwaysSuccess name="maybe" />'
+        "</Sequence></BehaviorTree></root>"
+    )
+    out = tmp_path / "bench"
+    code = main(
+        [
+            "bench",
+            str(tree),
+            "--world",
+            str(root / "worlds" / "sawyer_table.yaml"),
+            "--runs",
+            "4",
+            "--jobs",
+            "2",
+            "--out",
+            str(out),
+            "--inject",
+            "maybe:failure:0.5",
+            "--seed",
+            "1",
+        ]
+    )
+    text = capsys.readouterr().out
+    summary = json.loads((out / "summary.json").read_text())
+    episodes = json.loads((out / "episodes.json").read_text())
+    assert [e["seed"] for e in episodes] == [1, 2, 3, 4]
+    assert summary["runs"] == 4
+    assert summary["successes"] == sum(e["status"] == "SUCCESS" for e in episodes)
+    assert code == (0 if summary["successes"] == 4 else 1)
+    assert all(e["sim_time"] == pytest.approx(0.5, abs=0.06) for e in episodes)
+    assert summary["metrics"]["blocks"]["mean"] == 3.0
+    assert summary["injected"].get("failure", 0) == 4 - summary["successes"]
+    assert (out / "episodes.csv").read_text().splitlines()[0].endswith("injected,blocks")
+    assert (out / "outcomes.png").stat().st_size > 1000
+    assert f"success: {summary['successes']}/4" in text
