@@ -12,10 +12,12 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev,bench]'
 	@touch $(STAMP)
 
-## demo: set up and run the main job (Husky scenario, headless)
+## demo: set up and run the main job (Scenario A, headless): summary, report, replay page
 demo: $(STAMP)
 	@mkdir -p out
-	$(BIN)/bt-manip world worlds/tb3_house.yaml --seed 0 --settle 5
+	$(BIN)/bt-manip run trees/husky_carry_wall.xml --world worlds/tb3_house.yaml --seed 0 \
+		--report out/husky_report.json --record out/husky_replay.html
+	@echo "run report: out/husky_report.json; replay page (open in a browser): out/husky_replay.html"
 
 ## test: run the whole test suite on two processes
 test: $(STAMP)

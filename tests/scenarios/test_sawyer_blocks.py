@@ -14,14 +14,19 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_all_blocks_end_in_the_bin_moved_only_by_the_gripper() -> None:
-    spec = EpisodeSpec(tree=str(ROOT / "trees" / "sawyer_blocks_to_bin.xml"),
-                       world=str(ROOT / "worlds" / "sawyer_table.yaml"), seed=11)
+    spec = EpisodeSpec(
+        tree=str(ROOT / "trees" / "sawyer_blocks_to_bin.xml"),
+        world=str(ROOT / "worlds" / "sawyer_table.yaml"),
+        seed=11,
+    )
     with Episode(spec) as episode:
         world = episode.world
         robot = world.robots["sawyer"]
         c = world.client
-        start = {n: np.array(pb.getBasePositionAndOrientation(b, physicsClientId=c)[0])
-                 for n, b in world.movable.items()}
+        start = {
+            n: np.array(pb.getBasePositionAndOrientation(b, physicsClientId=c)[0])
+            for n, b in world.movable.items()
+        }
         first_move: dict[str, bool] = {}
 
         def watch(_: Runner) -> None:
