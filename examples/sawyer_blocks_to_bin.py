@@ -30,7 +30,7 @@ def block_to_bin() -> Fallback:
     """One block: pick top-down, lift, carry over its spot, release, check; retried once,
     otherwise skipped (gripper opened, hand raised, counted)."""
     pick_and_place = Sequence("pick_and_place", children=[
-        OpenGripper("open"),
+        OpenGripper("open", opening=0.075),
         MoveToPose("reach_block", object="{block}", match_object_yaw=True, approach=0.12,
                    path="line"),
         CloseGripper("grasp", require_object=True),
