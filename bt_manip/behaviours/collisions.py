@@ -6,34 +6,14 @@ allowed (grasping needs contact), and so is the robot's base touching the floor 
 
 from __future__ import annotations
 
-import functools
 from typing import Any
 
 import pybullet as pb
 
 
-@functools.cache
-def _arm_links(client: int, body: int, first_arm_joint: int) -> frozenset[int]:
-    """Links moved by the arm: the first arm joint's child link and everything below it."""
-    parents = {
-        j: pb.getJointInfo(body, j, physicsClientId=client)[16]
-        for j in range(pb.getNumJoints(body, physicsClientId=client))
-    }
-    links = {first_arm_joint}
-    changed = True
-    while changed:
-        changed = False
-        for child, parent in parents.items():
-            if parent in links and child not in links:
-                links.add(child)
-                changed = True
-    return frozenset(links)
-
-
 def arm_link_ids(robot: Any) -> frozenset[int]:
     """PyBullet link indices of the arm and gripper of ``robot``."""
-    first = robot.joint_index(robot.description.arm.joints[0])
-    return _arm_links(robot.client, robot.body, first)
+    return frozenset(robot.arm_link_ids())
 
 
 def _static_ids(world: Any) -> dict[int, str]:

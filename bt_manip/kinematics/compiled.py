@@ -33,17 +33,14 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from bt_manip.cache import cache_dir as shared_cache_dir
+
 COMPILER_FLAGS = ("-O2", "-shared", "-fPIC")
 
 
 def cache_dir() -> Path:
-    """The folder that holds compiled libraries."""
-    env = os.environ.get("BT_MANIP_IK_CACHE")
-    if env:
-        return Path(env)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    base = Path(xdg) if xdg else Path.home() / ".cache"
-    return base / "bt-manip" / "ik"
+    """The folder that holds compiled libraries (``$BT_MANIP_IK_CACHE`` overrides it)."""
+    return shared_cache_dir("ik", "BT_MANIP_IK_CACHE")
 
 
 class VirtualMachineRunner:

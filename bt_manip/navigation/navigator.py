@@ -72,18 +72,9 @@ class NavigatorOptions:
 
 def split_links(robot: Any) -> tuple[list[int], list[int]]:
     """The robot's links the arm does not move (root included) and those it moves."""
-    c = robot.client
-    n = pb.getNumJoints(robot.body, physicsClientId=c)
-    parents = {j: pb.getJointInfo(robot.body, j, physicsClientId=c)[16] for j in range(n)}
-    arm = {robot.joint_index(robot.description.arm.joints[0])}
-    grew = True
-    while grew:
-        grew = False
-        for child, parent in parents.items():
-            if parent in arm and child not in arm:
-                arm.add(child)
-                grew = True
-    return [-1, *(j for j in range(n) if j not in arm)], sorted(arm)
+    arm = robot.arm_link_ids()
+    n = pb.getNumJoints(robot.body, physicsClientId=robot.client)
+    return [-1, *(j for j in range(n) if j not in arm)], arm
 
 
 def robot_top(robot: Any) -> float:

@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING
 
 import defusedxml.ElementTree as SafeET
 
+from bt_manip.cache import cache_dir as shared_cache_dir
 from bt_manip.errors import InputError, Problem
 from bt_manip.sim.assets import resolve_uri
 
@@ -86,12 +87,7 @@ class Recipe:
 
 def cache_dir() -> Path:
     """Folder for composed URDFs: ``$BT_MANIP_CACHE`` or ``$XDG_CACHE_HOME/bt-manip/urdf``."""
-    env = os.environ.get("BT_MANIP_CACHE")
-    if env:
-        return Path(env)
-    xdg = os.environ.get("XDG_CACHE_HOME")
-    root = Path(xdg) if xdg else Path.home() / ".cache"
-    return root / "bt-manip" / "urdf"
+    return shared_cache_dir("urdf", "BT_MANIP_CACHE")
 
 
 def composed_urdf(description: RobotDescription | Recipe | Path | str) -> Path:

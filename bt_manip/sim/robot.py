@@ -445,6 +445,7 @@ class Robot:
         self.arm_joint_ids = [self.joint_index(n) for n in description.arm.joints]
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
+        self._arm_links: list[int] | None = None
         self.wheel_ids_left = [self.joint_index(n) for n in description.base.left_wheels]
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
         arm = description.arm
@@ -535,6 +536,25 @@ class Robot:
         except KeyError:
             raise KeyError(f"{self.name} has no joint '{name}'; joints: "
                            f"{', '.join(self._joints)}") from None
+
+    def arm_link_ids(self) -> list[int]:
+        """PyBullet indices of the links the arm moves: the first arm joint's child link and
+        everything below it (gripper included)."""
+        if self._arm_links is None:
+            n = pb.getNumJoints(self.body, physicsClientId=self.client)
+            parents = {
+                j: pb.getJointInfo(self.body, j, physicsClientId=self.client)[16] for j in range(n)
+            }
+            links = {self.joint_index(self.description.arm.joints[0])}
+            grew = True
+            while grew:
+                grew = False
+                for child, parent in parents.items():
+                    if parent in links and child not in links:
+                        links.add(child)
+                        grew = True
+            self._arm_links = sorted(links)
+        return list(self._arm_links)
 
     def link_index(self, name: str) -> int:
         """PyBullet link index of the URDF link ``name`` (-1 for the root link)."""

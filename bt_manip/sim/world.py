@@ -258,23 +258,17 @@ class World:
             lengths = [p.size[2] for p in parts]
             frames = [list(np.subtract(p.xyz, com)) for p in parts]
             orns = [list(pb.getQuaternionFromEuler(p.rpy)) for p in parts]
+            shapes = {
+                "radii": radii,
+                "halfExtents": halves,
+                "lengths": lengths,
+                "physicsClientId": c,
+            }
             col = pb.createCollisionShapeArray(
-                types,
-                radii=radii,
-                halfExtents=halves,
-                lengths=lengths,
-                collisionFramePositions=frames,
-                collisionFrameOrientations=orns,
-                physicsClientId=c,
+                types, collisionFramePositions=frames, collisionFrameOrientations=orns, **shapes
             )
             vis = pb.createVisualShapeArray(
-                types,
-                radii=radii,
-                halfExtents=halves,
-                lengths=lengths,
-                visualFramePositions=frames,
-                visualFrameOrientations=orns,
-                physicsClientId=c,
+                types, visualFramePositions=frames, visualFrameOrientations=orns, **shapes
             )
         # the body frame sits at the centre of mass; shift the spawn point to match
         rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
@@ -301,10 +295,14 @@ class World:
             robot.reset_arm(states[rspec.arm_state])
         return robot
 
+    def _penetration(self, a: int, b: int) -> float:
+        """Signed distance (m) between two bodies where they touch; negative when overlapping."""
+        pts = pb.getClosestPoints(a, b, 0.0, physicsClientId=self.client)
+        return min((p[8] for p in pts), default=0.0)
+
     def _overlaps(self) -> list[Problem]:
         """Movable objects and robots must not start inside anything else."""
         problems = []
-        c = self.client
         movers = [i for i in self.infos.values() if i.kind in ("object", "robot")]
         others = [i for i in self.infos.values() if i.kind != "ground"]
         reported: set[frozenset[str]] = set()
@@ -313,8 +311,7 @@ class World:
                 pair = frozenset((a.name, b.name))
                 if a.name == b.name or pair in reported:
                     continue
-                pts = pb.getClosestPoints(a.body_id, b.body_id, 0.0, physicsClientId=c)
-                depth = min((p[8] for p in pts), default=0.0)
+                depth = self._penetration(a.body_id, b.body_id)
                 if depth < -OVERLAP_TOLERANCE:
                     reported.add(pair)
                     line = max(a.line, b.line)
@@ -362,8 +359,7 @@ class World:
         for info in list(self.infos.values()):
             if info.kind == "ground" or info.name == spec.name:
                 continue
-            pts = pb.getClosestPoints(body, info.body_id, 0.0, physicsClientId=self.client)
-            depth = min((p[8] for p in pts), default=0.0)
+            depth = self._penetration(body, info.body_id)
             if depth < -OVERLAP_TOLERANCE:
                 self.remove(spec.name)
                 raise ValueError(
