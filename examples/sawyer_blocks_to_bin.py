@@ -14,6 +14,7 @@ from pathlib import Path
 from bt_manip.behaviours.arm import Lift, MoveJoints, MoveToPose
 from bt_manip.behaviours.conditions import IsHolding, ObjectInRegion
 from bt_manip.behaviours.gripper import CloseGripper, OpenGripper
+from bt_manip.behaviours.world_ops import DeleteModel, SpawnModel
 from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
@@ -53,19 +54,36 @@ def block_to_bin() -> Fallback:
     ])
 
 
+def count_if_in_bin() -> ForceSuccess:
+    """At the end: one more in ``resting_in_bin`` if the block rests in the bin."""
+    return ForceSuccess(child=Sequence(children=[
+        ObjectInRegion(object="{block}", inside="bin"),
+        Script(code="resting_in_bin += 1"),
+    ]))
+
+
 def build(context: TreeContext | None = None) -> Tree:
-    """The whole task: start at home, each of the ten blocks, back home, check."""
+    """The whole task: spawn the blocks, start at home, each of the ten blocks, back home,
+    count the blocks resting in the bin, delete the blocks, check."""
+    names = [f"block_{i}" for i in range(len(BIN_GRID))]
     blocks = [
         SubTree("BlockToBin", child=block_to_bin(), block=f"block_{i}",
                 drop=f"{x:g};{y:g};{DROP_HEIGHT:g}", in_bin="{in_bin}", skipped="{skipped}")
         for i, (x, y) in enumerate(BIN_GRID)
     ]
     root = Sequence("blocks_to_bin", children=[
-        Script("init", code="in_bin := 0; skipped := 0"),
+        Script("init", code="in_bin := 0; skipped := 0; resting_in_bin := 0"),
+        Sequence("spawn_blocks", children=[SpawnModel(model=n) for n in names]),
         MoveJoints("start_at_home", state="home"),
         *blocks,
         MoveJoints("back_home", state="home"),
-        ScriptCondition("at_least_one_in_bin", code="in_bin >= 1"),
+        Sequence("count_resting_in_bin", children=[
+            SubTree("CountIfInBin", child=count_if_in_bin(), block=n,
+                    resting_in_bin="{resting_in_bin}")
+            for n in names
+        ]),
+        Sequence("delete_blocks", children=[DeleteModel(model=n) for n in names]),
+        ScriptCondition("at_least_one_in_bin", code="resting_in_bin >= 1"),
     ])
     return Tree(root, context=context or TreeContext(), tree_id="BlocksToBin")
 
@@ -85,7 +103,7 @@ def main() -> int:
         tree = build(TreeContext(clock=world.clock, world=world))
         report = Runner(tree, world).run()
         print(report.summary())
-        print("blocks in the bin:", tree.blackboard.as_dict()["in_bin"])
+        print("blocks resting in the bin:", tree.blackboard.as_dict()["resting_in_bin"])
         return report.exit_code
 
 

@@ -15,29 +15,38 @@ from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
 @registry.register
 class SpawnModel(RobotAction):
-    """Adds a primitive model to the world.
+    """Adds a model to the world: one declared in the world file's ``models`` (at its pose,
+    moved by the seeded ``randomize`` offset), or else a primitive given by the ports.
 
-    ``pose`` is ``x;y;z;yaw`` (z of the centre); ``size`` the box extents ``x;y;z``, or
-    ``radius;height`` for a cylinder, ``radius`` for a sphere. ``mass`` 0 makes it static.
+    For a primitive, ``pose`` is ``x;y;z;yaw`` (z of the centre); ``size`` the box extents
+    ``x;y;z``, or ``radius;height`` for a cylinder, ``radius`` for a sphere; ``mass`` 0 makes
+    it static.
 
     - SUCCESS when the model is in the world;
-    - FAILURE when the name is taken, the shape is unknown, or it would start inside another
-      body.
+    - FAILURE when the name is taken, the shape is unknown or incomplete, or it would start
+      inside another body.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "model": PortInformation(str, True, "name of the new model"),
+        "model": PortInformation(str, True, "a model of the world file, or a new name"),
         "shape": PortInformation(str, False, "box, cylinder or sphere", "box"),
         "size": PortInformation(
-            list[float], True, "box x;y;z, cylinder radius;height, sphere radius"
+            list[float], False, "box x;y;z, cylinder radius;height, sphere radius", []
         ),
-        "pose": PortInformation(list[float], True, "x;y;z;yaw of its centre"),
+        "pose": PortInformation(list[float], False, "x;y;z;yaw of its centre", []),
         "mass": PortInformation(float, False, "kg; 0 for a static model", 0.1),
         "colour": PortInformation(str, False, "colour name", "orange"),
         "friction": PortInformation(float, False, "lateral friction", 0.8),
     }
 
     def step(self) -> Status:
+        name = self.get_input("model")
+        if name in self.world.models:
+            try:
+                self.world.spawn_model(name)
+            except ValueError as exc:
+                raise ActionFailed(str(exc)) from None
+            return Status.SUCCESS
         shape = self.get_input("shape")
         size = list(self.get_input("size"))
         need = {"box": 3, "cylinder": 2, "sphere": 1}

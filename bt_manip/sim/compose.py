@@ -50,11 +50,18 @@ FILLER_INERTIA = 1e-7
 DROPPED_TAGS = ("gazebo", "transmission")
 OPTENV = re.compile(r"\$\(optenv\s+\S+\s*([^)]*)\)")
 LIMIT_KEYS = ("lower", "upper", "velocity", "effort")
-CONTACT_KEYS = ("lateral_friction", "rolling_friction", "spinning_friction", "stiffness",
-                "damping")
+CONTACT_KEYS = ("lateral_friction", "rolling_friction", "spinning_friction", "stiffness", "damping")
 RECIPE_KEYS = {"base", "attach", "joint_limits", "contacts"}
-ATTACH_KEYS = {"urdf", "parent", "xyz", "rpy", "joint_name", "link_prefix", "joint_prefix",
-               "drop_links"}
+ATTACH_KEYS = {
+    "urdf",
+    "parent",
+    "xyz",
+    "rpy",
+    "joint_name",
+    "link_prefix",
+    "joint_prefix",
+    "drop_links",
+}
 
 
 @dataclass(frozen=True)
@@ -192,15 +199,17 @@ def _graft(robot: ET.Element, att: Attachment, path: Path, where: str) -> None:
     if missing:
         raise InputError.single(where, None, f"drop_links: no link {sorted(missing)} in {path}")
     kept_joints = [
-        j for j in joints
+        j
+        for j in joints
         if _joint_end(j, "parent") not in dropped and _joint_end(j, "child") not in dropped
     ]
     kept_links = [name for name in links if name not in dropped]
     children = {_joint_end(j, "child") for j in kept_joints}
     roots = [name for name in kept_links if name not in children]
     if len(roots) != 1:
-        raise InputError.single(where, None, f"{path} must form one tree after drop_links; "
-                                f"found root links {roots}")
+        raise InputError.single(
+            where, None, f"{path} must form one tree after drop_links; found root links {roots}"
+        )
     existing_links = {el.get("name") for el in robot.findall("link")}
     existing_joints = {el.get("name") for el in robot.findall("joint")}
     if att.parent not in existing_links:
@@ -210,14 +219,20 @@ def _graft(robot: ET.Element, att: Attachment, path: Path, where: str) -> None:
         return att.link_prefix + name
 
     clashes = [link_name(n) for n in kept_links if link_name(n) in existing_links]
-    clashes += [att.joint_prefix + (j.get("name") or "") for j in kept_joints
-                if att.joint_prefix + (j.get("name") or "") in existing_joints]
+    clashes += [
+        att.joint_prefix + (j.get("name") or "")
+        for j in kept_joints
+        if att.joint_prefix + (j.get("name") or "") in existing_joints
+    ]
     mount_name = att.joint_name or f"{link_name(roots[0])}_mount"
     if mount_name in existing_joints:
         clashes.append(mount_name)
     if clashes:
-        raise InputError.single(where, None, f"names already used in the robot: {clashes}; "
-                                "set link_prefix / joint_prefix")
+        raise InputError.single(
+            where,
+            None,
+            f"names already used in the robot: {clashes}; set link_prefix / joint_prefix",
+        )
 
     known_materials = {m.get("name") for m in robot.findall("material")}
     for mat in part.findall("material"):
@@ -263,8 +278,7 @@ def _override_limits(robot: ET.Element, limits: dict[str, dict[str, float]], whe
         raise InputError(problems)
 
 
-def _replace_contacts(robot: ET.Element, contacts: dict[str, dict[str, float]],
-                      where: str) -> None:
+def _replace_contacts(robot: ET.Element, contacts: dict[str, dict[str, float]], where: str) -> None:
     links = {el.get("name"): el for el in robot.findall("link")}
     unknown = sorted(set(contacts) - links.keys())
     if unknown:
@@ -328,8 +342,11 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
 
     def vec3(d: dict, key: str, where: str) -> tuple[float, float, float]:
         value = d.get(key, [0.0, 0.0, 0.0])
-        if not (isinstance(value, list) and len(value) == 3 and all(
-                isinstance(v, int | float) and not isinstance(v, bool) for v in value)):
+        if not (
+            isinstance(value, list)
+            and len(value) == 3
+            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
+        ):
             fail(d, key, f"{where}.{key} must be a list of 3 numbers, got {value!r}")
             return (0.0, 0.0, 0.0)
         return (float(value[0]), float(value[1]), float(value[2]))
@@ -346,12 +363,18 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
                 continue
             for k, v in values.items():
                 if k not in allowed:
-                    fail(values, k, f"unknown key '{k}' in urdf.{key}.{item}; allowed: "
-                         f"{', '.join(allowed)}")
+                    fail(
+                        values,
+                        k,
+                        f"unknown key '{k}' in urdf.{key}.{item}; allowed: {', '.join(allowed)}",
+                    )
                 elif isinstance(v, bool) or not isinstance(v, int | float):
                     fail(values, k, f"urdf.{key}.{item}.{k} must be a number, got {v!r}")
-            out[str(item)] = {k: float(v) for k, v in values.items()
-                              if k in allowed and isinstance(v, int | float)}
+            out[str(item)] = {
+                k: float(v)
+                for k, v in values.items()
+                if k in allowed and isinstance(v, int | float)
+            }
         return out
 
     for key in data:
@@ -376,8 +399,11 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
             continue
         for key in item:
             if key not in ATTACH_KEYS:
-                fail(item, key, f"unknown key '{key}' in {where}; allowed: "
-                     f"{', '.join(sorted(ATTACH_KEYS))}")
+                fail(
+                    item,
+                    key,
+                    f"unknown key '{key}' in {where}; allowed: {', '.join(sorted(ATTACH_KEYS))}",
+                )
         texts = {}
         for key in ("urdf", "parent", "joint_name", "link_prefix", "joint_prefix"):
             value = item.get(key, "")
@@ -391,9 +417,18 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
         if not isinstance(drop, list) or not all(isinstance(d, str) for d in drop):
             fail(item, "drop_links", f"{where}.drop_links must be a list of link names")
             drop = []
-        attachments.append(Attachment(
-            texts["urdf"], texts["parent"], vec3(item, "xyz", where), vec3(item, "rpy", where),
-            texts["joint_name"], texts["link_prefix"], texts["joint_prefix"], tuple(drop)))
+        attachments.append(
+            Attachment(
+                texts["urdf"],
+                texts["parent"],
+                vec3(item, "xyz", where),
+                vec3(item, "rpy", where),
+                texts["joint_name"],
+                texts["link_prefix"],
+                texts["joint_prefix"],
+                tuple(drop),
+            )
+        )
     limits = table(data, "joint_limits", LIMIT_KEYS)
     contacts = table(data, "contacts", CONTACT_KEYS)
     if problems:

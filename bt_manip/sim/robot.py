@@ -43,14 +43,42 @@ __all__ = [
 # -- descriptors --------------------------------------------------------------------------------
 ROBOTS_DIR = REPO_ROOT / "robots"
 BASE_TYPES = ("skid_steer", "fixed")
-TOP_KEYS = {"name", "urdf", "spawn_height", "base", "arm", "end_effector", "grasp_frame",
-            "gripper", "states", "footprint"}
-BASE_KEYS = {"type", "left_wheels", "right_wheels", "wheel_radius", "track_width",
-             "max_wheel_speed", "wheel_max_torque", "wheel_friction", "wheel_spinning_friction",
-             "wheel_rolling_friction", "wheel_axle_friction_scale", "pivot_offset"}
+TOP_KEYS = {
+    "name",
+    "urdf",
+    "spawn_height",
+    "base",
+    "arm",
+    "end_effector",
+    "grasp_frame",
+    "gripper",
+    "states",
+    "footprint",
+}
+BASE_KEYS = {
+    "type",
+    "left_wheels",
+    "right_wheels",
+    "wheel_radius",
+    "track_width",
+    "max_wheel_speed",
+    "wheel_max_torque",
+    "wheel_friction",
+    "wheel_spinning_friction",
+    "wheel_rolling_friction",
+    "wheel_axle_friction_scale",
+    "pivot_offset",
+}
 ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
-GRIPPER_KEYS = {"joints", "finger_links", "open", "closed", "max_force", "max_speed",
-                "pad_friction"}
+GRIPPER_KEYS = {
+    "joints",
+    "finger_links",
+    "open",
+    "closed",
+    "max_force",
+    "max_speed",
+    "pad_friction",
+}
 FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
 
 
@@ -165,8 +193,9 @@ class RobotDescription:
         try:
             return self.states[name]
         except KeyError:
-            raise KeyError(f"{self.name} has no arm state '{name}'; states: "
-                           f"{', '.join(self.states)}") from None
+            raise KeyError(
+                f"{self.name} has no arm state '{name}'; states: {', '.join(self.states)}"
+            ) from None
 
     @property
     def urdf_path(self) -> Path:
@@ -210,8 +239,10 @@ class _Fields:
     def unknown(self, d: LineDict, allowed: set[str], where: str) -> None:
         for key in d:
             if key not in allowed:
-                self.fail(d.line_of(key), f"unknown key '{key}' in {where}; allowed: "
-                          f"{', '.join(sorted(allowed))}")
+                self.fail(
+                    d.line_of(key),
+                    f"unknown key '{key}' in {where}; allowed: {', '.join(sorted(allowed))}",
+                )
 
     def text(self, d: LineDict, key: str, where: str, default: str | None = None) -> str:
         value = d.get(key, default)
@@ -220,14 +251,24 @@ class _Fields:
             return ""
         return value
 
-    def number(self, d: LineDict, key: str, where: str, default: float | None = None,
-               minimum: float | None = None, positive: bool = False) -> float:
+    def number(
+        self,
+        d: LineDict,
+        key: str,
+        where: str,
+        default: float | None = None,
+        minimum: float | None = None,
+        positive: bool = False,
+    ) -> float:
         if key not in d and default is None:
             self.fail(d.line, f"{where} is missing '{key}'")
             return 0.0
         value = d.get(key, default)
-        if (isinstance(value, bool) or not isinstance(value, int | float)
-                or not math.isfinite(value)):
+        if (
+            isinstance(value, bool)
+            or not isinstance(value, int | float)
+            or not math.isfinite(value)
+        ):
             self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
             return 0.0
         if positive and value <= 0:
@@ -240,16 +281,24 @@ class _Fields:
         value = d.get(key)
         if value is None and not required:
             return ()
-        if not isinstance(value, list) or not value or not all(
-                isinstance(v, str) and v for v in value):
+        if (
+            not isinstance(value, list)
+            or not value
+            or not all(isinstance(v, str) and v for v in value)
+        ):
             self.fail(d.line_of(key), f"{where}.{key} must be a non-empty list of names")
             return ()
         return tuple(value)
 
     def numbers(self, value: object, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        ok = isinstance(value, list) and len(value) == n and all(
-            isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-            for v in value)
+        ok = (
+            isinstance(value, list)
+            and len(value) == n
+            and all(
+                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+                for v in value
+            )
+        )
         if not ok:
             self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
             return None
@@ -268,8 +317,9 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     path = find_description(name_or_path)
     if not path.is_file():
         known = ", ".join(known_robots()) or "none"
-        raise InputError.single(str(path), None,
-                                f"no robot descriptor '{name_or_path}'; known robots: {known}")
+        raise InputError.single(
+            str(path), None, f"no robot descriptor '{name_or_path}'; known robots: {known}"
+        )
     data = load_yaml(path)
     f = _Fields(path)
     if not isinstance(data, LineDict):
@@ -281,11 +331,15 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     b = f.section(data, "base", BASE_KEYS)
     base_type = b.get("type", "fixed")
     if base_type not in BASE_TYPES:
-        f.fail(b.line_of("type"), f"base.type must be one of {', '.join(BASE_TYPES)}, "
-               f"got {base_type!r}")
+        f.fail(
+            b.line_of("type"),
+            f"base.type must be one of {', '.join(BASE_TYPES)}, got {base_type!r}",
+        )
     if base_type == "skid_steer":
         base = BaseSpec(
-            "skid_steer", f.names(b, "left_wheels", "base"), f.names(b, "right_wheels", "base"),
+            "skid_steer",
+            f.names(b, "left_wheels", "base"),
+            f.names(b, "right_wheels", "base"),
             f.number(b, "wheel_radius", "base", positive=True),
             f.number(b, "track_width", "base", positive=True),
             f.number(b, "max_wheel_speed", "base", positive=True),
@@ -294,14 +348,22 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             f.number(b, "wheel_spinning_friction", "base", 0.0, minimum=0.0),
             f.number(b, "wheel_rolling_friction", "base", 0.0, minimum=0.0),
             f.number(b, "wheel_axle_friction_scale", "base", 1.0, positive=True),
-            f.number(b, "pivot_offset", "base", 0.0))
+            f.number(b, "pivot_offset", "base", 0.0),
+        )
     else:
         base = BaseSpec("fixed")
 
     a = f.section(data, "arm", ARM_KEYS)
     joints = f.names(a, "joints", "arm")
-    vel = f.numbers(a.get("velocity_limits"), len(joints), a.line_of("velocity_limits"),
-                    "arm.velocity_limits") or ()
+    vel = (
+        f.numbers(
+            a.get("velocity_limits"),
+            len(joints),
+            a.line_of("velocity_limits"),
+            "arm.velocity_limits",
+        )
+        or ()
+    )
     if any(v <= 0 for v in vel):
         f.fail(a.line_of("velocity_limits"), "arm.velocity_limits must all be > 0")
     efforts: tuple[float | None, ...] = (None,) * len(joints)
@@ -312,11 +374,14 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
 
     g = f.section(data, "gripper", GRIPPER_KEYS)
     gripper = GripperSpec(
-        f.names(g, "joints", "gripper"), f.names(g, "finger_links", "gripper"),
-        f.number(g, "open", "gripper"), f.number(g, "closed", "gripper"),
+        f.names(g, "joints", "gripper"),
+        f.names(g, "finger_links", "gripper"),
+        f.number(g, "open", "gripper"),
+        f.number(g, "closed", "gripper"),
         f.number(g, "max_force", "gripper", positive=True),
         f.number(g, "max_speed", "gripper", 0.1, positive=True),
-        f.number(g, "pad_friction", "gripper", 1.5, minimum=0.0))
+        f.number(g, "pad_friction", "gripper", 1.5, minimum=0.0),
+    )
 
     raw_states = data.get("states")
     s = f.section(data, "states", set(raw_states) if isinstance(raw_states, dict) else set())
@@ -333,18 +398,30 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     if "radius" in fp:
         footprint = Footprint(radius=f.number(fp, "radius", "footprint", positive=True))
     else:
-        footprint = Footprint(f.number(fp, "length", "footprint", positive=True),
-                              f.number(fp, "width", "footprint", positive=True),
-                              f.number(fp, "x_offset", "footprint", 0.0))
+        footprint = Footprint(
+            f.number(fp, "length", "footprint", positive=True),
+            f.number(fp, "width", "footprint", positive=True),
+            f.number(fp, "x_offset", "footprint", 0.0),
+        )
     end_effector = f.text(data, "end_effector", "descriptor")
     grasp_frame = f.text(data, "grasp_frame", "descriptor")
     spawn_height = f.number(data, "spawn_height", "descriptor", 0.0)
     if f.problems:
         raise InputError(f.problems)
 
-    desc = RobotDescription(name, path, urdf, base, ArmSpec(arm_base, joints, vel, efforts,
-                            position_gain=gain), gripper, end_effector, grasp_frame, states,
-                            footprint, spawn_height)
+    desc = RobotDescription(
+        name,
+        path,
+        urdf,
+        base,
+        ArmSpec(arm_base, joints, vel, efforts, position_gain=gain),
+        gripper,
+        end_effector,
+        grasp_frame,
+        states,
+        footprint,
+        spawn_height,
+    )
     return _check_against_urdf(desc, data, f)
 
 
@@ -377,8 +454,9 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
         for n in names:
             if n not in kind:
                 what = "joint" if kind is joints else "link"
-                f.fail(line, f"{section + '.' if section else ''}{key}: no {what} '{n}' in the "
-                       f"URDF")
+                f.fail(
+                    line, f"{section + '.' if section else ''}{key}: no {what} '{n}' in the URDF"
+                )
 
     need(desc.base.left_wheels + desc.base.right_wheels, joints, "base", "left_wheels")
     need(desc.arm.joints, joints, "arm", "joints")
@@ -405,7 +483,6 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
         raise InputError(f.problems)
     arm = dataclasses.replace(desc.arm, lower=tuple(lower), upper=tuple(upper))
     return dataclasses.replace(desc, arm=arm)
-
 
 
 @dataclass(frozen=True)
@@ -461,8 +538,15 @@ class Robot:
 
     # -- construction -------------------------------------------------------------------------
     @classmethod
-    def spawn(cls, client: int, description: RobotDescription | str | Path, x: float, y: float,
-              yaw: float, z: float | None = None) -> Robot:
+    def spawn(
+        cls,
+        client: int,
+        description: RobotDescription | str | Path,
+        x: float,
+        y: float,
+        yaw: float,
+        z: float | None = None,
+    ) -> Robot:
         """Load the robot as one multibody at (x, y, yaw) and hold it still.
 
         ``z`` defaults to the descriptor's ``spawn_height`` (wheels touching z=0). Fixed-base
@@ -496,15 +580,25 @@ class Robot:
         for j in self.wheel_ids_left + self.wheel_ids_right:
             axle = np.abs(np.asarray(self._joint_info[j][13], dtype=float))
             anisotropic = 1.0 - (1.0 - base.wheel_axle_friction_scale) * axle
-            pb.changeDynamics(self.body, j, lateralFriction=base.wheel_friction,
-                              spinningFriction=base.wheel_spinning_friction,
-                              rollingFriction=base.wheel_rolling_friction,
-                              anisotropicFriction=anisotropic.tolist(), frictionAnchor=1,
-                              physicsClientId=self.client)
+            pb.changeDynamics(
+                self.body,
+                j,
+                lateralFriction=base.wheel_friction,
+                spinningFriction=base.wheel_spinning_friction,
+                rollingFriction=base.wheel_rolling_friction,
+                anisotropicFriction=anisotropic.tolist(),
+                frictionAnchor=1,
+                physicsClientId=self.client,
+            )
         gripper = self.description.gripper
         for link in self.finger_link_ids:
-            pb.changeDynamics(self.body, link, lateralFriction=gripper.pad_friction,
-                              frictionAnchor=1, physicsClientId=self.client)
+            pb.changeDynamics(
+                self.body,
+                link,
+                lateralFriction=gripper.pad_friction,
+                frictionAnchor=1,
+                physicsClientId=self.client,
+            )
 
     def _couple_fingers(self) -> None:
         """Make two fingers move as mirror images (a gear constraint: equal joint positions).
@@ -515,10 +609,24 @@ class Robot:
         if len(self.gripper_joint_ids) != 2:
             return
         a, b = self.gripper_joint_ids
-        gear = pb.createConstraint(self.body, a, self.body, b, pb.JOINT_GEAR, [0, 1, 0],
-                                   [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
-        pb.changeConstraint(gear, gearRatio=-1, maxForce=10 * self.description.gripper.max_force,
-                            erp=0.2, physicsClientId=self.client)
+        gear = pb.createConstraint(
+            self.body,
+            a,
+            self.body,
+            b,
+            pb.JOINT_GEAR,
+            [0, 1, 0],
+            [0, 0, 0],
+            [0, 0, 0],
+            physicsClientId=self.client,
+        )
+        pb.changeConstraint(
+            gear,
+            gearRatio=-1,
+            maxForce=10 * self.description.gripper.max_force,
+            erp=0.2,
+            physicsClientId=self.client,
+        )
 
     # -- names --------------------------------------------------------------------------------
     @property
@@ -534,8 +642,9 @@ class Robot:
         try:
             return self._joints[name]
         except KeyError:
-            raise KeyError(f"{self.name} has no joint '{name}'; joints: "
-                           f"{', '.join(self._joints)}") from None
+            raise KeyError(
+                f"{self.name} has no joint '{name}'; joints: {', '.join(self._joints)}"
+            ) from None
 
     def arm_link_ids(self) -> list[int]:
         """PyBullet indices of the links the arm moves: the first arm joint's child link and
@@ -561,8 +670,9 @@ class Robot:
         try:
             return self._links[name]
         except KeyError:
-            raise KeyError(f"{self.name} has no link '{name}'; links: "
-                           f"{', '.join(self._links)}") from None
+            raise KeyError(
+                f"{self.name} has no link '{name}'; links: {', '.join(self._links)}"
+            ) from None
 
     def link_name(self, index: int) -> str:
         """URDF name of the link with PyBullet index ``index``."""
@@ -578,8 +688,9 @@ class Robot:
         if index == -1:
             pos, quat = self._root_pose()
             return np.array(pos), np.array(quat)
-        state = pb.getLinkState(self.body, index, computeForwardKinematics=1,
-                                physicsClientId=self.client)
+        state = pb.getLinkState(
+            self.body, index, computeForwardKinematics=1, physicsClientId=self.client
+        )
         return np.array(state[4]), np.array(state[5])
 
     def link_transform(self, name: str) -> np.ndarray:
@@ -641,13 +752,21 @@ class Robot:
         if max_velocity is not None:
             limits = np.minimum(limits, np.broadcast_to(np.asarray(max_velocity, float), (n,)))
         q = np.clip(q, arm.lower, arm.upper)
-        for j, target, speed, effort in zip(self.arm_joint_ids, q, limits, self._arm_effort,
-                                            strict=True):
-            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL,
-                                     targetPosition=float(target), targetVelocity=0.0,
-                                     force=effort, maxVelocity=float(speed),
-                                     positionGain=arm.position_gain, velocityGain=1.0,
-                                     physicsClientId=self.client)
+        for j, target, speed, effort in zip(
+            self.arm_joint_ids, q, limits, self._arm_effort, strict=True
+        ):
+            pb.setJointMotorControl2(
+                self.body,
+                j,
+                pb.POSITION_CONTROL,
+                targetPosition=float(target),
+                targetVelocity=0.0,
+                force=effort,
+                maxVelocity=float(speed),
+                positionGain=arm.position_gain,
+                velocityGain=1.0,
+                physicsClientId=self.client,
+            )
 
     def hold_arm(self) -> None:
         """Hold every arm joint at its current position."""
@@ -668,13 +787,23 @@ class Robot:
     def set_gripper(self, opening: float) -> None:
         """Command the distance between the finger pads (m), clipped to the gripper's stroke."""
         g = self.description.gripper
-        finger = float(np.clip(opening / len(self.gripper_joint_ids),
-                               min(g.closed, g.open), max(g.closed, g.open)))
+        finger = float(
+            np.clip(
+                opening / len(self.gripper_joint_ids), min(g.closed, g.open), max(g.closed, g.open)
+            )
+        )
         self._gripper_target = finger * len(self.gripper_joint_ids)
         for j in self.gripper_joint_ids:
-            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL, targetPosition=finger,
-                                     targetVelocity=0.0, force=g.max_force,
-                                     maxVelocity=g.max_speed, physicsClientId=self.client)
+            pb.setJointMotorControl2(
+                self.body,
+                j,
+                pb.POSITION_CONTROL,
+                targetPosition=finger,
+                targetVelocity=0.0,
+                force=g.max_force,
+                maxVelocity=g.max_speed,
+                physicsClientId=self.client,
+            )
 
     def open_gripper(self) -> None:
         """Open the fingers fully."""
@@ -693,8 +822,9 @@ class Robot:
         """Last commanded opening (m)."""
         return self._gripper_target
 
-    def contacts(self, other_body: int | None = None,
-                 links: Sequence[int] | None = None) -> list[ContactPoint]:
+    def contacts(
+        self, other_body: int | None = None, links: Sequence[int] | None = None
+    ) -> list[ContactPoint]:
         """Contacts of this robot's links (all, or ``links``) with ``other_body`` (or any body)."""
         kwargs = {"bodyA": self.body, "physicsClientId": self.client}
         if other_body is not None:
@@ -726,8 +856,14 @@ class Robot:
         for ids, speed in ((self.wheel_ids_left, left), (self.wheel_ids_right, right)):
             speed = float(np.clip(speed, -limit, limit))
             for j in ids:
-                pb.setJointMotorControl2(self.body, j, pb.VELOCITY_CONTROL, targetVelocity=speed,
-                                         force=base.wheel_max_torque, physicsClientId=self.client)
+                pb.setJointMotorControl2(
+                    self.body,
+                    j,
+                    pb.VELOCITY_CONTROL,
+                    targetVelocity=speed,
+                    force=base.wheel_max_torque,
+                    physicsClientId=self.client,
+                )
 
     def set_base_twist(self, v: float, w: float) -> None:
         """Drive the base at forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s), skid-steer.
@@ -753,14 +889,19 @@ class Robot:
         base = self.description.base
         ids = self.wheel_ids_left + self.wheel_ids_right
         for j, angle in zip(ids, self._positions(ids), strict=True):
-            pb.setJointMotorControl2(self.body, j, pb.POSITION_CONTROL,
-                                     targetPosition=float(angle), targetVelocity=0.0,
-                                     force=base.wheel_max_torque,
-                                     positionGain=0.5, velocityGain=1.0,
-                                     physicsClientId=self.client)
+            pb.setJointMotorControl2(
+                self.body,
+                j,
+                pb.POSITION_CONTROL,
+                targetPosition=float(angle),
+                targetVelocity=0.0,
+                force=base.wheel_max_torque,
+                positionGain=0.5,
+                velocityGain=1.0,
+                physicsClientId=self.client,
+            )
 
     def halt(self) -> None:
         """Leave the robot safe: base braked, arm holding its position, gripper unchanged."""
         self.stop_base()
         self.hold_arm()
-

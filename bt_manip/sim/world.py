@@ -107,6 +107,7 @@ class World:
         self.infos: dict[str, BodyInfo] = {}
         self.robots: dict[str, Any] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
+        self.models: dict[str, BodySpec] = {m.name: m for m in self.spec.models}
         self._step_listeners: list[Callable[[World], None]] = []
         self.attachments = Attachments(self)
         try:
@@ -346,15 +347,28 @@ class World:
         return self.clock.now()
 
     # -- changing the world while it runs --------------------------------------------------
-    def spawn(self, spec: BodySpec) -> int:
-        """Add a body while the world runs (movable if ``spec.movable``); returns its id.
+    def spawn_model(self, name: str) -> int:
+        """Add the model ``name`` declared in the world file's ``models``, at its pose plus
+        the offset its ``randomize`` ranges draw for this world's seed; returns its id.
+
+        Raises KeyError for an unknown model, ValueError as :meth:`spawn` does.
+        """
+        spec = self.models.get(name)
+        if spec is None:
+            known = ", ".join(sorted(self.models)) or "none"
+            raise KeyError(f"no model named '{name}' in {self.path.name}; models: {known}")
+        return self.spawn(spec, _sample(entity_rng(self.seed, name), spec.randomize))
+
+    def spawn(self, spec: BodySpec, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> int:
+        """Add a body while the world runs (movable if ``spec.movable``), moved by ``offset``
+        (x, y, yaw); returns its id.
 
         Raises ValueError when the name is taken or the body would start inside another.
         """
         if spec.name in self.infos:
             raise ValueError(f"a body named '{spec.name}' already exists")
         kind = "object" if spec.movable else "furniture"
-        body = self._make_body(spec, (0.0, 0.0, 0.0))
+        body = self._make_body(spec, offset)
         self._add(spec.name, body, kind, spec, spec.line)
         for info in list(self.infos.values()):
             if info.kind == "ground" or info.name == spec.name:
@@ -436,7 +450,8 @@ class World:
             f"world '{self.spec.name}' ({self.path}), seed {self.seed}, "
             f"{self.rate_hz:g} Hz physics",
             f"  {kinds.get('wall', 0)} walls, {kinds.get('furniture', 0)} furniture, "
-            f"{kinds.get('object', 0)} movable objects, {len(self.robots)} robots",
+            f"{kinds.get('object', 0)} movable objects, {len(self.models)} models to spawn, "
+            f"{len(self.robots)} robots",
         ]
         for name, robot in self.robots.items():
             x, y, yaw = robot.base_pose2d()

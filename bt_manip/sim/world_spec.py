@@ -6,6 +6,8 @@ A world file describes, in metres, radians and kilograms (see ``worlds/README.md
                into them (``at`` = distance of the door centre from ``from``, ``width``);
 ``furniture``  static bodies: a primitive ``shape``, a list of ``parts``, or a ``urdf`` file;
 ``objects``    movable bodies, the same forms plus ``mass``, ``friction`` and ``randomize``;
+``models``     movable bodies declared like ``objects`` but not spawned: a tree adds them
+               (SpawnModel) and may remove them (DeleteModel);
 ``robots``     a robot ``description`` (``robots/<name>.yaml``), a start ``pose``, an
                ``arm_state`` and ``randomize``;
 ``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees.
@@ -157,12 +159,24 @@ class WorldSpec:
     walls: list[WallSpec] = field(default_factory=list)
     furniture: list[BodySpec] = field(default_factory=list)
     objects: list[BodySpec] = field(default_factory=list)
+    models: list[BodySpec] = field(default_factory=list)
+    """Movable objects declared but not spawned: trees add them with SpawnModel."""
     robots: list[RobotSpec] = field(default_factory=list)
     poses: dict[str, Pose2D] = field(default_factory=dict)
     pose_lines: dict[str, int] = field(default_factory=dict)
 
 
-TOP_KEYS = {"name", "description", "physics", "walls", "furniture", "objects", "robots", "poses"}
+TOP_KEYS = {
+    "name",
+    "description",
+    "physics",
+    "walls",
+    "furniture",
+    "objects",
+    "models",
+    "robots",
+    "poses",
+}
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
 DOOR_KEYS = {"at", "width"}
@@ -645,14 +659,15 @@ def parse_world(path: str | Path) -> WorldSpec:
     spec = WorldSpec(path=path, name=str(data.get("name", path.stem)), physics=physics)
     walls = rd.seq(data.get("walls"), data.line_of("walls"), "walls")
     spec.walls = _parse_walls(rd, walls) if walls else []
-    for key, movable in (("furniture", False), ("objects", True)):
+    lists = {"furniture": spec.furniture, "objects": spec.objects, "models": spec.models}
+    for key, target in lists.items():
         items = rd.seq(data.get(key), data.line_of(key), key)
         for i, raw in enumerate(items or []):
             d = rd.mapping(raw, items.line_of(i), f"{key}[{i}]")  # type: ignore[union-attr]
             if d is not None:
-                body = _parse_body(rd, d, f"{key}[{i}]", movable, base)
+                body = _parse_body(rd, d, f"{key}[{i}]", key != "furniture", base)
                 if body is not None:
-                    (spec.objects if movable else spec.furniture).append(body)
+                    target.append(body)
     robots = rd.seq(data.get("robots"), data.line_of("robots"), "robots")
     spec.robots = _parse_robots(rd, robots, base) if robots else []
     if "poses" in data:
@@ -671,7 +686,7 @@ def parse_world(path: str | Path) -> WorldSpec:
 def _check_unique_names(rd: _Reader, spec: WorldSpec) -> None:
     seen: dict[str, int] = {}
     entries: list[tuple[str, int]] = [(w.name, w.line) for w in spec.walls]
-    entries += [(b.name, b.line) for b in spec.furniture + spec.objects]
+    entries += [(b.name, b.line) for b in spec.furniture + spec.objects + spec.models]
     entries += [(r.name, r.line) for r in spec.robots]
     for name, line in entries:
         if name in seen:

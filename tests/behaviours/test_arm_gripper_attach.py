@@ -109,25 +109,32 @@ def test_spawn_and_delete_models(table: World) -> None:
     report, _ = run_xml(
         table,
         "<Sequence>"
+        '<SpawnModel model="block_0"/><SpawnModel model="block_1"/>'
         '<SpawnModel model="crate" size="0.1;0.1;0.1" pose="1.2;0.3;0.8;0.5"'
         ' mass="0.5" colour="blue"/>'
         '<Sleep msec="1000"/><DeleteModel model="block_0"/></Sequence>',
     )
     assert report.status == "SUCCESS", report.reason
-    assert "block_0" not in table.movable
+    assert sorted(table.movable) == ["block_1", "crate"]
     crate = table.movable["crate"]
     pos, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=table.client)
     assert pos[2] == pytest.approx(0.7475 + 0.05, abs=0.003)  # fell onto the table top
+    block = pb.getBasePositionAndOrientation(
+        table.movable["block_1"], physicsClientId=table.client
+    )[0]
+    assert block[2] == pytest.approx(0.7725, abs=0.002)  # a model of the world file, resting
     report, _ = run_xml(
         table, '<SpawnModel model="ghost" size="0.05;0.05;0.05" pose="0.7;0.1;0.7725;0"/>'
     )
-    assert (
-        "'ghost' would start" in reasons(report)["SpawnModel"]
-        and "inside 'block_1'" in reasons(report)["SpawnModel"]
-    )
+    why = reasons(report)["SpawnModel"]
+    assert "'ghost' would start" in why and "inside 'block_1'" in why
     assert "ghost" not in table.movable
+    report, _ = run_xml(table, '<SpawnModel model="block_1"/>')
+    assert "a body named 'block_1' already exists" in reasons(report)["SpawnModel"]
     report, _ = run_xml(table, '<DeleteModel model="block_0"/>')
     assert "no object or furniture named 'block_0'" in reasons(report)["DeleteModel"]
+    report, _ = run_xml(table, '<SpawnModel model="teapot"/>')
+    assert "a box needs 3 positive size values" in reasons(report)["SpawnModel"]
 
 
 def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None:
@@ -138,8 +145,9 @@ def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None
     world = house_at_pregrasp
     faults = FaultInjector([FaultSpec("slip", 1.0)], seed=0, clock=world.clock)
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{PICK}</BehaviorTree></root>'
-    tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world,
-                                                     services={"faults": faults}))
+    tree = load_tree_string(
+        xml, context=TreeContext(clock=world.clock, world=world, services={"faults": faults})
+    )
     report = Runner(tree, world, RunOptions(max_sim_time=60)).run()
     assert report.status == "FAILURE"
     assert [e.kind for e in faults.events][:1] == ["slip"]

@@ -16,22 +16,31 @@ TABLE = ROOT / "worlds" / "sawyer_table.yaml"
 
 
 @pytest.mark.parametrize(
-    ("path", "robot", "description", "n_objects"),
-    [(HOUSE, "husky", "husky_ur3", 1), (TABLE, "sawyer", "sawyer", 10)],
+    ("path", "robot", "description", "n_objects", "n_models"),
+    [(HOUSE, "husky", "husky_ur3", 1, 0), (TABLE, "sawyer", "sawyer", 0, 10)],
 )
 def test_world_loads_with_its_robot(
-    path: Path, robot: str, description: str, n_objects: int
+    path: Path, robot: str, description: str, n_objects: int, n_models: int
 ) -> None:
     with World(path, seed=0) as world:
         assert list(world.robots) == [robot]
         assert world.robots[robot].description.name == description
         assert len(world.movable) == n_objects
+        assert len(world.models) == n_models
         assert world.obstacle_body_ids()
+
+
+def _table_with_blocks(seed: int) -> World:
+    """The table world with its ten block models spawned."""
+    world = World(TABLE, seed=seed)
+    for name in sorted(world.models):
+        world.spawn_model(name)
+    return world
 
 
 @pytest.mark.parametrize("path", [HOUSE, TABLE], ids=["house", "table"])
 def test_ten_seconds_with_no_commands_leaves_everything_at_rest(path: Path) -> None:
-    with World(path, seed=3) as world:
+    with _table_with_blocks(3) if path == TABLE else World(path, seed=3) as world:
         before = world.snapshot()
         world.step(round(10.0 * world.rate_hz))
         after = world.snapshot()
@@ -68,9 +77,10 @@ def test_different_seeds_give_different_starts_within_ranges() -> None:
     for seed in (1, 2):
         with World(HOUSE, seed=seed) as world:
             starts[seed] = world.robots["husky"].base_pose2d()
-        with World(TABLE, seed=seed) as world:
+        with _table_with_blocks(seed) as world:
             blocks = {n: world.body_pose(n).xyz for n in world.movable}
-        nominal = {b.name: b.pose.xyz for b in world.spec.objects}
+        assert len(blocks) == 10
+        nominal = {b.name: b.pose.xyz for b in world.spec.models}
         for name, xyz in blocks.items():
             assert abs(xyz[0] - nominal[name][0]) <= 0.01 + 1e-9
             assert abs(xyz[1] - nominal[name][1]) <= 0.01 + 1e-9
