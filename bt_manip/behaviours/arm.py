@@ -303,7 +303,8 @@ class MoveToPose(JointMove):
     ``free_yaw`` the rotation about the tool axis is left to the solver. ``path="line"`` moves
     the tool on a straight line from where it is (orientation turning evenly); the default
     ``joint`` interpolates the joints. With ``approach`` > 0 the last ``approach`` metres are a
-    straight line along the tool axis.
+    straight line along the tool axis; with ``retreat`` > 0 the move starts by backing out that
+    far along the tool axis from where the tool is (leaving a grasp or a drop the way it came).
 
     - RUNNING while the arm moves through the joint waypoints;
     - SUCCESS when the last waypoint is reached within ``tolerance``;
@@ -325,6 +326,9 @@ class MoveToPose(JointMove):
             bool, False, "leave the rotation about the tool axis free", False
         ),
         "approach": PortInformation(float, False, "straight-line approach length (m)", 0.0),
+        "retreat": PortInformation(
+            float, False, "first back out this far along the tool axis (m)", 0.0
+        ),
         "frame": PortInformation(str, False, "robot link to place (default: grasp frame)", ""),
         "path": PortInformation(
             str, False, "joint: interpolate joints; line: straight line from where it is", "joint"
@@ -358,16 +362,27 @@ class MoveToPose(JointMove):
         free = bool(self.get_input("free_yaw"))
         n = len(q_now)
         approach = float(self.get_input("approach"))
+        retreat = float(self.get_input("retreat"))
+        if approach < 0 or retreat < 0:
+            raise ActionFailed("approach and retreat are distances: they cannot be negative")
+        here = robot.link_transform(tip)
+        stages: list[Stage] = []
+        if retreat > 0:
+            # leave along the tool axis first, as the tool came in
+            back = here.copy()
+            back[:3, 3] -= retreat * here[:3, 2]
+            path = cartesian.line(robot, tip, here, back, q_now)
+            stages += [Stage(q, list(range(n)), via=True) for q in path]
+            here, q_now = back, path[-1]
         first = target.copy()
         if approach > 0:
             first[:3, 3] -= approach * target[:3, 2]
         if self.get_input("path") == "line":
-            here = robot.link_transform(tip)
-            stages = _through(cartesian.line(robot, tip, here, first, q_now, free), n)
+            stages += _through(cartesian.line(robot, tip, here, first, q_now, free), n)
             q_first = stages[-1].command
         elif self.get_input("path") == "joint":
             q_first = cartesian.solve(robot, tip, first, q_now, free)
-            stages = [Stage(q_first, list(range(n)))]
+            stages.append(Stage(q_first, list(range(n))))
         else:
             raise ActionFailed(f"path must be 'joint' or 'line', got '{self.get_input('path')}'")
         if approach > 0:

@@ -155,3 +155,33 @@ def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None
     world.step(480)
     lo, _ = pb.getAABB(world.movable["panel"], physicsClientId=world.client)
     assert lo[2] < 0.05  # it fell to the floor
+
+
+def test_move_to_pose_reaches_the_pose_and_retreats_first(table: World) -> None:
+    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.runner import Runner, RunOptions
+
+    robot = table.robots["sawyer"]
+    report, _ = run_xml(table, '<MoveToPose position="0.75;0.2;0.9" approach="0.1"/>')
+    assert report.status == "SUCCESS", report.reason
+    tip = robot.link_transform("grasp_frame")
+    assert np.allclose(tip[:3, 3], [0.75, 0.2, 0.9], atol=0.01)
+    assert tip[2, 2] == pytest.approx(-1.0, abs=0.01)  # tool pointing down
+    heights: list[float] = []
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Main">'
+        '<MoveToPose position="0.75;-0.1;0.9" retreat="0.1"/></BehaviorTree></root>'
+    )
+    tree = load_tree_string(xml, context=TreeContext(clock=table.clock, world=table))
+    report = Runner(
+        tree,
+        table,
+        RunOptions(max_sim_time=30),
+        on_tick=[lambda _: heights.append(robot.link_transform("grasp_frame")[2, 3])],
+    ).run()
+    assert report.status == "SUCCESS", report.reason
+    assert max(heights) > 0.98  # it backed up along the tool axis before moving across
+    assert np.allclose(robot.link_transform("grasp_frame")[:3, 3], [0.75, -0.1, 0.9], atol=0.01)
+    report, _ = run_xml(table, '<MoveToPose position="2.5;0;0.9"/>')
+    assert report.status == "FAILURE"
+    assert "beyond reach" in reasons(report)["MoveToPose"]
