@@ -15,10 +15,10 @@ from bt_manip.behaviours.arm import Lift, MoveJoints, MoveJointsSequentially
 from bt_manip.behaviours.attach import Attach
 from bt_manip.behaviours.conditions import CarriedClear, IsAttached, ObjectAbove
 from bt_manip.behaviours.gripper import CloseGripper, OpenGripper
-from bt_manip.behaviours.navigate import Navigate
+from bt_manip.behaviours.navigate import BackUp, Navigate
 from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
-from bt_manip.bt.decorators import RetryUntilSuccessful
+from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
 from bt_manip.bt.leaves import AlwaysFailure
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -60,8 +60,14 @@ def build(context: TreeContext | None = None) -> Tree:
             IsAttached("panel_attached", object="panel"),
             ObjectAbove("panel_off_floor", object="panel", height=0.1),
         ]),
-        RetryUntilSuccessful("carry_attempts", num_attempts=3,
-                             child=Navigate("carry_to_goal", goal="goal")),
+        RetryUntilSuccessful("carry_attempts", num_attempts=3, child=Fallback(
+            "carry_or_back_off", children=[
+                Navigate("carry_to_goal", goal="goal"),
+                Sequence("clear_and_retry", children=[
+                    ForceSuccess(child=BackUp("back_up", distance=0.5)),
+                    AlwaysFailure("carry_failed"),
+                ]),
+            ])),
         Sequence("delivered", children=[
             IsAttached("still_attached", object="panel"),
             ObjectAbove("still_off_floor", object="panel", height=0.1),

@@ -24,6 +24,8 @@ from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
 BLOCK_SIZE = 0.3
 """Side (m) of the crate an injected ``block`` fault drops on the route."""
+BLOCK_CLEARANCE = 1.5
+"""The crate falls at least this far (m) from the route's start and its goal."""
 
 
 def navigator_for(world: Any, robot: Any) -> Navigator:
@@ -68,8 +70,9 @@ class Navigate(RobotAction):
     - SUCCESS when the base is within ``xy_tolerance`` (m) and ``yaw_tolerance`` (rad) of the
       goal;
     - FAILURE when there is no path (the reason says why: goal in an obstacle, no way wide
-      enough for the footprint, ...), the base is stuck, ``timeout`` passes, or a carried object
-      touches a wall or furniture.
+      enough for the footprint, ...), the base is stuck, ``timeout`` passes, a carried object
+      touches a wall or furniture, or the robot runs into a movable object (it stops rather than
+      push it; a retry plans around it).
     Halted: the base is braked where it is.
     """
 
@@ -110,7 +113,7 @@ class Navigate(RobotAction):
 
     def step(self) -> Status:
         robot = self.robot()
-        hits = carried_collisions(self.world, robot)
+        hits = carried_collisions(self.world, robot) + self._bumped()
         if hits:
             robot.stop_base()
             raise ActionFailed("; ".join(hits))
@@ -128,6 +131,22 @@ class Navigate(RobotAction):
         robot.set_base_twist(*status.cmd)
         return Status.RUNNING
 
+    def _bumped(self) -> list[str]:
+        """Movable objects the robot (not its fingers' load) has run into: it does not push
+        things out of its way, it stops so that a retry can plan around them."""
+        import pybullet as pb
+
+        world = self.world
+        robot = self.robot()
+        held = {a.object_body for a in world.attachments.held_by(self.robot_name())}
+        movable = {b: n for n, b in world.movable.items() if b not in held}
+        bumped = {
+            movable[pt[2]]
+            for pt in pb.getContactPoints(bodyA=robot.body, physicsClientId=world.client)
+            if pt[2] in movable and pt[3] not in robot.finger_link_ids
+        }
+        return [f"ran into '{name}'" for name in sorted(bumped)]
+
     def on_halt(self) -> None:
         self._show(None)
 
@@ -141,18 +160,20 @@ class Navigate(RobotAction):
             overlay.show_path("base_plan", np.asarray(polyline)[:, :2])
 
     def _maybe_block(self, polyline: np.ndarray) -> None:
-        """The ``block`` fault: a crate falls on the route, halfway along (at least 1.5 m on)."""
+        """The ``block`` fault: a crate falls on the route, at the middle point of the route
+        that is at least :data:`BLOCK_CLEARANCE` from both ends (a route with no such point
+        gets none): it tests going around an obstacle, not a goal made unreachable."""
         faults = self.faults()
         if faults is None or not faults.specs or polyline is None or len(polyline) < 2:
             return
-        if not faults.block(self.get_input("goal")):
+        pts = np.asarray(polyline)[:, :2]
+        far = (np.linalg.norm(pts - pts[0], axis=1) >= BLOCK_CLEARANCE) & (
+            np.linalg.norm(pts - pts[-1], axis=1) >= BLOCK_CLEARANCE
+        )
+        if not far.any() or not faults.block(self.get_input("goal")):
             return
-        seg = np.linalg.norm(np.diff(polyline[:, :2], axis=0), axis=1)
-        along = np.concatenate([[0.0], np.cumsum(seg)])
-        if along[-1] < 3.0:
-            return
-        i = int(np.searchsorted(along, max(1.5, along[-1] / 2)))
-        x, y = polyline[min(i, len(polyline) - 1), :2]
+        candidates = np.flatnonzero(far)
+        x, y = pts[candidates[len(candidates) // 2]]
         n = sum(1 for name in self.world.movable if name.startswith("dropped_crate"))
         spec = BodySpec(
             name=f"dropped_crate_{n}",
@@ -171,3 +192,67 @@ class Navigate(RobotAction):
             self.world.spawn(spec)
         except ValueError:
             return
+
+
+@registry.register
+class BackUp(RobotAction):
+    """Drives the base straight backwards by ``distance`` metres at ``speed`` (a recovery to
+    get clear of an obstacle before planning again).
+
+    - RUNNING while reversing;
+    - SUCCESS once ``distance`` has been covered;
+    - FAILURE when the robot or what it carries comes into contact with anything but the floor
+      (it stops there), or it is not done after ``timeout`` s.
+    Halted: the base is braked where it is.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **RobotAction.INPUT_PORTS,
+        "distance": PortInformation(float, False, "how far to reverse (m)", 0.5),
+        "speed": PortInformation(float, False, "reversing speed (m/s)", 0.2),
+        "timeout": PortInformation(float, False, "sim seconds allowed", 10.0),
+    }
+
+    def start(self) -> None:
+        robot = self.robot()
+        if robot.description.base.type != "skid_steer":
+            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        self.distance = float(self.get_input("distance"))
+        self.speed = abs(float(self.get_input("speed")))
+        if self.distance <= 0 or self.speed <= 0:
+            raise ActionFailed("distance and speed must be positive")
+        self.origin = robot.base_pose2d()
+        self.touching = self._contacts()
+
+    def _contacts(self) -> set[str]:
+        """Bodies other than the floor that the robot or its load touch now."""
+        import pybullet as pb
+
+        world = self.world
+        robot = self.robot()
+        ground = world.body_id("ground")
+        mine = {robot.body} | {a.object_body for a in world.attachments.held_by(self.robot_name())}
+        out = set()
+        for body in mine:
+            for pt in pb.getContactPoints(bodyA=body, physicsClientId=world.client):
+                if pt[2] != ground and pt[2] not in mine:
+                    out.add(world.name_of(pt[2]) or str(pt[2]))
+        return out
+
+    def step(self) -> Status:
+        robot = self.robot()
+        new = self._contacts() - self.touching
+        if new:
+            robot.stop_base()
+            raise ActionFailed(f"backing up, touched {', '.join(sorted(new))}")
+        x, y, _ = robot.base_pose2d()
+        if math.hypot(x - self.origin[0], y - self.origin[1]) >= self.distance:
+            robot.stop_base()
+            return Status.SUCCESS
+        if self.elapsed() > float(self.get_input("timeout")):
+            robot.stop_base()
+            raise ActionFailed(
+                f"backed up only {math.hypot(x - self.origin[0], y - self.origin[1]):.2f} m"
+            )
+        robot.set_base_twist(-self.speed, 0.0)
+        return Status.RUNNING
