@@ -15,7 +15,7 @@ from bt_manip.behaviours.arm import Lift, MoveJoints, MoveJointsSequentially
 from bt_manip.behaviours.attach import Attach
 from bt_manip.behaviours.conditions import CarriedClear, IsAttached, ObjectAbove
 from bt_manip.behaviours.gripper import CloseGripper, OpenGripper
-from bt_manip.behaviours.navigate import BackUp, Navigate
+from bt_manip.behaviours.navigate import Navigate, Reverse
 from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
@@ -64,7 +64,7 @@ def build(context: TreeContext | None = None) -> Tree:
             "carry_or_back_off", children=[
                 Navigate("carry_to_goal", goal="goal"),
                 Sequence("clear_and_retry", children=[
-                    ForceSuccess(child=BackUp("back_up", distance=0.5)),
+                    ForceSuccess(child=Reverse("back_up", distance=0.5)),
                     AlwaysFailure("carry_failed"),
                 ]),
             ])),

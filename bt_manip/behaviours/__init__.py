@@ -1,6 +1,6 @@
 """Robot behaviours for trees: importing this package registers them with the node registry.
 
-- Base: Navigate.
+- Base: Navigate, Reverse.
 - Arm: MoveJointsSequentially, MoveJoints, MoveToPose, Lift.
 - Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.
 - Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear.

@@ -195,7 +195,7 @@ class Navigate(RobotAction):
 
 
 @registry.register
-class BackUp(RobotAction):
+class Reverse(RobotAction):
     """Drives the base straight backwards by ``distance`` metres at ``speed`` (a recovery to
     get clear of an obstacle before planning again).
 
