@@ -244,7 +244,7 @@ class Reverse(RobotAction):
         new = self._contacts() - self.touching
         if new:
             robot.stop_base()
-            raise ActionFailed(f"backing up, touched {', '.join(sorted(new))}")
+            raise ActionFailed("backing up, touched " + ", ".join(f"'{n}'" for n in sorted(new)))
         x, y, _ = robot.base_pose2d()
         if math.hypot(x - self.origin[0], y - self.origin[1]) >= self.distance:
             robot.stop_base()

@@ -1,0 +1,83 @@
+"""Navigate and Reverse on the Husky in the house."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pybullet as pb
+import pytest
+from bhelpers import place_robot, reasons, run_xml
+
+from bt_manip.bt import TreeContext, load_tree_string
+from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.runner import Runner, RunOptions
+from bt_manip.sim.world import World
+
+ROOT = Path(__file__).resolve().parents[2]
+HOUSE = ROOT / "worlds" / "tb3_house.yaml"
+
+
+def test_navigate_to_coordinates_and_to_a_named_pose() -> None:
+    with World(HOUSE, seed=2) as world:
+        x0, y0, _ = world.robots["husky"].base_pose2d()
+        xml = (
+            '<Sequence><MoveJoints state="tuck"/>'
+            '<Navigate goal="-1.5;-2.5;1.57" path_length="{len}"/>'
+            '<Navigate goal="start" xy_tolerance="0.03" yaw_tolerance="0.03"/></Sequence>'
+        )
+        report, tree = run_xml(world, xml, 120)
+        assert report.status == "SUCCESS", report.reason
+        x, y, yaw = world.robots["husky"].base_pose2d()
+        start = world.poses["start"]
+        assert math.hypot(x - start.x, y - start.y) <= 0.03
+        assert abs(math.remainder(yaw - start.yaw, math.tau)) <= 0.03
+        # the first leg: no shorter than the straight line from where the robot started
+        assert tree.blackboard.as_dict()["len"] >= math.hypot(-1.5 - x0, -2.5 - y0) - 0.05
+        report, _ = run_xml(world, '<Navigate goal="kitchen"/>')
+        assert "goal 'kitchen' is neither a named pose" in reasons(report)["Navigate"]
+        report, _ = run_xml(world, '<Navigate goal="2.6;4.6;0"/>')  # inside the counter
+        assert reasons(report)["Navigate"].startswith("no path to 2.6;4.6;0:")
+
+
+def test_a_crate_dropped_on_the_route_is_not_pushed_along() -> None:
+    with World(HOUSE, seed=0) as world:
+        faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)
+        xml = (
+            '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
+            '<MoveJoints state="tuck"/><Navigate goal="goal"/></Sequence>'
+            "</BehaviorTree></root>"
+        )
+        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        tree = load_tree_string(xml, context=context)
+        landed: dict[str, np.ndarray] = {}
+
+        def watch(_: Runner) -> None:
+            for name, body in world.movable.items():
+                pos = np.array(
+                    pb.getBasePositionAndOrientation(body, physicsClientId=world.client)[0]
+                )
+                if name.startswith("dropped_crate") and world.time > 1.5:
+                    landed.setdefault(name, pos)
+                    assert np.linalg.norm(pos - landed[name]) < 0.05, f"{name} was pushed"
+
+        report = Runner(tree, world, RunOptions(max_sim_time=90), on_tick=[watch]).run()
+        assert [e.kind for e in faults.events] == ["block"]
+        assert "dropped_crate_0" in landed
+        # it went around the crate, or stopped at it and said so
+        assert report.status == "SUCCESS" or "ran into 'dropped_crate_0'" in report.reason
+
+
+def test_reverse_backs_straight_up_and_stops_at_a_wall() -> None:
+    with World(HOUSE, seed=0) as world:
+        place_robot(world, "husky", 0.0, -2.0, 0.0)
+        report, _ = run_xml(world, '<Reverse distance="0.6"/>')
+        assert report.status == "SUCCESS", report.reason
+        x, y, yaw = world.robots["husky"].base_pose2d()
+        assert x == pytest.approx(-0.6, abs=0.05) and abs(y + 2.0) < 0.05 and abs(yaw) < 0.05
+        # 1.5 m from the west wall of the workshop: backing up 2 m must stop at it
+        place_robot(world, "husky", -1.9, -2.0, 0.0)
+        report, _ = run_xml(world, '<Reverse distance="2.0"/>')
+        assert report.status == "FAILURE"
+        assert "backing up, touched 'wall_x_m3'" in reasons(report)["Reverse"]
