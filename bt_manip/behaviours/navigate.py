@@ -110,10 +110,13 @@ class Navigate(RobotAction):
         self.timeout = timeout or 1.5 * plan.length / follower.max_speed + 30.0
         self._show(plan.polyline)
         self._maybe_block(plan.polyline)
+        self.touching_at_start = set(self._bumped())  # it may drive away from these
 
     def step(self) -> Status:
         robot = self.robot()
-        hits = carried_collisions(self.world, robot) + self._bumped()
+        hits = carried_collisions(self.world, robot) + sorted(
+            set(self._bumped()) - self.touching_at_start
+        )
         if hits:
             robot.stop_base()
             raise ActionFailed("; ".join(hits))
