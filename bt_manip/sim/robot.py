@@ -25,7 +25,7 @@ import pybullet as pb
 from bt_manip.errors import InputError, Problem
 from bt_manip.sim.assets import REPO_ROOT
 from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
-from bt_manip.sim.yaml_lines import LineDict, load_yaml
+from bt_manip.sim.yaml_lines import LineDict, is_number, load_yaml, numbers_of
 
 __all__ = [
     "ArmSpec",
@@ -264,11 +264,7 @@ class _Fields:
             self.fail(d.line, f"{where} is missing '{key}'")
             return 0.0
         value = d.get(key, default)
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, int | float)
-            or not math.isfinite(value)
-        ):
+        if not is_number(value):
             self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
             return 0.0
         if positive and value <= 0:
@@ -291,18 +287,10 @@ class _Fields:
         return tuple(value)
 
     def numbers(self, value: object, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        ok = (
-            isinstance(value, list)
-            and len(value) == n
-            and all(
-                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-                for v in value
-            )
-        )
-        if not ok:
+        out = numbers_of(value, n)
+        if out is None:
             self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
-            return None
-        return tuple(float(v) for v in value)
+        return out
 
 
 def _empty(line: int) -> LineDict:

@@ -25,7 +25,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from bt_manip.errors import InputError, Problem
-from bt_manip.sim.yaml_lines import LineDict, LineList, load_yaml
+from bt_manip.sim.yaml_lines import LineDict, LineList, is_number, load_yaml, numbers_of
 
 COLOURS: dict[str, tuple[float, float, float, float]] = {
     "white": (0.95, 0.95, 0.95, 1.0),
@@ -240,11 +240,7 @@ class _Reader:
                 self.fail(d.line, f"{where} is missing '{key}'")
             return default
         value = d[key]
-        if (
-            isinstance(value, bool)
-            or not isinstance(value, int | float)
-            or not math.isfinite(value)
-        ):
+        if not is_number(value):
             self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
             return default
         if positive and value <= 0:
@@ -256,18 +252,10 @@ class _Reader:
         return float(value)
 
     def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        ok = (
-            isinstance(value, list)
-            and len(value) == n
-            and all(
-                isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
-                for v in value
-            )
-        )
-        if not ok:
+        out = numbers_of(value, n)
+        if out is None:
             self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
-            return None
-        return tuple(float(v) for v in value)
+        return out
 
     def colour(
         self, d: LineDict, where: str, default: tuple[float, float, float, float]

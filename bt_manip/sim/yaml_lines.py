@@ -8,6 +8,7 @@ each item).
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -90,3 +91,15 @@ def load_yaml(path: str | Path) -> Any:
         raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
     except yaml.YAMLError as exc:
         raise InputError([Problem(str(path), None, f"invalid YAML: {exc}")]) from None
+
+
+def is_number(value: Any) -> bool:
+    """A finite int or float read from YAML (booleans are not numbers)."""
+    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
+
+
+def numbers_of(value: Any, n: int) -> tuple[float, ...] | None:
+    """``value`` as ``n`` floats if it is a YAML list of ``n`` finite numbers, else None."""
+    if isinstance(value, list) and len(value) == n and all(is_number(v) for v in value):
+        return tuple(float(v) for v in value)
+    return None
