@@ -117,3 +117,21 @@ def test_ctrl_c_halts_and_exits_130(tmp_path: Path) -> None:
     assert "result: INTERRUPTED" in out
     assert "Traceback" not in err
     assert json.loads(report.read_text())["status"] == "INTERRUPTED"
+
+
+def test_live_view_shows_what_finished_nodes_returned() -> None:
+    from bt_manip.bt import TreeContext, load_tree
+    from bt_manip.bt.display import render_status
+    from bt_manip.clock import ManualClock
+
+    clock = ManualClock()
+    tree = load_tree(str(ROOT / "trees" / "builtins_demo.xml"), context=TreeContext(clock=clock))
+    assert "[ ] Script 'init'" in render_status(tree)  # not run yet
+    for _ in range(100):
+        if tree.tick().name == "SUCCESS":
+            break
+        clock.advance(0.05)
+    view = render_status(tree)
+    assert "[+] Script 'init'" in view
+    assert "[x] AlwaysFailure 'plan_a'" in view
+    assert "[+] Sleep 'short_wait'" in view

@@ -30,10 +30,14 @@ def _ports(node: BtNode) -> str:
 
 def render_status(tree: Tree) -> str:
     """One line per node: ``[marker] label``; markers: * running, + success, x failure,
-    - skipped, blank idle. A node's feedback message (failure reason) follows ``--``."""
+    - skipped, blank not run yet. A node that finished shows what it returned last (in
+    BehaviorTree.CPP it is IDLE again). Its feedback message (failure reason) follows ``--``."""
     lines = []
     for _, depth, node in tree.walk():
-        marker = MARKERS[node.bt_status.value]
+        status = node.bt_status.value
+        if status == "IDLE":
+            status = node.last_status.value
+        marker = MARKERS[status]
         reason = f" -- {node.feedback_message}" if node.feedback_message else ""
         lines.append(f"{'  ' * depth}[{marker}] {_label(node)}{reason}")
     return "\n".join(lines)
