@@ -359,6 +359,9 @@ class MoveToPose(JointMove):
         target = cartesian.pose_matrix(np.add(position, offset), self.get_input("orientation"))
         if self.get_input("match_object_yaw") and yaw is not None:
             target = self._turned_to(robot, tip, target, yaw)
+        from bt_manip.viz.overlay import overlay_for
+
+        overlay_for(self.world).show_frame("ik_target", target)  # drawn when a viewer is on
         free = bool(self.get_input("free_yaw"))
         n = len(q_now)
         approach = float(self.get_input("approach"))

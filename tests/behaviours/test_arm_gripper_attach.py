@@ -166,6 +166,10 @@ def test_move_to_pose_reaches_the_pose_and_retreats_first(table: World) -> None:
     assert report.status == "SUCCESS", report.reason
     tip = robot.link_transform("grasp_frame")
     assert np.allclose(tip[:3, 3], [0.75, 0.2, 0.9], atol=0.01)
+    from bt_manip.viz.overlay import overlay_for
+
+    target = overlay_for(table).items["ik_target"]  # what a viewer draws as a triad
+    assert np.allclose(target.matrix[:3, 3], [0.75, 0.2, 0.9])
     assert tip[2, 2] == pytest.approx(-1.0, abs=0.01)  # tool pointing down
     heights: list[float] = []
     xml = (
