@@ -236,6 +236,11 @@ class Navigator:
         if not self.plan.ok:
             self.plan = self.plan_to(pose, goal)  # the reason, in the caller's coordinates
             if not self.plan.ok:
+                if self.plan.outcome is PlanOutcome.FOOTPRINT and self._carry is None:
+                    # the grid is inflated for turning anywhere; over poses the robot may
+                    # still drive straight through a narrow doorway
+                    grid = self.costmap.grid
+                    return self._follow_poses(pose, goal, self.footprint, grid, clearance(grid))
                 return self.plan
         if self._carry is not None:
             return self._start_carrying(pose, goal)
@@ -253,15 +258,28 @@ class Navigator:
         """Plan over poses for the robot with its load; the grid plan said a way may exist."""
         assert self._carry is not None
         low_fp, high_fp, low, clear_low, clear_high = self._carry
+        return self._follow_poses(pose, goal, low_fp, low, clear_low, high_fp, clear_high)
+
+    def _follow_poses(
+        self,
+        pose: Pose2D,
+        goal: Pose2D,
+        footprint: PlanarFootprint,
+        grid: OccupancyGrid,
+        clear: np.ndarray,
+        carried: PlanarFootprint | None = None,
+        clear_high: np.ndarray | None = None,
+    ) -> NavPlan:
+        """Plan over poses with ``footprint`` (and ``carried``) and get ready to follow."""
         poses = plan_poses(
-            low,
-            clear_low,
-            low_fp,
+            grid,
+            clear,
+            footprint,
             pose,
             goal,
             self.pivot,
             self.options.lattice,
-            carried=high_fp,
+            carried=carried,
             clear_high=clear_high,
         )
         if not poses.ok:

@@ -81,3 +81,29 @@ def test_reverse_backs_straight_up_and_stops_at_a_wall() -> None:
         report, _ = run_xml(world, '<Reverse distance="2.0"/>')
         assert report.status == "FAILURE"
         assert "backing up, touched 'wall_x_m3'" in reasons(report)["Reverse"]
+
+
+def test_the_bare_robot_drives_through_a_one_metre_doorway() -> None:
+    with World(HOUSE, seed=0) as world:
+        robot = world.robots["husky"]
+        static = {
+            i.body_id: i.name for i in world.infos.values() if i.kind in ("wall", "furniture")
+        }
+        touched: set[str] = set()
+
+        def watch(_: Runner) -> None:
+            for pt in pb.getContactPoints(bodyA=robot.body, physicsClientId=world.client):
+                if pt[2] in static:
+                    touched.add(static[pt[2]])
+
+        xml = (
+            '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
+            '<MoveJoints state="tuck"/><Navigate goal="-4.6;2.6;3.14"/></Sequence>'
+            "</BehaviorTree></root>"
+        )
+        tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+        report = Runner(tree, world, RunOptions(max_sim_time=60), on_tick=[watch]).run()
+        assert report.status == "SUCCESS", report.reason
+        x, y, _ = robot.base_pose2d()
+        assert x < -3.3 and 1.6 < y < 4.9  # in bedroom 2, behind the 1.0 m doorway at x = -3
+        assert touched == set()
