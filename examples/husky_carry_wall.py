@@ -33,8 +33,15 @@ TUCK_RAD = [1.5708, -3.05, 2.95, -0.1, -1.5708, 0.0]
 def grasp_panel() -> Fallback:
     """One grasp attempt; on failure the arm backs off the way it came and the attempt fails."""
     approach_and_grasp = Sequence("approach_and_grasp", children=[
-        RetryUntilSuccessful("reach_pregrasp", num_attempts=3, child=Navigate(
-            "to_pregrasp", goal="pregrasp_panel", xy_tolerance=0.03, yaw_tolerance=0.03)),
+        RetryUntilSuccessful("reach_pregrasp", num_attempts=3, child=Fallback(
+            "drive_or_back_off", children=[
+                Navigate("to_pregrasp", goal="pregrasp_panel", xy_tolerance=0.03,
+                         yaw_tolerance=0.03),
+                Sequence("clear_and_drive_again", children=[
+                    ForceSuccess(child=Reverse("reverse", distance=0.5)),
+                    AlwaysFailure("drive_failed"),
+                ]),
+            ])),
         MoveJointsSequentially("pregrasp_arm", targets=PREGRASP_DEG, order=PREGRASP_ORDER),
         CloseGripper("close_gripper", require_object=True),
         Attach("attach_panel", object="panel"),
