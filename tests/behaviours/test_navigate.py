@@ -107,3 +107,29 @@ def test_the_bare_robot_drives_through_a_one_metre_doorway() -> None:
         x, y, _ = robot.base_pose2d()
         assert x < -3.3 and 1.6 < y < 4.9  # in bedroom 2, behind the 1.0 m doorway at x = -3
         assert touched == set()
+
+
+def test_halted_actions_leave_the_robot_stopped_and_holding() -> None:
+    with World(HOUSE, seed=0) as world:
+        robot = world.robots["husky"]
+        report, _ = run_xml(
+            world,
+            '<Sequence><MoveJoints state="tuck"/>'
+            '<Timeout msec="1500"><Navigate goal="goal"/></Timeout></Sequence>',
+        )
+        assert report.status == "FAILURE"  # the Timeout halted the drive while it was running
+        world.step(120)
+        before = robot.base_pose2d()
+        world.step(240)
+        after = robot.base_pose2d()
+        assert math.hypot(after[0] - before[0], after[1] - before[1]) < 0.005
+        assert np.linalg.norm(robot.base_velocity()) < 0.01
+        report, _ = run_xml(
+            world,
+            '<Timeout msec="300"><MoveJoints targets="90;-90;0;-90;0;0" speed="0.2"/></Timeout>',
+        )
+        assert report.status == "FAILURE"
+        q = robot.arm_positions()
+        world.step(240)
+        assert np.allclose(robot.arm_positions(), q, atol=0.01)  # holding where it was halted
+        assert not np.allclose(q, np.radians([90, -90, 0, -90, 0, 0]), atol=0.05)
