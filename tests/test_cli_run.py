@@ -135,3 +135,45 @@ def test_live_view_shows_what_finished_nodes_returned() -> None:
     assert "[+] Script 'init'" in view
     assert "[x] AlwaysFailure 'plan_a'" in view
     assert "[+] Sleep 'short_wait'" in view
+
+
+def test_groot_model_lists_the_robot_nodes_with_their_ports(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import xml.etree.ElementTree as ET
+
+    assert main(["nodes", "--groot"]) == 0
+    text = capsys.readouterr().out
+    model = tmp_path / "model.xml"
+    model.write_text(text)
+    nodes = {el.get("ID"): el for el in ET.fromstring(text).find("TreeNodesModel")}
+    robot_nodes = {
+        "Navigate",
+        "Reverse",
+        "MoveJointsSequentially",
+        "MoveJoints",
+        "MoveToPose",
+        "Lift",
+        "OpenGripper",
+        "CloseGripper",
+        "Attach",
+        "Detach",
+        "IsAttached",
+        "IsHolding",
+        "ObjectInRegion",
+        "ObjectAbove",
+        "CarriedClear",
+        "SpawnModel",
+        "DeleteModel",
+    }
+    assert robot_nodes <= set(nodes)
+    assert "Sequence" not in nodes and "Timeout" not in nodes  # built-ins are not listed
+    ports = {p.get("name"): p for p in nodes["MoveJointsSequentially"]}
+    assert {"targets", "order", "units", "tolerance", "speed"} <= set(ports)
+    assert ports["targets"].get("type") == "std::vector<double>"
+    assert nodes["CloseGripper"].tag == "Action" and nodes["IsAttached"].tag == "Condition"
+    # the model file loads back: the scenario tree validates against it
+    assert (
+        main(["validate", str(ROOT / "trees" / "husky_carry_wall.xml"), "--models", str(model)])
+        == 0
+    )
