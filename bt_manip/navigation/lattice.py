@@ -81,6 +81,47 @@ def outline_samples(footprint: PlanarFootprint, spacing: float = 0.05) -> np.nda
     return np.concatenate(pts)
 
 
+@numba.njit(cache=True, inline="always")
+def _heap_push(keys: np.ndarray, vals: np.ndarray, size: int, key: float, val: int) -> int:
+    """Add (key, val) to the binary min-heap in ``keys``/``vals``; returns the new size."""
+    j = size
+    while j > 0:
+        p = (j - 1) >> 1
+        if keys[p] <= key:
+            break
+        keys[j] = keys[p]
+        vals[j] = vals[p]
+        j = p
+    keys[j] = key
+    vals[j] = val
+    return size + 1
+
+
+@numba.njit(cache=True, inline="always")
+def _heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> tuple[float, int, int]:
+    """Remove the smallest entry of the heap; returns (key, val, new size)."""
+    key = keys[0]
+    val = vals[0]
+    size -= 1
+    last_key = keys[size]
+    last_val = vals[size]
+    i = 0
+    while True:  # sift the last entry down from the root
+        ch = 2 * i + 1
+        if ch >= size:
+            break
+        if ch + 1 < size and keys[ch + 1] < keys[ch]:
+            ch += 1
+        if keys[ch] >= last_key:
+            break
+        keys[i] = keys[ch]
+        vals[i] = vals[ch]
+        i = ch
+    keys[i] = last_key
+    vals[i] = last_val
+    return key, val, size
+
+
 @numba.njit(cache=True)
 def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
     """Shortest 8-connected distance (cells, no corner cutting) from every free cell to goal."""
@@ -99,26 +140,7 @@ def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
     dc = (0, 0, -1, 1, -1, 1, -1, 1)
     sq2 = math.sqrt(2.0)
     while size > 0:
-        d = heap_d[0]
-        node = heap_i[0]
-        size -= 1
-        # sift the last entry down from the root
-        ld = heap_d[size]
-        li = heap_i[size]
-        i = 0
-        while True:
-            ch = 2 * i + 1
-            if ch >= size:
-                break
-            if ch + 1 < size and heap_d[ch + 1] < heap_d[ch]:
-                ch += 1
-            if heap_d[ch] >= ld:
-                break
-            heap_d[i] = heap_d[ch]
-            heap_i[i] = heap_i[ch]
-            i = ch
-        heap_d[i] = ld
-        heap_i[i] = li
+        d, node, size = _heap_pop(heap_d, heap_i, size)
         r = node // cols
         c = node % cols
         if d > dist[r, c]:
@@ -133,17 +155,7 @@ def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
             nd = d + (sq2 if k >= 4 else 1.0)
             if nd < dist[nr, nc] and size < heap_d.shape[0]:
                 dist[nr, nc] = nd
-                j = size
-                size += 1
-                while j > 0:
-                    p = (j - 1) >> 1
-                    if heap_d[p] <= nd:
-                        break
-                    heap_d[j] = heap_d[p]
-                    heap_i[j] = heap_i[p]
-                    j = p
-                heap_d[j] = nd
-                heap_i[j] = nr * cols + nc
+                size = _heap_push(heap_d, heap_i, size, nd, nr * cols + nc)
     return dist
 
 
@@ -297,25 +309,7 @@ def _search(
         ]
     )
     while size > 0:
-        f = hf[0]
-        k = hi[0]
-        size -= 1
-        lf = hf[size]
-        lk = hi[size]
-        i = 0
-        while True:
-            ch = 2 * i + 1
-            if ch >= size:
-                break
-            if ch + 1 < size and hf[ch + 1] < hf[ch]:
-                ch += 1
-            if hf[ch] >= lf:
-                break
-            hf[i] = hf[ch]
-            hi[i] = hi[ch]
-            i = ch
-        hf[i] = lf
-        hi[i] = lk
+        f, k, size = _heap_pop(hf, hi, size)
         x = pose[k, 0]
         y = pose[k, 1]
         th = pose[k, 2]
@@ -364,17 +358,7 @@ def _search(
                 hf = nhf
                 hi = nhi
             nf = ng + heur(nx, ny)
-            j = size
-            size += 1
-            while j > 0:
-                p = (j - 1) >> 1
-                if hf[p] <= nf:
-                    break
-                hf[j] = hf[p]
-                hi[j] = hi[p]
-                j = p
-            hf[j] = nf
-            hi[j] = nk
+            size = _heap_push(hf, hi, size, nf, nk)
     return parent, move_of, pose, -1, expanded
 
 
