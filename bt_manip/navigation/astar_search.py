@@ -92,17 +92,11 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
 
 
 @numba.njit(cache=True)
-def _grow_pool(
-    pn: np.ndarray, pg: np.ndarray, pnext: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    n = pn.shape[0] * 2
-    nn = np.empty(n, np.int32)
-    ng = np.empty(n, np.float64)
-    nx = np.empty(n, np.int32)
-    nn[: pn.shape[0]] = pn
-    ng[: pg.shape[0]] = pg
-    nx[: pnext.shape[0]] = pnext
-    return nn, ng, nx
+def _doubled(a: np.ndarray) -> np.ndarray:
+    """A copy of ``a`` with twice the room (the new half is left uninitialised)."""
+    out = np.empty(a.shape[0] * 2, a.dtype)
+    out[: a.shape[0]] = a
+    return out
 
 
 @numba.njit(cache=True)
@@ -202,7 +196,7 @@ def search_buckets(
                 free = pnext[s]
             else:
                 if used == pn.shape[0]:
-                    pn, pg, pnext = _grow_pool(pn, pg, pnext)
+                    pn, pg, pnext = _doubled(pn), _doubled(pg), _doubled(pnext)
                 s = used
                 used += 1
             kb = kb % span
@@ -218,20 +212,6 @@ def search_buckets(
 def _before(fa: float, ga: float, fb: float, gb: float) -> bool:
     """Heap order: smaller f first; on equal f, larger g (deeper) first."""
     return fa < fb or (fa == fb and ga > gb)
-
-
-@numba.njit(cache=True)
-def _grow_heap(
-    hf: np.ndarray, hg: np.ndarray, hn: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    n = hf.shape[0] * 2
-    nf = np.empty(n, np.float64)
-    ng = np.empty(n, np.float64)
-    nn = np.empty(n, np.int32)
-    nf[: hf.shape[0]] = hf
-    ng[: hg.shape[0]] = hg
-    nn[: hn.shape[0]] = hn
-    return nf, ng, nn
 
 
 @numba.njit(cache=True)
@@ -315,7 +295,7 @@ def search_heap(
             parent[nb] = node
             nf_ = math.floor((ng_ + _h(nr, nc, gr, gc, diagonal, hmin)) * inv_q)
             if size == hf.shape[0]:
-                hf, hg, hn = _grow_heap(hf, hg, hn)
+                hf, hg, hn = _doubled(hf), _doubled(hg), _doubled(hn)
             i = size
             size += 1
             while i > 0:  # move the new entry up
