@@ -22,10 +22,10 @@ import defusedxml.ElementTree as SafeET
 import numpy as np
 import pybullet as pb
 
-from bt_manip.errors import InputError, Problem
+from bt_manip.errors import InputError
 from bt_manip.sim.assets import REPO_ROOT
 from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
-from bt_manip.sim.yaml_lines import LineDict, is_number, load_yaml, numbers_of
+from bt_manip.sim.yaml_lines import LineDict, ProblemCollector, is_number, load_yaml, numbers_of
 
 __all__ = [
     "ArmSpec",
@@ -216,15 +216,8 @@ def known_robots() -> list[str]:
     return sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
 
 
-class _Fields:
+class _Fields(ProblemCollector):
     """Typed field access on a YAML mapping that records problems with file and line."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self.problems: list[Problem] = []
-
-    def fail(self, line: int | None, message: str) -> None:
-        self.problems.append(Problem(str(self.path), line, message))
 
     def section(self, d: LineDict, key: str, allowed: set[str], required: bool = True) -> LineDict:
         value = d.get(key)
@@ -233,16 +226,8 @@ class _Fields:
         if not isinstance(value, LineDict):
             self.fail(d.line_of(key), f"'{key}' must be a mapping")
             return _empty(d.line_of(key))
-        self.unknown(value, allowed, key)
+        self.unknown_keys(value, allowed, key)
         return value
-
-    def unknown(self, d: LineDict, allowed: set[str], where: str) -> None:
-        for key in d:
-            if key not in allowed:
-                self.fail(
-                    d.line_of(key),
-                    f"unknown key '{key}' in {where}; allowed: {', '.join(sorted(allowed))}",
-                )
 
     def text(self, d: LineDict, key: str, where: str, default: str | None = None) -> str:
         value = d.get(key, default)
@@ -312,7 +297,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     f = _Fields(path)
     if not isinstance(data, LineDict):
         raise InputError.single(str(path), 1, "a robot descriptor must be a YAML mapping")
-    f.unknown(data, TOP_KEYS, "the descriptor")
+    f.unknown_keys(data, TOP_KEYS, "the descriptor")
     name = f.text(data, "name", "descriptor", default=path.stem)
     urdf = _parse_urdf_source(f, data, path)
 

@@ -24,8 +24,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from bt_manip.errors import InputError, Problem
-from bt_manip.sim.yaml_lines import LineDict, LineList, is_number, load_yaml, numbers_of
+from bt_manip.errors import InputError
+from bt_manip.sim.yaml_lines import (
+    LineDict,
+    LineList,
+    ProblemCollector,
+    is_number,
+    load_yaml,
+    numbers_of,
+)
 
 COLOURS: dict[str, tuple[float, float, float, float]] = {
     "white": (0.95, 0.95, 0.95, 1.0),
@@ -188,30 +195,10 @@ ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize"}
 RANDOM_KEYS = {"x", "y", "yaw"}
 
 
-class _Reader:
+class _Reader(ProblemCollector):
     """Walks the YAML tree, converting values and collecting problems."""
 
-    def __init__(self, path: Path) -> None:
-        self.path = path
-        self.problems: list[Problem] = []
-
-    def fail(self, line: int | None, message: str) -> None:
-        self.problems.append(Problem(str(self.path), line, message))
-
     # -- generic checks ---------------------------------------------------------------
-    def keys(self, d: LineDict, allowed: set[str], where: str) -> None:
-        import difflib
-
-        for key in d:
-            if key not in allowed:
-                close = difflib.get_close_matches(key, sorted(allowed), n=1)
-                hint = (
-                    f"; did you mean '{close[0]}'?"
-                    if close
-                    else (f"; allowed: {', '.join(sorted(allowed))}")
-                )
-                self.fail(d.line_of(key), f"unknown key '{key}' in {where}{hint}")
-
     def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
         if isinstance(value, LineDict):
             return value
@@ -299,7 +286,7 @@ class _Reader:
             return Pose2D(*vec) if vec else None
         if isinstance(value, LineDict):
             allowed = {"x", "y", "yaw", "qz", "qw"}
-            self.keys(value, allowed, where)
+            self.unknown_keys(value, allowed, where)
             x = self.number(value, "x", where)
             y = self.number(value, "y", where)
             if "yaw" in value and ("qz" in value or "qw" in value):
@@ -332,7 +319,7 @@ class _Reader:
                 return None
             return Pose3D((p2.x, p2.y, 0.0), tuple(pb.getQuaternionFromEuler((0, 0, p2.yaw)))), True
         if isinstance(value, LineDict):
-            self.keys(value, {"xyz", "rpy", "quat"}, where)
+            self.unknown_keys(value, {"xyz", "rpy", "quat"}, where)
             xyz = self.vector(value["xyz"], 3, value.line_of("xyz"), f"{where}.xyz")
             if "rpy" in value and "quat" in value:
                 self.fail(value.line, f"{where}: give either 'rpy' or 'quat', not both")
@@ -361,7 +348,7 @@ class _Reader:
         r = self.mapping(d["randomize"], d.line_of("randomize"), f"{where}.randomize")
         if r is None:
             return Range2D()
-        self.keys(r, RANDOM_KEYS, f"{where}.randomize")
+        self.unknown_keys(r, RANDOM_KEYS, f"{where}.randomize")
         out: dict[str, tuple[float, float]] = {}
         for key in RANDOM_KEYS & set(r):
             vec = self.vector(r[key], 2, r.line_of(key), f"{where}.randomize.{key} ([low, high])")
@@ -423,7 +410,7 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
         d = rd.mapping(raw, walls.line_of(i), where)
         if d is None:
             continue
-        rd.keys(d, WALL_KEYS, where)
+        rd.unknown_keys(d, WALL_KEYS, where)
         start = rd.vector(d.get("from"), 2, d.line_of("from"), f"{where}.from ([x, y])")
         end = rd.vector(d.get("to"), 2, d.line_of("to"), f"{where}.to ([x, y])")
         thickness = rd.number(d, "thickness", where, default=0.12, positive=True)
@@ -443,7 +430,7 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
             dd = rd.mapping(rawd, door_list.line_of(j), dw)  # type: ignore[union-attr]
             if dd is None:
                 continue
-            rd.keys(dd, DOOR_KEYS, dw)
+            rd.unknown_keys(dd, DOOR_KEYS, dw)
             at = rd.number(dd, "at", dw)
             width = rd.number(dd, "width", dw, positive=True)
             if at is None or width is None:
@@ -465,7 +452,7 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
 
 
 def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path) -> BodySpec | None:
-    rd.keys(d, OBJECT_KEYS if movable else BODY_KEYS, where)
+    rd.unknown_keys(d, OBJECT_KEYS if movable else BODY_KEYS, where)
     name = rd.name(d, where)
     colour = rd.colour(d, where, COLOURS["wood"] if not movable else COLOURS["orange"])
     forms = [k for k in ("shape", "parts", "urdf") if k in d]
@@ -493,7 +480,7 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
             pd = rd.mapping(rawp, plist.line_of(j), pw)
             if pd is None:
                 continue
-            rd.keys(pd, PART_KEYS, pw)
+            rd.unknown_keys(pd, PART_KEYS, pw)
             part = rd.shape(pd, pw, rd.colour(pd, pw, colour), with_offset=True)
             if part is not None:
                 parts.append(part)
@@ -582,7 +569,7 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
         d = rd.mapping(raw, robots.line_of(i), where)
         if d is None:
             continue
-        rd.keys(d, ROBOT_KEYS, where)
+        rd.unknown_keys(d, ROBOT_KEYS, where)
         name = rd.name(d, where)
         desc = d.get("description")
         if not isinstance(desc, str):
@@ -627,13 +614,13 @@ def parse_world(path: str | Path) -> WorldSpec:
             1,
             "a world file must be a YAML mapping (name, walls, furniture, objects, robots, poses)",
         )
-    rd.keys(data, TOP_KEYS, "the world")
+    rd.unknown_keys(data, TOP_KEYS, "the world")
     base = path.resolve().parent
     physics = PhysicsSpec()
     if "physics" in data:
         ph = rd.mapping(data["physics"], data.line_of("physics"), "physics")
         if ph is not None:
-            rd.keys(ph, PHYSICS_KEYS, "physics")
+            rd.unknown_keys(ph, PHYSICS_KEYS, "physics")
             physics.rate_hz = rd.number(ph, "rate_hz", "physics", 240.0, positive=True) or 240.0
             if "gravity" in ph:
                 g = rd.vector(ph["gravity"], 3, ph.line_of("gravity"), "physics.gravity")

@@ -103,3 +103,28 @@ def numbers_of(value: Any, n: int) -> tuple[float, ...] | None:
     if isinstance(value, list) and len(value) == n and all(is_number(v) for v in value):
         return tuple(float(v) for v in value)
     return None
+
+
+class ProblemCollector:
+    """Base of the readers of YAML input files: records every problem with file and line."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        self.problems: list[Problem] = []
+
+    def fail(self, line: int | None, message: str) -> None:
+        self.problems.append(Problem(str(self.path), line, message))
+
+    def unknown_keys(self, d: LineDict, allowed: set[str], where: str) -> None:
+        """One problem per key of ``d`` not in ``allowed``, with the closest known key."""
+        import difflib
+
+        for key in d:
+            if key not in allowed:
+                close = difflib.get_close_matches(key, sorted(allowed), n=1)
+                hint = (
+                    f"; did you mean '{close[0]}'?"
+                    if close
+                    else f"; allowed: {', '.join(sorted(allowed))}"
+                )
+                self.fail(d.line_of(key), f"unknown key '{key}' in {where}{hint}")
