@@ -192,20 +192,33 @@ def _material(rgba: tuple[float, ...]) -> dict[str, Any]:
     }
 
 
-def primitive_json(kind: str, size: tuple[float, ...], rgba: tuple[float, ...],
-                   matrix: np.ndarray) -> dict[str, Any]:
+def primitive_json(
+    kind: str, size: tuple[float, ...], rgba: tuple[float, ...], matrix: np.ndarray
+) -> dict[str, Any]:
     """A three.js object JSON for a box (full extents), cylinder (radius, length, axis z) or
     sphere (radius), placed by ``matrix`` in its node."""
     geom: dict[str, Any] = {"uuid": str(uuid.uuid4())}
     if kind == "box":
         geom.update(type="BoxGeometry", width=size[0], height=size[1], depth=size[2])
     elif kind == "cylinder":
-        geom.update(type="CylinderGeometry", radiusTop=size[0], radiusBottom=size[0],
-                    height=size[1], radialSegments=32)
+        geom.update(
+            type="CylinderGeometry",
+            radiusTop=size[0],
+            radiusBottom=size[0],
+            height=size[1],
+            radialSegments=32,
+        )
         matrix = matrix @ _X_TO_Z
     else:
         geom.update(type="SphereGeometry", radius=size[0], widthSegments=20, heightSegments=16)
     material = _material(rgba)
+    return _mesh_object(geom, material, matrix)
+
+
+def _mesh_object(
+    geom: dict[str, Any], material: dict[str, Any], matrix: np.ndarray
+) -> dict[str, Any]:
+    """A meshcat scene object: one geometry with one material at ``matrix``."""
     return {
         "metadata": {"version": 4.5, "type": "Object"},
         "geometries": [geom],
@@ -237,18 +250,7 @@ def _mesh_json(fmt: str, rgba: tuple[float, ...] | None, matrix: np.ndarray) -> 
         }
     geom = {"uuid": str(uuid.uuid4()), "type": "_meshfile_geometry", "format": fmt}
     material = _material(rgba or DEFAULT_RGBA)
-    return {
-        "metadata": {"version": 4.5, "type": "Object"},
-        "geometries": [geom],
-        "materials": [material],
-        "object": {
-            "uuid": str(uuid.uuid4()),
-            "type": "Mesh",
-            "geometry": geom["uuid"],
-            "material": material["uuid"],
-            "matrix": column_major(matrix),
-        },
-    }
+    return _mesh_object(geom, material, matrix)
 
 
 def _visual_object(path: str, body: str, visual: Visual, scale: float) -> SceneObject | None:
@@ -260,8 +262,9 @@ def _visual_object(path: str, body: str, visual: Visual, scale: float) -> SceneO
         if fmt is None:
             return None
         matrix = origin @ np.diag([*(s * scale for s in visual.scale), 1.0])
-        return SceneObject(path, _mesh_json(fmt, visual.rgba, matrix), body, visual.rgba,
-                           visual.mesh, fmt)
+        return SceneObject(
+            path, _mesh_json(fmt, visual.rgba, matrix), body, visual.rgba, visual.mesh, fmt
+        )
     size = tuple(v * scale for v in visual.size)
     rgba = visual.rgba or DEFAULT_RGBA
     return SceneObject(path, primitive_json(visual.kind, size, rgba, origin), body, rgba)
@@ -293,8 +296,9 @@ def _urdf_of(info: Any, world: Any) -> Path | None:
     return Path(urdf) if urdf is not None else None
 
 
-def _add_urdf_body(scene: Scene, world: Any, name: str, body_id: int, urdf: Path, scale: float,
-                   movable: bool) -> None:
+def _add_urdf_body(
+    scene: Scene, world: Any, name: str, body_id: int, urdf: Path, scale: float, movable: bool
+) -> None:
     c = world.client
     root_link = pb.getBodyInfo(body_id, physicsClientId=c)[0].decode()
     links = {root_link: -1}
@@ -351,8 +355,9 @@ def _add_primitive_body(scene: Scene, world: Any, info: Any, movable: bool) -> N
             continue
         indices.append(len(scene.objects))
         scene.objects.append(
-            SceneObject(f"{body_path}/v{k}", primitive_json(kind, size, rgba, local), info.name,
-                        rgba)  # type: ignore[arg-type]
+            SceneObject(
+                f"{body_path}/v{k}", primitive_json(kind, size, rgba, local), info.name, rgba
+            )  # type: ignore[arg-type]
         )
     if movable:
         scene._bodies.append(_BodyFrames(info.body_id, np.eye(4), [], len(scene.tracks)))
