@@ -15,7 +15,6 @@ from __future__ import annotations
 import contextlib
 import math
 import zlib
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -108,7 +107,6 @@ class World:
         self.robots: dict[str, Any] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
         self.models: dict[str, BodySpec] = {m.name: m for m in self.spec.models}
-        self._step_listeners: list[Callable[[World], None]] = []
         self.attachments = Attachments(self)
         try:
             self._setup_physics()
@@ -334,12 +332,6 @@ class World:
             self.step_count += 1
             self.clock.t = self.step_count * self.dt
             self.attachments.record_contacts()
-        for listener in self._step_listeners:
-            listener(self)
-
-    def add_step_listener(self, fn: Callable[[World], None]) -> None:
-        """Call ``fn(world)`` after every :meth:`step` call (viewers, recorders)."""
-        self._step_listeners.append(fn)
 
     @property
     def time(self) -> float:
