@@ -7,11 +7,11 @@ nesting depth and the number of elements, and records the line and column of eve
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from xml.parsers import expat
 
-from bt_manip.errors import Problem
+from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import read_bounded, size_text
 
 MAX_BYTES = 10 * 1024 * 1024
 MAX_DEPTH = 256
@@ -49,7 +49,8 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
     """Parse XML text into :class:`Element` objects; raises :class:`XmlError`."""
     data = text.encode("utf-8") if isinstance(text, str) else text
     if len(data) > MAX_BYTES:
-        raise XmlError(Problem(file, None, f"file is larger than {MAX_BYTES} bytes"))
+        raise XmlError(Problem(file, None,
+                               f"file is larger than the limit of {size_text(MAX_BYTES)}"))
     parser = expat.ParserCreate()
     stack: list[Element] = []
     roots: list[Element] = []
@@ -115,11 +116,7 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
 def parse_xml_file(path: str) -> Element:
     """Read and parse ``path``; raises :class:`XmlError` (also for a missing file)."""
     try:
-        size = os.path.getsize(path)
-        if size > MAX_BYTES:
-            raise XmlError(Problem(path, None, f"file is larger than {MAX_BYTES} bytes"))
-        with open(path, "rb") as f:
-            data = f.read()
-    except OSError as e:
-        raise XmlError(Problem(path, None, f"cannot read file: {e.strerror}")) from None
+        data = read_bounded(path, MAX_BYTES, "file")
+    except InputError as e:
+        raise XmlError(e.problems[0]) from None
     return parse_xml_text(data, path)

@@ -36,7 +36,9 @@ import defusedxml.ElementTree as SafeET
 
 from bt_manip.cache import cache_dir as shared_cache_dir
 from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import line_of_text, read_bounded
 from bt_manip.sim.assets import resolve_uri
+from bt_manip.sim.mesh_check import mesh_problem
 
 if TYPE_CHECKING:
     from bt_manip.sim.robot import RobotDescription
@@ -154,18 +156,15 @@ def _hash_inputs(recipe: dict, files: list[Path]) -> str:
     digest = hashlib.sha256(json.dumps(recipe, sort_keys=True, default=str).encode())
     for f in files:
         digest.update(str(f).encode())
-        digest.update(f.read_bytes())
+        digest.update(read_bounded(f, MAX_URDF_BYTES, "URDF file"))
     return digest.hexdigest()[:16]
 
 
 def _read_urdf(path: Path) -> ET.Element:
     """Parse a URDF (no entities), drop simulator-specific tags, make mesh paths absolute."""
-    if not path.is_file():
-        raise InputError.single(str(path), None, "URDF file not found")
-    if path.stat().st_size > MAX_URDF_BYTES:
-        raise InputError.single(str(path), None, f"URDF larger than {MAX_URDF_BYTES} bytes")
+    data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
     try:
-        root = SafeET.parse(str(path)).getroot()
+        root = SafeET.fromstring(data)
     except Exception as exc:  # defusedxml and expat raise several unrelated types
         raise InputError.single(str(path), None, f"unreadable URDF: {exc}") from None
     if root.tag != "robot":
@@ -181,8 +180,9 @@ def _read_urdf(path: Path) -> ET.Element:
     for mesh in root.iter("mesh"):
         uri = mesh.get("filename", "")
         resolved = resolve_uri(uri, path.parent)
-        if not resolved.is_file():
-            problems.append(Problem(str(path), None, f"mesh '{uri}' not found (at {resolved})"))
+        problem = mesh_problem(resolved, uri)
+        if problem is not None:
+            problems.append(Problem(str(path), line_of_text(data, uri), problem))
         mesh.set("filename", str(resolved))
     if problems:
         raise InputError(problems)

@@ -531,14 +531,20 @@ class Robot:
         path = composed_urdf(description)
         z = description.spawn_height if z is None else z
         flags = pb.URDF_USE_INERTIA_FROM_FILE
-        body = pb.loadURDF(
-            str(path),
-            basePosition=(x, y, z),
-            baseOrientation=pb.getQuaternionFromEuler((0.0, 0.0, yaw)),
-            useFixedBase=description.base.type == "fixed",
-            flags=flags,
-            physicsClientId=client,
-        )
+        try:
+            body = pb.loadURDF(
+                str(path),
+                basePosition=(x, y, z),
+                baseOrientation=pb.getQuaternionFromEuler((0.0, 0.0, yaw)),
+                useFixedBase=description.base.type == "fixed",
+                flags=flags,
+                physicsClientId=client,
+            )
+        except pb.error:
+            raise InputError.single(
+                str(description.path), None,
+                f"PyBullet cannot load the robot's URDF {path} (check its links and meshes)"
+            ) from None
         robot = cls(client, body, description)
         robot._apply_friction()
         robot._couple_fingers()

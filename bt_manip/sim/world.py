@@ -197,14 +197,20 @@ class World:
         c = self.client
         pos, quat = self._placed_pose(spec, offset)
         if spec.urdf is not None:
-            body = pb.loadURDF(
-                str(spec.urdf),
-                pos,
-                quat,
-                useFixedBase=not spec.movable,
-                globalScaling=spec.scale,
-                physicsClientId=c,
-            )
+            try:
+                body = pb.loadURDF(
+                    str(spec.urdf),
+                    pos,
+                    quat,
+                    useFixedBase=not spec.movable,
+                    globalScaling=spec.scale,
+                    physicsClientId=c,
+                )
+            except pb.error:
+                raise InputError.single(
+                    str(self.path), spec.line,
+                    f"'{spec.name}': PyBullet cannot load its URDF {spec.urdf} (check its links "
+                    "and meshes)") from None
         else:
             body = self._make_compound(spec, pos, quat)
         if spec.movable:

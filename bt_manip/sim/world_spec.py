@@ -522,21 +522,32 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
 
 
 def _check_urdf_meshes(urdf: Path) -> list[str]:
-    """Every mesh a URDF names must exist (relative to the file, or a known package URI)."""
+    """Every mesh a URDF names must exist (relative to the file, or a known package URI) and
+    be a mesh PyBullet reads; each problem names the URDF (and line) and the mesh."""
     import defusedxml.ElementTree as SafeET
 
+    from bt_manip.input_files import line_of_text, read_bounded
     from bt_manip.sim.assets import resolve_uri
+    from bt_manip.sim.compose import MAX_URDF_BYTES
+    from bt_manip.sim.mesh_check import mesh_problem
 
     try:
-        tree = SafeET.parse(urdf)
+        data = read_bounded(urdf, MAX_URDF_BYTES, "URDF file")
+    except InputError as exc:
+        return [exc.problems[0].message + f" ({urdf.name})"]
+    try:
+        root = SafeET.fromstring(data)
     except Exception as exc:
         return [f"cannot parse {urdf.name}: {exc}"]
-    names = dict.fromkeys(mesh.get("filename", "") for mesh in tree.getroot().iter("mesh"))
-    return [
-        f"mesh not found: {fn} (named in {urdf.name})"
-        for fn in names
-        if not resolve_uri(fn, urdf.parent).is_file()
-    ]
+    names = dict.fromkeys(mesh.get("filename", "") for mesh in root.iter("mesh"))
+    out = []
+    for fn in names:
+        problem = mesh_problem(resolve_uri(fn, urdf.parent), fn)
+        if problem is not None:
+            line = line_of_text(data, fn)
+            where = f"{urdf.name}:{line}" if line else urdf.name
+            out.append(f"{problem} (named in {where})")
+    return out
 
 
 def _find_robot(name: str, world_dir: Path) -> Path | None:

@@ -15,6 +15,7 @@ from typing import Any
 import yaml
 
 from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import read_bounded
 
 
 class LineDict(dict):
@@ -37,8 +38,50 @@ class LineList(list):
         return self.item_lines[index] if index < len(self.item_lines) else self.line
 
 
+MAX_YAML_BYTES = 1024 * 1024
+MAX_YAML_NODES = 100_000
+
+
+class _TooManyNodes(yaml.composer.ComposerError):
+    pass
+
+
 class _Loader(yaml.SafeLoader):
-    """Safe loader that keeps line numbers and refuses duplicate keys."""
+    """Safe loader that keeps line numbers, refuses duplicate keys and bounds the node count.
+
+    Aliases are counted once per use, as if expanded: while composing, each node's expanded
+    size (itself and everything below it) is known as soon as the node ends, and a document
+    whose expanded size passes :data:`MAX_YAML_NODES` is refused there, before any value is
+    constructed.
+    """
+
+    def __init__(self, stream: str) -> None:
+        super().__init__(stream)
+        self._sizes: dict[int, int] = {}
+
+    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
+        alias = self.check_event(yaml.AliasEvent)
+        mark = self.peek_event().start_mark
+        node = super().compose_node(parent, index)  # type: ignore[misc]
+        size = self._sizes.get(id(node))
+        if size is None:
+            if alias:  # an alias to a node still being composed: the value contains itself
+                raise yaml.composer.ComposerError(
+                    None, None, "an alias refers to a value that contains it", mark)
+            if isinstance(node, yaml.MappingNode):
+                size = 1 + sum(self._sizes.get(id(k), 1) + self._sizes.get(id(v), 1)
+                               for k, v in node.value)
+            elif isinstance(node, yaml.SequenceNode):
+                size = 1 + sum(self._sizes.get(id(v), 1) for v in node.value)
+            else:
+                size = 1
+            self._sizes[id(node)] = size
+        if size > MAX_YAML_NODES:
+            raise _TooManyNodes(
+                None, None,
+                f"more than {MAX_YAML_NODES} values once aliases are expanded (the limit of a "
+                "YAML input; an alias counts as a copy of what it names)", mark)
+        return node
 
 
 def _construct_mapping(loader: _Loader, node: yaml.MappingNode) -> LineDict:
@@ -69,17 +112,11 @@ def _construct_sequence(loader: _Loader, node: yaml.SequenceNode) -> LineList:
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
 
-MAX_YAML_BYTES = 4 * 1024 * 1024
-
-
 def load_yaml(path: str | Path) -> Any:
     """Read a YAML file; syntax errors become an InputError with the file and line."""
     path = Path(path)
-    if not path.is_file():
-        raise InputError.single(str(path), None, "file not found")
-    if path.stat().st_size > MAX_YAML_BYTES:
-        raise InputError.single(str(path), None, f"file larger than {MAX_YAML_BYTES} bytes")
-    text = path.read_text(encoding="utf-8", errors="replace")
+    data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
+    text = data.decode("utf-8", errors="replace")
     try:
         return yaml.load(text, Loader=_Loader)
     except yaml.MarkedYAMLError as exc:
@@ -88,6 +125,8 @@ def load_yaml(path: str | Path) -> Any:
         what = exc.problem or exc.context or "invalid YAML"
         if exc.context and exc.problem:
             what = f"{exc.context}, {exc.problem}"
+        if isinstance(exc, _TooManyNodes):
+            raise InputError([Problem(str(path), line, f"refused YAML: {what}")]) from None
         raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
     except yaml.YAMLError as exc:
         raise InputError([Problem(str(path), None, f"invalid YAML: {exc}")]) from None
