@@ -10,6 +10,7 @@ then instantiates the main tree, each ``<SubTree>`` instance getting its own cop
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterable
 from typing import Any
 
@@ -41,6 +42,13 @@ from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 from bt_manip.bt.xml_parse import Element
 from bt_manip.errors import InputError, Problem
+
+MAX_SUBTREE_DEPTH = 256
+"""SubTrees nested in SubTrees: at most this many levels (like the nesting of XML elements)."""
+MAX_NODE_DEPTH = 2048
+"""Nodes nested in nodes, SubTrees expanded: at most this many levels."""
+FRAMES_PER_LEVEL = 8
+"""Python frames that ticking, halting or walking one level of a tree may take."""
 
 EXPLICIT_TAGS = ("Action", "Condition", "Control", "Decorator")
 NAME_ATTRIBUTES = ("name", "ID")
@@ -165,27 +173,115 @@ class _Checker:
                 self.check_node(child, tree)
 
     def check_recursion(self) -> None:
+        """Report SubTree cycles, and chains of SubTrees nested deeper than the limit.
+
+        Iterative, so that a chain of thousands of SubTrees is reported, not a RecursionError.
+        """
         state: dict[str, int] = {}  # 1 = on the stack, 2 = done
+        depth: dict[str, int] = {}  # SubTree levels below each tree (cycles not counted)
+        nodes: dict[str, int] = {}  # nodes nested below each tree's root, SubTrees expanded
+        below: dict[str, str | None] = {}  # the tree through which the deepest chain goes
         reported: set[tuple[str, int]] = set()
+        for start in self.doc.trees:
+            if start in state:
+                continue
+            path = [start]
+            stack = [(start, 0)]
+            state[start] = 1
+            while stack:
+                tree_id, index = stack[-1]
+                edges = self.edges.get(tree_id, [])
+                if index < len(edges):
+                    stack[-1] = (tree_id, index + 1)
+                    target, element, file = edges[index]
+                    if state.get(target) == 1:
+                        key = (file, element.line)
+                        if key not in reported:
+                            reported.add(key)
+                            cycle = [*path[path.index(target):], target]
+                            self.add(file, element,
+                                     "recursive SubTree: " + " -> ".join(cycle)
+                                     + "; a tree cannot contain itself")
+                    elif target not in state:
+                        state[target] = 1
+                        path.append(target)
+                        stack.append((target, 0))
+                    continue
+                stack.pop()
+                path.pop()
+                state[tree_id] = 2
+                self._measure(tree_id, depth, nodes, below)
+        self._check_depth(depth, nodes, below)
 
-        def visit(tree_id: str, path: list[str]) -> None:
-            state[tree_id] = 1
-            for target, element, file in self.edges.get(tree_id, []):
-                if state.get(target) == 1:
-                    key = (file, element.line)
-                    if key not in reported:
-                        reported.add(key)
-                        cycle = [*path[path.index(target):], target]
-                        self.add(file, element,
-                                 "recursive SubTree: " + " -> ".join(cycle)
-                                 + "; a tree cannot contain itself")
-                elif state.get(target) is None:
-                    visit(target, [*path, target])
-            state[tree_id] = 2
+    def _measure(self, tree_id: str, depth: dict[str, int], nodes: dict[str, int],
+                 below: dict[str, str | None]) -> None:
+        """SubTree levels and node nesting of ``tree_id``, its SubTrees being measured."""
+        best, through = 0, None
+        for target, _element, _file in self.edges.get(tree_id, []):
+            if target in depth and depth[target] + 1 > best:
+                best, through = depth[target] + 1, target
+        depth[tree_id] = best
+        below[tree_id] = through
+        roots = self.doc.trees[tree_id].element.children
+        nodes[tree_id] = max((_nesting(root, nodes) for root in roots), default=0)
 
-        for tree_id in self.doc.trees:
-            if state.get(tree_id) is None:
-                visit(tree_id, [tree_id])
+    def _check_depth(self, depth: dict[str, int], nodes: dict[str, int],
+                     below: dict[str, str | None]) -> None:
+        deep = [t for t in self.doc.trees if depth.get(t, 0) > MAX_SUBTREE_DEPTH]
+        inner = {below[t] for t in deep}
+        for tree_id in deep:
+            if tree_id in inner:  # reported once, at the outermost tree of the chain
+                continue
+            chain = [tree_id]
+            while below.get(chain[-1]) is not None and len(chain) <= depth[tree_id]:
+                chain.append(below[chain[-1]])  # type: ignore[arg-type]
+            shown = " -> ".join(chain[:3]) + " -> ... -> " + " -> ".join(chain[-2:])
+            tree = self.doc.trees[tree_id]
+            element = next(e for t, e, _f in self.edges[tree_id] if t == chain[1])
+            self.add(tree.file, element,
+                     f"SubTrees nested {depth[tree_id]} levels deep ({shown}); bt-manip "
+                     f"allows at most {MAX_SUBTREE_DEPTH} levels of SubTree nesting")
+        if deep:
+            return
+        tree_id = max(self.doc.trees, key=lambda t: nodes.get(t, 0), default=None)
+        if tree_id is not None and nodes.get(tree_id, 0) > MAX_NODE_DEPTH:
+            tree = self.doc.trees[tree_id]
+            self.add(tree.file, tree.element,
+                     f"tree '{tree_id}' nests nodes {nodes[tree_id]} levels deep once its "
+                     f"SubTrees are expanded; bt-manip allows at most {MAX_NODE_DEPTH}")
+
+
+def _elements(root: Element) -> list[Element]:
+    out, stack = [], [root]
+    while stack:
+        element = stack.pop()
+        out.append(element)
+        stack.extend(element.children)
+    return out
+
+
+def allow_depth(levels: int) -> None:
+    """Raise Python's recursion limit so that a tree ``levels`` deep can be ticked and walked.
+
+    Ticking, halting, copying and drawing a tree recurse once per level; trees are bounded
+    (:data:`MAX_NODE_DEPTH`), so the limit stays bounded too.
+    """
+    need = min(levels, MAX_NODE_DEPTH) * FRAMES_PER_LEVEL + 1000
+    if sys.getrecursionlimit() < need:
+        sys.setrecursionlimit(need)
+
+
+def _nesting(root: Element, nodes: dict[str, int]) -> int:
+    """Depth of the node tree under ``root`` (1 for a leaf), SubTrees counted by ``nodes``."""
+    best = 0
+    stack = [(root, 1)]
+    while stack:
+        element, level = stack.pop()
+        if element.tag == SUBTREE_ID:
+            level += nodes.get(element.get("ID") or "", 0)
+        best = max(best, level)
+        stack.extend((child, level + 1) for child in element.children)
+    return best
 
 
 class _Rule:
@@ -278,6 +374,23 @@ class _Builder:
         node.xml_line = element.line
         return node
 
+    @staticmethod
+    def depth_of(doc: Document, tree_id: str) -> int:
+        """Nesting depth of the nodes of ``tree_id`` with its SubTrees expanded."""
+        memo: dict[str, int] = {}
+        order = [tree_id]
+        stack = [tree_id]
+        while stack:  # every tree reachable from tree_id (the checker refused cycles)
+            for element in _elements(doc.trees[stack.pop()].element):
+                target = element.get("ID") if element.tag == SUBTREE_ID else None
+                if target and target not in order:
+                    order.append(target)
+                    stack.append(target)
+        for tid in reversed(order):  # each tree after the trees it contains
+            memo[tid] = max((_nesting(r, memo) for r in doc.trees[tid].element.children),
+                            default=0)
+        return memo[tree_id]
+
     def _stand_in(self, node_id: str) -> type[BtNode]:
         if not self.placeholders:
             raise KeyError(node_id)
@@ -327,6 +440,7 @@ def load_tree(
     if problems:
         raise InputError(problems)
     assert main is not None
+    allow_depth(_Builder.depth_of(doc, main))
     root = _Builder(doc, reg, placeholders).tree_root(main)
     tree = Tree(root, context=context, blackboard=blackboard, tree_id=main, source=path)
     tree.warnings = doc.warnings  # type: ignore[attr-defined]
