@@ -45,11 +45,26 @@ def _positive(kind: type) -> Any:
     return convert
 
 
-def _bb_pair(text: str) -> tuple[str, str]:
+def _bb_pair(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE``; VALUE is read as a JSON scalar when it is one, else kept as text."""
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
         raise argparse.ArgumentTypeError(f"expected key=value, got '{text}'")
-    return key.strip(), value
+    return key.strip(), bb_value(value)
+
+
+def bb_value(text: str) -> Any:
+    """``1`` -> 1, ``2.5`` -> 2.5, ``true`` -> True, ``"a b"`` -> 'a b'; anything that is
+    not a JSON number, boolean or string (``abc``, ``[1]``, ``null``, ``NaN``) stays the text."""
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return text
+    if isinstance(value, float) and not math.isfinite(value):
+        return text  # json reads NaN and Infinity; keep them as text
+    if isinstance(value, bool | int | float | str):
+        return value
+    return text
 
 
 def _fault(text: str) -> Any:
@@ -103,7 +118,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_bb_pair,
         default=[],
         metavar="KEY=VALUE",
-        help="set a root blackboard entry before the first tick",
+        help="set a root blackboard entry before the first tick; VALUE is a JSON number, "
+        'true/false or "string" when it reads as one, else text',
     )
     run.add_argument("--bb-out", metavar="FILE.json", help="write the root blackboard at the end")
     run.add_argument("--report", metavar="FILE.json", help="write the run report as JSON")

@@ -24,7 +24,7 @@ class EpisodeSpec:
     seed: int = 0
     tree_id: str | None = None
     models: list[str] = field(default_factory=list)
-    blackboard: dict[str, str] = field(default_factory=dict)
+    blackboard: dict[str, Any] = field(default_factory=dict)
     inject: list[FaultSpec] = field(default_factory=list)
     options: RunOptions = field(default_factory=RunOptions)
 

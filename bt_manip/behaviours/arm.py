@@ -19,11 +19,14 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
+from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
 
-UNITS = PortInformation(str, False, "unit of targets: deg or rad", "deg")
-TOLERANCE = PortInformation(float, False, "how close each joint must get (rad)", 0.01)
-SPEED = PortInformation(float, False, "fraction of each joint's velocity limit, 0..1", 0.5)
-TIMEOUT = PortInformation(float, False, "sim seconds allowed per joint move", 10.0)
+UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
+TOLERANCE = Port(float, False, "how close each joint must get (rad)", 0.01, POSITIVE)
+SPEED = Port(
+    float, False, "fraction of each joint's velocity limit, 0..1", 0.5, Accepts(0, 1, low_open=True)
+)
+TIMEOUT = Port(float, False, "sim seconds allowed per joint move", 10.0, POSITIVE)
 CHECK = PortInformation(bool, False, "fail when the arm touches walls, furniture or floor", True)
 SETTLE_SPEED = 0.05
 """A joint counts as arrived when within tolerance and slower than this (rad/s)."""
@@ -182,8 +185,9 @@ class MoveJointsSequentially(JointMove):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
-        "order": PortInformation(
-            list[int], False, "joint indices in the order to move them (empty: 0, 1, ...)", []
+        "order": Port(
+            list[int], False, "joint indices in the order to move them (empty: 0, 1, ...)", [],
+            NON_NEGATIVE,
         ),
     }
 
@@ -256,7 +260,7 @@ class Lift(JointMove):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **JointMove.INPUT_PORTS,
         "deltas": PortInformation(list[float], False, "change of each arm joint", []),
-        "order": PortInformation(list[int], False, "joints in the order to move them", []),
+        "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
         "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
     }
 
@@ -325,13 +329,16 @@ class MoveToPose(JointMove):
         "free_yaw": PortInformation(
             bool, False, "leave the rotation about the tool axis free", False
         ),
-        "approach": PortInformation(float, False, "straight-line approach length (m)", 0.0),
-        "retreat": PortInformation(
-            float, False, "first back out this far along the tool axis (m)", 0.0
+        "approach": Port(
+            float, False, "straight-line approach length (m)", 0.0, NON_NEGATIVE
+        ),
+        "retreat": Port(
+            float, False, "first back out this far along the tool axis (m)", 0.0, NON_NEGATIVE
         ),
         "frame": PortInformation(str, False, "robot link to place (default: grasp frame)", ""),
-        "path": PortInformation(
-            str, False, "joint: interpolate joints; line: straight line from where it is", "joint"
+        "path": Port(
+            str, False, "joint: interpolate joints; line: straight line from where it is", "joint",
+            Accepts(choices=("joint", "line")),
         ),
     }
 

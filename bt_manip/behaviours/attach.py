@@ -13,6 +13,7 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.bt import registry
+from bt_manip.bt.ports import NON_NEGATIVE, Port
 from bt_manip.sim.attach import DEFAULT_MAX_DISTANCE
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")
@@ -31,8 +32,9 @@ class Attach(RobotAction):
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
         "link": PortInformation(str, False, "robot link to attach to (default: end effector)", ""),
-        "max_distance": PortInformation(
-            float, False, "farthest the object may be from a finger (m)", DEFAULT_MAX_DISTANCE
+        "max_distance": Port(
+            float, False, "farthest the object may be from a finger (m)", DEFAULT_MAX_DISTANCE,
+            NON_NEGATIVE,
         ),
     }
 

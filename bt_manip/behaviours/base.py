@@ -3,9 +3,9 @@ leaving the robot safe when halted.
 
 A robot behaviour is an :class:`~bt_manip.bt.ActionNode` whose ``robot`` port names a robot of
 the world (empty = the world's only robot). It never raises through the tree: anything that
-prevents the action (no world, unknown robot or object, unreachable target, time-out) makes it
-return FAILURE with the reason in ``feedback_message``, which the console and the run report
-show.
+prevents the action (no world, unknown robot or object, unreachable target, time-out, a port
+value read from the blackboard that the port cannot take) makes it return FAILURE with the
+reason in ``feedback_message``, which the console and the run report show.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from typing import Any, ClassVar
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt import ActionNode, ConditionNode
+from bt_manip.bt import ActionNode, ConditionNode, PortError
 
 ROBOT_PORT = PortInformation(
     data_type=str,
@@ -101,7 +101,7 @@ class RobotAction(WorldAccess, ActionNode):
             self.start()
             if self.CARRIES:
                 self._draw_slip()
-        except ActionFailed as exc:
+        except (ActionFailed, PortError) as exc:
             self._start_error = str(exc)
 
     def _draw_slip(self) -> None:
@@ -135,7 +135,7 @@ class RobotAction(WorldAccess, ActionNode):
             if self._slip is not None and self.now() >= self._slip[0]:
                 self._apply_slip()
             return self.step()
-        except ActionFailed as exc:
+        except (ActionFailed, PortError) as exc:
             self.feedback_message = str(exc)
             self._make_safe()
             return Status.FAILURE
@@ -174,7 +174,7 @@ class WorldCondition(WorldAccess, ConditionNode):
     def update(self) -> Status:
         try:
             ok, reason = self.check()
-        except ActionFailed as exc:
+        except (ActionFailed, PortError) as exc:
             ok, reason = False, str(exc)
         self.feedback_message = "" if ok else reason
         return Status.SUCCESS if ok else Status.FAILURE

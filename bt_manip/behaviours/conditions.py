@@ -10,6 +10,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
 from bt_manip.behaviours.gripper import held_object
 from bt_manip.bt import registry
+from bt_manip.bt.ports import NON_NEGATIVE, Port
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")
 
@@ -93,7 +94,7 @@ class ObjectAbove(WorldCondition):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "object": OBJECT,
-        "height": PortInformation(float, False, "clearance above the floor (m)", 0.1),
+        "height": Port(float, False, "clearance above the floor (m)", 0.1, NON_NEGATIVE),
     }
 
     def check(self) -> tuple[bool, str]:

@@ -9,7 +9,10 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.bt import registry
+from bt_manip.bt.ports import POSITIVE, Accepts, Port
 
+OPENING = Accepts(low=0, also=(-1,))
+"""An opening is a distance between the pads, or -1 (fully open or closed)."""
 SETTLED_SPEED = 0.002
 """The fingers count as stopped when the opening changes by less than this per tick (m)."""
 
@@ -27,7 +30,7 @@ class _GripperMove(RobotAction):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
-        "timeout": PortInformation(float, False, "sim seconds allowed", 3.0),
+        "timeout": Port(float, False, "sim seconds allowed", 3.0, POSITIVE),
     }
 
     def target(self, robot: Any) -> float:
@@ -69,7 +72,9 @@ class OpenGripper(_GripperMove):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **_GripperMove.INPUT_PORTS,
-        "opening": PortInformation(float, False, "opening between the pads (m); -1 = fully", -1.0),
+        "opening": Port(
+            float, False, "opening between the pads (m); -1 = fully", -1.0, OPENING
+        ),
     }
 
     def target(self, robot: Any) -> float:
@@ -88,7 +93,9 @@ class CloseGripper(_GripperMove):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **_GripperMove.INPUT_PORTS,
-        "opening": PortInformation(float, False, "target opening (m); -1 = fully closed", -1.0),
+        "opening": Port(
+            float, False, "target opening (m); -1 = fully closed", -1.0, OPENING
+        ),
         "require_object": PortInformation(
             bool, False, "fail when nothing is between the fingers", False
         ),

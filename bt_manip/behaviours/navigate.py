@@ -18,6 +18,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
+from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.navigator import Navigator
 from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
@@ -80,9 +81,13 @@ class Navigate(RobotAction):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
         "goal": PortInformation(str, True, "named world pose, or x;y;yaw"),
-        "xy_tolerance": PortInformation(float, False, "distance to the goal that counts (m)", 0.1),
-        "yaw_tolerance": PortInformation(float, False, "heading error that counts (rad)", 0.1),
-        "timeout": PortInformation(float, False, "sim seconds; 0 = from the path length", 0.0),
+        "xy_tolerance": Port(
+            float, False, "distance to the goal that counts (m)", 0.1, POSITIVE
+        ),
+        "yaw_tolerance": Port(float, False, "heading error that counts (rad)", 0.1, POSITIVE),
+        "timeout": Port(
+            float, False, "sim seconds; 0 = from the path length", 0.0, NON_NEGATIVE
+        ),
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "path_length": PortInformation(float, False, "length of the planned path (m)"),
@@ -211,9 +216,9 @@ class Reverse(RobotAction):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
-        "distance": PortInformation(float, False, "how far to reverse (m)", 0.5),
-        "speed": PortInformation(float, False, "reversing speed (m/s)", 0.2),
-        "timeout": PortInformation(float, False, "sim seconds allowed", 10.0),
+        "distance": Port(float, False, "how far to reverse (m)", 0.5, POSITIVE),
+        "speed": Port(float, False, "reversing speed (m/s)", 0.2, POSITIVE),
+        "timeout": Port(float, False, "sim seconds allowed", 10.0, POSITIVE),
     }
 
     def start(self) -> None:

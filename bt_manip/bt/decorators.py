@@ -10,8 +10,8 @@ from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
-from bt_manip.bt.node import BtNode, DecoratorNode
-from bt_manip.bt.ports import Ref
+from bt_manip.bt.node import BtNode, DecoratorNode, PortError
+from bt_manip.bt.ports import NON_NEGATIVE, Port, Ref
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
 from bt_manip.bt.status import NodeStatus
@@ -183,12 +183,14 @@ class Timeout(_Decorator):
     """Halts the child and returns FAILURE when it has been RUNNING for ``msec`` milliseconds.
 
     The time starts at the first tick; a child that finishes earlier returns its status. With
-    ``msec`` 0 there is no time limit.
+    ``msec`` 0 there is no time limit. A negative ``msec`` is refused at load; read from the
+    blackboard, it makes the node fail (halting the child) with the reason.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "msec": PortInformation(
-            int, description="after this many milliseconds, halt the child if still running"),
+        "msec": Port(
+            int, description="after this many milliseconds, halt the child if still running",
+            accepts=NON_NEGATIVE),
     }
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -198,7 +200,13 @@ class Timeout(_Decorator):
         self._started = False
 
     def tick_node(self) -> NodeStatus:
-        msec = self.get_input("msec")
+        try:
+            msec = self.get_input("msec")
+        except PortError as e:  # a blackboard value it cannot take
+            self.reset_child()
+            self._started = False
+            self.feedback_message = str(e)
+            return FAILURE
         if not self._started:
             self._started = True
             self._start()

@@ -8,8 +8,8 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.decorators import TIME_EPS, _ScriptHolder
-from bt_manip.bt.node import ActionNode, ConditionNode, TreeRuntimeError, _truth
-from bt_manip.bt.ports import InOutPortInformation, Literal, Ref
+from bt_manip.bt.node import ActionNode, ConditionNode, PortError, TreeRuntimeError, _truth
+from bt_manip.bt.ports import NON_NEGATIVE, InOutPortInformation, Literal, Port, Ref
 from bt_manip.bt.registry import registry
 
 Ports = dict[str, PortInformation]
@@ -113,19 +113,24 @@ class UnsetBlackboard(ActionNode):
 class Sleep(ActionNode):
     """Returns RUNNING until ``msec`` milliseconds of the tree's clock have passed, then SUCCESS.
 
-    The first tick always returns RUNNING (SUCCESS at once when ``msec`` <= 0). Halting it
-    stops the wait; the next start waits the full time again.
+    The first tick always returns RUNNING (SUCCESS at once when ``msec`` is 0). Halting it
+    stops the wait; the next start waits the full time again. A negative ``msec`` is refused
+    at load; read from the blackboard, it makes the node fail with the reason.
     """
 
     INPUT_PORTS: ClassVar[Ports] = {
-        "msec": PortInformation(int, description="milliseconds to wait")}
+        "msec": Port(int, description="milliseconds to wait", accepts=NON_NEGATIVE)}
 
     def initialise(self) -> None:
         self._start_time = self.now()
         self._first = True
 
     def update(self) -> Status:
-        msec = self.get_input("msec")
+        try:
+            msec = self.get_input("msec")
+        except PortError as e:  # a blackboard value it cannot take
+            self.feedback_message = str(e)
+            return Status.FAILURE
         if self._first:
             self._first = False
             return Status.SUCCESS if msec <= 0 else Status.RUNNING

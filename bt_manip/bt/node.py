@@ -45,6 +45,7 @@ from bt_manip.bt.ports import (
     convert_literal,
     format_literal,
     parse_reference,
+    value_problem,
 )
 from bt_manip.bt.script import Script, ScriptRuntimeError, ScriptSyntaxError, parse_script
 from bt_manip.bt.status import NodeStatus
@@ -194,8 +195,17 @@ class BtNode(PortsMixin):
             except ValueError as e:
                 check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {e}", None))
                 return
+            problem = value_problem(info, converted, value)
+            if problem is not None:
+                check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {problem}",
+                                     None))
+                return
             check.bindings[port] = Literal(converted)
             check.texts[port] = value
+            return
+        problem = value_problem(info, value)
+        if problem is not None:
+            check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {problem}", None))
             return
         check.bindings[port] = Literal(value)
         check.texts[port] = format_literal(value)
@@ -245,11 +255,15 @@ class BtNode(PortsMixin):
                 f"'{binding.key}', which does not exist") from None
         if isinstance(value, str) and info.data_type is not str:
             try:
-                return convert_literal(value, info.data_type)
+                value = convert_literal(value, info.data_type)
             except ValueError as e:
                 raise PortError(
                     f"{self.describe()}: input port '{port_name}' (entry '{binding.key}'): {e}"
                 ) from None
+        problem = value_problem(info, value)
+        if problem is not None:
+            raise PortError(
+                f"{self.describe()}: input port '{port_name}' (entry '{binding.key}'): {problem}")
         return value
 
     def set_output(self, port_name: str, value: Any) -> bool:

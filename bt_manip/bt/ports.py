@@ -8,6 +8,7 @@ named like the port) or ``{@key}`` (a key of the root blackboard).
 
 from __future__ import annotations
 
+import math
 import typing
 from dataclasses import dataclass
 from typing import Any, get_args, get_origin
@@ -20,6 +21,90 @@ from bt_manip.bt.status import NodeStatus
 @dataclass(frozen=True)
 class InOutPortInformation(PortInformation):
     """A port that is both read and written (BT.CPP's ``BidirectionalPort``)."""
+
+
+@dataclass(frozen=True)
+class Accepts:
+    """The values a port takes beyond its type: a range, a set of choices, or both.
+
+    ``low``/``high`` bound a number (inclusive, unless ``low_open``/``high_open``); ``choices``
+    lists the only values allowed; ``also`` lists values allowed outside the range (such as a
+    ``-1`` meaning "all"). For a list port the rule applies to each item. Numbers of a ``float``
+    port must be finite whatever the rule.
+    """
+
+    low: float | None = None
+    high: float | None = None
+    low_open: bool = False
+    high_open: bool = False
+    choices: tuple[Any, ...] = ()
+    also: tuple[Any, ...] = ()
+
+    def text(self) -> str:
+        """What is allowed, as the end of 'must be ...'."""
+        if self.choices:
+            return "one of " + ", ".join(format_literal(c) for c in self.choices)
+        parts = []
+        if self.low is not None and self.high is not None:
+            left = "(" if self.low_open else "["
+            right = ")" if self.high_open else "]"
+            parts.append(f"in {left}{self.low:g}, {self.high:g}{right}")
+        elif self.low is not None:
+            parts.append(f"{'>' if self.low_open else '>='} {self.low:g}")
+        elif self.high is not None:
+            parts.append(f"{'<' if self.high_open else '<='} {self.high:g}")
+        text = " and ".join(parts) or "any value"
+        if self.also:
+            text += " or " + " or ".join(format_literal(a) for a in self.also)
+        return text
+
+    def allows(self, value: Any) -> bool:
+        if value in self.also:
+            return True
+        if self.choices:
+            return value in self.choices
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            return True
+        if self.low is not None and (value < self.low or (self.low_open and value == self.low)):
+            return False
+        return not (self.high is not None
+                    and (value > self.high or (self.high_open and value == self.high)))
+
+
+NON_NEGATIVE = Accepts(low=0)
+POSITIVE = Accepts(low=0, low_open=True)
+
+
+@dataclass(frozen=True)
+class Port(PortInformation):
+    """An input port whose values must also satisfy ``accepts`` (checked at load for literals,
+    when read for blackboard values)."""
+
+    accepts: Accepts | None = None
+
+
+def value_problem(info: PortInformation, value: Any, text: str | None = None) -> str | None:
+    """Why ``value`` cannot go through the port ``info``, or None when it can.
+
+    ``text`` is the value as the user wrote it, shown in the message (default: its text form).
+    """
+    shown = text if text is not None else format_literal(value)
+    many = isinstance(value, list | tuple)
+    numeric = _carries_floats(info.data_type)
+    rule = getattr(info, "accepts", None)
+    for item in value if many else [value]:
+        if numeric and isinstance(item, float) and not math.isfinite(item):
+            return f"must be a finite number, got {shown}"
+        if rule is not None and not rule.allows(item):
+            each = "each value " if many else ""
+            return f"{each}must be {rule.text()}, got {shown}"
+    return None
+
+
+def _carries_floats(data_type: Any) -> bool:
+    if data_type is float:
+        return True
+    return any(_carries_floats(arg) for arg in get_args(data_type))
 
 
 @dataclass(frozen=True)
@@ -68,9 +153,12 @@ def convert_literal(text: str, data_type: Any) -> Any:
             raise ValueError(f"expected an integer, got '{text}'") from None
     if data_type is float:
         try:
-            return float(s)
+            number = float(s)
         except ValueError:
             raise ValueError(f"expected a number, got '{text}'") from None
+        if not math.isfinite(number):
+            raise ValueError(f"expected a finite number, got '{text}'")
+        return number
     if data_type is NodeStatus:
         return NodeStatus.parse(s)
     origin = get_origin(data_type)
