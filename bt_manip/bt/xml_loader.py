@@ -20,7 +20,7 @@ from py_trees.ports import PortInformation
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.documents import Document, TreeDef, read_document, read_model_file
-from bt_manip.bt.models import NodeSpec, spec_of
+from bt_manip.bt.models import NodeSpec, PortSpec, spec_of
 from bt_manip.bt.node import (
     IGNORED_ATTRIBUTES,
     POST_CONDITIONS,
@@ -36,6 +36,7 @@ from bt_manip.bt.node import (
     closest,
     parse_condition_scripts,
 )
+from bt_manip.bt.ports import convert_literal, parse_reference, type_from_name
 from bt_manip.bt.registry import SUBTREE_ID, NodeRegistry, registry
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
@@ -133,6 +134,11 @@ class _Checker:
                     check.errors.append(
                         (f"'{key}' is not a port of {spec.node_id} in its TreeNodesModel"
                          f"{closest(key, set(spec.ports))}; declared ports: {declared}", None))
+                else:
+                    problem = model_port_problem(spec.ports[key], attributes[key])
+                    if problem is not None:
+                        check.errors.append(
+                            (f"bad value for port '{key}' of {spec.node_id}: {problem}", None))
             if self.need_implementation:
                 check.errors.append(
                     (f"node '{spec.node_id}' is declared in a TreeNodesModel but has no "
@@ -282,6 +288,27 @@ def _nesting(root: Element, nodes: dict[str, int]) -> int:
         best = max(best, level)
         stack.extend((child, level + 1) for child in element.children)
     return best
+
+
+def model_port_problem(port: PortSpec, value: str) -> str | None:
+    """What is wrong with ``value`` for a port declared in a TreeNodesModel, or None."""
+    if parse_reference(value) is not None:
+        return None
+    if port.direction == "output":
+        return (f"an output port takes a blackboard reference like \"{{{port.name}}}\", "
+                f"got '{value}'")
+    data_type = type_from_name(port.type_name)
+    if data_type is object:
+        return None
+    declared = f"(its TreeNodesModel declares type=\"{port.type_name}\")"
+    try:
+        converted = convert_literal(value, data_type)
+    except ValueError as e:
+        return f"{e} {declared}"
+    unsigned = port.type_name.strip().startswith(("unsigned", "uint", "size_t"))
+    if unsigned and isinstance(converted, int) and converted < 0:
+        return f"expected a non-negative integer, got '{value}' {declared}"
+    return None
 
 
 class _Rule:
