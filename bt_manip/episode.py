@@ -11,7 +11,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.faults import FaultInjector, FaultSpec, check_targets
 from bt_manip.runner import Runner, RunOptions, RunReport
 
 
@@ -59,6 +59,8 @@ class Episode:
                 context=self.context,
                 blackboard=dict(spec.blackboard),
             )
+            nodes = self.tree.nodes()
+            check_targets(list(spec.inject), {n.name for n in nodes}, {n.NODE_ID for n in nodes})
         except BaseException:
             self.close()
             raise

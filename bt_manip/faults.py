@@ -17,6 +17,7 @@ run report.
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -58,6 +59,13 @@ def parse_fault(text: str) -> FaultSpec:
         kind, target, p_text = parts[0], "", parts[1]
     elif len(parts) == 3 and parts[1] == "failure" and parts[0]:
         kind, target, p_text = "failure", parts[0], parts[2]
+    elif len(parts) == 3 and parts[0]:
+        raise bad(f"unknown fault kind '{parts[1]}'{_close(parts[1], ['failure'])}")
+    elif len(parts) == 2 and parts[0]:
+        hint = _close(parts[0], list(WORLD_FAULTS))
+        if not hint:
+            hint = f" (for a node, write {parts[0]}:failure:{parts[1]})"
+        raise bad(f"unknown fault kind '{parts[0]}'{hint}")
     else:
         raise bad("not a fault specification")
     try:
@@ -67,6 +75,30 @@ def parse_fault(text: str) -> FaultSpec:
     if not 0.0 <= p <= 1.0:
         raise bad(f"probability {p} is not within 0..1")
     return FaultSpec(kind, p, target)
+
+
+def _close(word: str, choices: list[str]) -> str:
+    matches = difflib.get_close_matches(word, choices, n=3, cutoff=0.5)
+    return " (did you mean " + ", ".join(f"'{m}'" for m in matches) + "?)" if matches else ""
+
+
+def check_targets(specs: list[FaultSpec], names: set[str], ids: set[str]) -> None:
+    """InputError for each node failure aimed at no node of the tree (by name or node ID)."""
+    problems = []
+    for spec in specs:
+        if spec.kind != "failure" or spec.target in names or spec.target in ids:
+            continue
+        known = sorted(names | ids)
+        hint = _close(spec.target, known)
+        if not hint:
+            shown = ", ".join(known[:12]) + (", ..." if len(known) > 12 else "")
+            hint = f"; the tree's node names and IDs: {shown}"
+        problems.append(Problem(
+            "--inject", None,
+            f"'{spec.text()}': no node of the tree is named '{spec.target}' or has that node "
+            f"ID{hint}"))
+    if problems:
+        raise InputError(problems)
 
 
 @dataclass

@@ -33,8 +33,10 @@ def test_parse_fault(text: str, spec: FaultSpec) -> None:
     [
         ("Attach:failure:1.5", "not within 0..1"),
         ("Attach:failure:often", "is not a number"),
-        ("Attach:0.3", "not a fault specification"),
-        ("rain:0.3", "not a fault specification"),
+        ("Attach:0.3", "unknown fault kind 'Attach' (for a node, write Attach:failure:0.3)"),
+        ("rain:0.3", "unknown fault kind 'rain' (for a node, write rain:failure:0.3)"),
+        ("slp:0.3", "unknown fault kind 'slp' (did you mean 'slip'?)"),
+        ("Attach:failur:0.3", "unknown fault kind 'failur' (did you mean 'failure'?)"),
     ],
 )
 def test_bad_fault_is_an_input_error(text: str, why: str) -> None:
