@@ -20,6 +20,7 @@ from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.navigation.controller import FollowState
+from bt_manip.navigation.grid import GridTooLarge
 from bt_manip.navigation.navigator import Navigator
 from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
@@ -34,7 +35,10 @@ def navigator_for(world: Any, robot: Any) -> Navigator:
     movable objects now in it and what the robot now carries."""
     nav: Navigator | None = robot.__dict__.get("_navigator")
     if nav is None:
-        nav = Navigator(robot, world.obstacle_body_ids(), world.movable)
+        try:
+            nav = Navigator(robot, world.obstacle_body_ids(), world.movable)
+        except GridTooLarge as exc:
+            raise ActionFailed(str(exc)) from None
         robot.__dict__["_navigator"] = nav
     nav.movable = {b: n for n, b in world.movable.items()}
     name = next((n for n, r in world.robots.items() if r is robot), "")

@@ -34,7 +34,14 @@ DEFAULT_RESOLUTION = 0.05
 DEFAULT_BAND: ZBand = (0.02, 2.0)
 """Height band (m) looked at when none is given: from just above the floor to 2 m."""
 
+MAX_CELLS = 25_000_000
+"""Largest grid built (cells): at 0.05 m, a world of 250 m x 250 m."""
+
 _EPS = 1e-9
+
+
+class GridTooLarge(ValueError):
+    """The grid asked for has more than :data:`MAX_CELLS` cells; the message says why."""
 
 
 @dataclass
@@ -66,10 +73,19 @@ class OccupancyGrid:
         resolution: float = DEFAULT_RESOLUTION,
         band: ZBand = DEFAULT_BAND,
     ) -> OccupancyGrid:
-        """A free grid covering ``(xmin, ymin, xmax, ymax)`` (rounded out to whole cells)."""
+        """A free grid covering ``(xmin, ymin, xmax, ymax)`` (rounded out to whole cells).
+
+        Raises :class:`GridTooLarge` beyond :data:`MAX_CELLS` cells.
+        """
         xmin, ymin, xmax, ymax = extent
         cols = max(1, math.ceil((xmax - xmin) / resolution - 1e-9))
         rows = max(1, math.ceil((ymax - ymin) / resolution - 1e-9))
+        if rows * cols > MAX_CELLS:
+            raise GridTooLarge(
+                f"the occupancy grid would have {rows * cols:,} cells ({cols:,} x {rows:,}): the "
+                f"world spans x {xmin:.2f}..{xmax:.2f} m, y {ymin:.2f}..{ymax:.2f} m (obstacles "
+                f"plus margin) at a resolution of {resolution:g} m, and bt-manip allows at most "
+                f"{MAX_CELLS:,} cells; make the world smaller")
         return cls(
             (float(xmin), float(ymin)), float(resolution), np.zeros((rows, cols), bool), band
         )
