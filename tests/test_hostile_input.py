@@ -1,0 +1,334 @@
+"""Hostile input through the real command line: bounded, refused with file:line, no traceback.
+
+Each test writes its hostile files in ``tmp_path`` and runs ``bt_manip.cli.main`` in a child
+process limited to 1.5 GB of address space (a regression then fails the test instead of eating
+the machine) and bounded by a subprocess time-out. Several invocations share one child, which
+records for each its exit code, stdout, stderr and the child's peak memory so far.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import os
+import re
+import resource
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from typing import Any
+
+ROOT = Path(__file__).resolve().parents[1]
+ADDRESS_SPACE = 1536 * 1024 * 1024
+PER_CHECK_SECONDS = 5.0
+PEAK_MB = 1024
+
+DRIVER = textwrap.dedent(
+    """
+    import contextlib, io, json, resource, sys, time, traceback
+    from bt_manip.cli import main
+
+    results = []
+    for argv in json.load(open(sys.argv[1])):
+        out, err = io.StringIO(), io.StringIO()
+        start = time.monotonic()
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                code = main(argv)
+            except SystemExit as exc:
+                code = exc.code if isinstance(exc.code, int) else 2
+            except BaseException:
+                code = None
+                traceback.print_exc()
+        results.append({
+            "code": code, "out": out.getvalue(), "err": err.getvalue(),
+            "seconds": time.monotonic() - start,
+            "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        })
+    json.dump(results, open(sys.argv[2], "w"))
+    """
+)
+
+
+def _limit_memory() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+
+
+def _env() -> dict[str, str]:
+    return {**os.environ, "PYTHONPATH": str(ROOT)}
+
+
+def run_cli(tmp_path: Path, *invocations: list[str]) -> list[dict[str, Any]]:
+    """Run each argv through ``bt_manip.cli.main`` in one bounded child; their results."""
+    checks, results = tmp_path / "checks.json", tmp_path / "results.json"
+    checks.write_text(json.dumps([[str(a) for a in argv] for argv in invocations]))
+    done = subprocess.run(
+        [sys.executable, "-c", DRIVER, str(checks), str(results)],
+        preexec_fn=_limit_memory,
+        capture_output=True,
+        text=True,
+        timeout=30 + PER_CHECK_SECONDS * len(invocations),
+        env=_env(),
+        cwd=tmp_path,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "Traceback" not in done.stdout + done.stderr
+    out = json.loads(results.read_text())
+    for argv, result in zip(invocations, out, strict=True):
+        text = result["out"] + result["err"]
+        assert "Traceback" not in text, (argv, text[-3000:])
+        assert result["seconds"] < PER_CHECK_SECONDS, (argv, result["seconds"])
+        assert result["peak_mb"] < PEAK_MB, (argv, result["peak_mb"])
+    return out
+
+
+def _tree(path: Path, body: str, extra: str = "") -> Path:
+    path.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
+        f'  <BehaviorTree ID="Main">\n{body}\n  </BehaviorTree>\n{extra}</root>\n'
+    )
+    return path
+
+
+def _chain(path: Path, levels: int, leaf: str = "<AlwaysSuccess/>") -> Path:
+    """Main -> T1 -> ... -> T<levels>: each tree a Sequence holding the SubTree of the next."""
+    names = ["Main"] + [f"T{i}" for i in range(1, levels + 1)]
+    lines = ['<root BTCPP_format="4" main_tree_to_execute="Main">']
+    for here, below in itertools.pairwise(names):
+        lines.append(f'<BehaviorTree ID="{here}"><Sequence><SubTree ID="{below}"/></Sequence>'
+                     "</BehaviorTree>")
+    lines.append(f'<BehaviorTree ID="{names[-1]}">{leaf}</BehaviorTree>')
+    lines.append("</root>")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
+    chain256 = _chain(tmp_path / "chain256.xml", 256, '<Script code="@done := @depth + 1"/>')
+    chain400 = _chain(tmp_path / "chain400.xml", 400)
+    chain2000 = _chain(tmp_path / "chain2000.xml", 2000)
+    literals = _tree(tmp_path / "literals.xml", "\n".join([
+        "    <Sequence>",
+        '      <Timeout msec="-100"><AlwaysSuccess/></Timeout>',  # line 4
+        '      <CloseGripper timeout="-5"/>',
+        '      <Lift height="nan"/>',
+        '      <Lift height="inf"/>',
+        '      <MoveJoints targets="0;1;-inf" units="grad" speed="2"/>',
+        '      <OpenGripper opening="-0.5"/>',
+        '      <OpenGripper opening="-1"/>',  # fine: -1 means fully
+        '      <Sleep msec="-3"/>',
+        "    </Sequence>",
+    ]))
+    runtime = _tree(tmp_path / "runtime.xml", "\n".join([
+        "    <Sequence>",
+        '      <Script code="y := x + 1"/>',
+        '      <Timeout msec="{m}"><AlwaysSuccess/></Timeout>',  # line 5
+        "    </Sequence>",
+    ]))
+    models = tmp_path / "models.xml"
+    models.write_text(
+        '<root BTCPP_format="4"><TreeNodesModel>\n'
+        '  <Action ID="Grab">\n'
+        '    <input_port name="count" type="int"/>\n'
+        '    <input_port name="force" type="double"/>\n'
+        '    <input_port name="wait" type="unsigned int"/>\n'
+        '    <output_port name="result" type="std::string"/>\n'
+        "  </Action>\n"
+        "</TreeNodesModel></root>\n"
+    )
+    uses_model = _tree(tmp_path / "uses_model.xml", "\n".join([
+        "    <Sequence>",
+        '      <Grab count="three" force="nan" wait="-1" result="text"/>',  # line 4
+        '      <Grab count="{c}" force="2.5" wait="10" result="{r}"/>',
+        "    </Sequence>",
+    ]))
+    huge = tmp_path / "huge.xml"
+    huge.write_bytes(b"<root>" + b" " * (10 * 1024 * 1024) + b"</root>")
+    bb_out = tmp_path / "bb.json"
+
+    results = run_cli(
+        tmp_path,
+        ["run", "/dev/zero"],
+        ["validate", huge],
+        ["run", chain400, "--quiet"],
+        ["validate", chain2000],
+        ["validate", chain256],
+        ["run", chain256, "--quiet", "--bb", "depth=256", "--bb-out", bb_out],
+        ["validate", literals],
+        ["run", literals, "--quiet"],
+        ["run", runtime, "--quiet", "--bb", "x=1", "--bb", "m=-100"],
+        ["run", runtime, "--quiet", "--bb", "x=1", "--bb", "m=5", "--inject",
+         "Timeot:failure:0.5"],
+        ["run", runtime, "--quiet", "--inject", "NoSuchNode:failure:0.5"],
+        ["run", runtime, "--quiet", "--inject", "Script:failur:0.5"],
+        ["run", runtime, "--quiet", "--inject", "slp:0.5"],
+        ["validate", uses_model, "--models", models],
+    )
+    (dev_zero, huge_r, run400, val2000, val256, run256, val_lit, run_lit, bad_bb, typo,
+     no_node, bad_kind, bad_world_kind, model_types) = results
+
+    assert dev_zero["code"] == 2
+    assert dev_zero["err"] == "/dev/zero: file is a device, not a regular file\n"
+    assert huge_r["code"] == 2
+    assert huge_r["err"] == f"{huge}: file is larger than the limit of 10 MB\n"
+
+    deep = "allows at most 256 levels of SubTree nesting"
+    assert run400["code"] == 2
+    assert run400["err"].startswith(f"{chain400}:2: SubTrees nested 400 levels deep (Main -> T1")
+    assert deep in run400["err"]
+    assert val2000["code"] == 2
+    assert val2000["err"].startswith(f"{chain2000}:2: SubTrees nested 2000 levels deep")
+    assert val256["code"] == 0 and val256["out"] == f"{chain256}: OK\n"
+    assert run256["code"] == 0 and "result: SUCCESS" in run256["out"]
+    assert json.loads(bb_out.read_text())["done"] == 257
+
+    expected = [
+        f"{literals}:4: bad value for port 'msec' of Timeout: must be >= 0, got -100",
+        f"{literals}:5: bad value for port 'timeout' of CloseGripper: must be > 0, got -5",
+        f"{literals}:6: bad value for port 'height' of Lift: expected a finite number, got 'nan'",
+        f"{literals}:7: bad value for port 'height' of Lift: expected a finite number, got 'inf'",
+        f"{literals}:8: bad value for port 'speed' of MoveJoints: must be in (0, 1], got 2",
+        f"{literals}:8: bad value for port 'targets' of MoveJoints: expected a finite number, "
+        "got '-inf'",
+        f"{literals}:8: bad value for port 'units' of MoveJoints: must be one of deg, rad, "
+        "got grad",
+        f"{literals}:9: bad value for port 'opening' of OpenGripper: must be >= 0 or -1, "
+        "got -0.5",
+        f"{literals}:11: bad value for port 'msec' of Sleep: must be >= 0, got -3",
+    ]
+    for result in (val_lit, run_lit):
+        assert result["code"] == 2
+        assert sorted(result["err"].splitlines()) == sorted(expected)
+
+    assert bad_bb["code"] == 1
+    assert ("result: FAILURE (Sequence/Timeout: Timeout (line 5): input port 'msec' (entry "
+            "'m'): must be >= 0, got -100)") in bad_bb["out"]
+
+    assert typo["code"] == 2
+    assert typo["err"] == ("--inject: 'Timeot:failure:0.5': no node of the tree is named "
+                           "'Timeot' or has that node ID (did you mean 'Timeout'?)\n")
+    assert no_node["code"] == 2
+    assert no_node["err"].startswith("--inject: 'NoSuchNode:failure:0.5': no node of the tree")
+    assert "AlwaysSuccess, Script, Sequence, Timeout" in no_node["err"]
+    assert bad_kind["code"] == 2
+    assert "--inject: 'Script:failur:0.5': unknown fault kind 'failur' (did you mean " \
+           "'failure'?)" in bad_kind["err"]
+    assert bad_world_kind["code"] == 2
+    assert "unknown fault kind 'slp' (did you mean 'slip'?)" in bad_world_kind["err"]
+
+    assert model_types["code"] == 2
+    assert model_types["err"].splitlines() == [
+        f"{uses_model}:4: bad value for port 'count' of Grab: expected an integer, got 'three' "
+        '(its TreeNodesModel declares type="int")',
+        f"{uses_model}:4: bad value for port 'force' of Grab: expected a finite number, got "
+        "'nan' (its TreeNodesModel declares type=\"double\")",
+        f"{uses_model}:4: bad value for port 'wait' of Grab: expected a non-negative integer, "
+        "got '-1' (its TreeNodesModel declares type=\"unsigned int\")",
+        f"{uses_model}:4: bad value for port 'result' of Grab: an output port takes a blackboard "
+        "reference like \"{result}\", got 'text'",
+    ]
+
+
+def _alias_bomb(path: Path, depth: int = 9, width: int = 9) -> Path:
+    """A world whose poses nest aliases ``depth`` deep, each level ``width`` copies wide."""
+    lines = ["name: bomb", "poses:", "  a0: &a0 [0, 0, 0]"]
+    for i in range(1, depth + 1):
+        lines.append(f"  a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * width)}]")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+BAD_MESH_URDF = """<robot name="statue">
+  <link name="base">
+    <visual><geometry><mesh filename="{mesh}"/></geometry></visual>
+    <inertial><mass value="1"/>
+      <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+  </link>
+</robot>
+"""
+
+
+def _furniture_world(folder: Path, name: str, mesh: str) -> Path:
+    (folder / f"{name}.urdf").write_text(BAD_MESH_URDF.format(mesh=mesh))
+    world = folder / f"{name}.yaml"
+    world.write_text(f"name: {name}\nfurniture:\n  - name: statue\n    urdf: {name}.urdf\n"
+                     "    pose: [1, 0, 0]\n")
+    return world
+
+
+def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:
+    bomb = _alias_bomb(tmp_path / "bomb.yaml")
+    assert bomb.stat().st_size < 600
+    big = tmp_path / "big.yaml"
+    big.write_text("name: big\n" + "# padding\n" * 110_000)
+    (tmp_path / "statue.png").write_bytes(b"\x89PNG not a mesh")
+    (tmp_path / "statue.stl").write_text("this is not a mesh\n")
+    png = _furniture_world(tmp_path, "png_mesh", "statue.png")
+    garbage = _furniture_world(tmp_path, "garbage_mesh", "statue.stl")
+
+    results = run_cli(
+        tmp_path,
+        ["world", bomb],
+        ["world", big],
+        ["world", "/dev/zero"],
+        ["world", tmp_path],
+        ["world", png],
+        ["world", garbage],
+    )
+    r_bomb, r_big, r_zero, r_dir, r_png, r_garbage = results
+    assert r_bomb["code"] == 2
+    assert r_bomb["err"].startswith(f"{bomb}:")
+    assert "refused YAML: more than 100000 values once aliases are expanded" in r_bomb["err"]
+    assert len(r_bomb["err"]) < 400  # the expanded value is not printed
+    assert r_big["code"] == 2
+    assert r_big["err"] == f"{big}: YAML file is larger than the limit of 1 MB\n"
+    assert r_zero["code"] == 2
+    assert r_zero["err"] == "/dev/zero: YAML file is a device, not a regular file\n"
+    assert r_dir["code"] == 2
+    assert r_dir["err"] == f"{tmp_path}: YAML file is a directory, not a regular file\n"
+    assert r_png["code"] == 2
+    assert r_png["err"] == (
+        f"{png}:4: furniture[0].urdf: mesh 'statue.png' is not a mesh PyBullet reads; use an "
+        ".stl, .obj or .dae file (named in png_mesh.urdf:3)\n")
+    assert r_garbage["code"] == 2
+    assert r_garbage["err"] == (
+        f"{garbage}:4: furniture[0].urdf: mesh 'statue.stl' is not an STL mesh (no triangles "
+        "found in statue.stl) (named in garbage_mesh.urdf:3)\n")
+
+
+def test_navigate_in_a_world_too_large_for_its_grid_fails_with_the_extent(tmp_path: Path) -> None:
+    world = tmp_path / "square.yaml"
+    world.write_text(
+        "name: square\nwalls:\n"
+        "  - {name: north, from: [-2000, 2000], to: [2000, 2000], thickness: 0.15, height: 1.5}\n"
+        "  - {name: south, from: [-2000, -2000], to: [2000, -2000], thickness: 0.15, "
+        "height: 1.5}\n"
+        "robots:\n  - {name: husky, description: husky_ur3, pose: [0, 0, 0]}\n"
+    )
+    tree = _tree(tmp_path / "nav.xml", '    <Navigate goal="2;0;0"/>')
+    (result,) = run_cli(tmp_path, ["run", tree, "--world", world, "--quiet"])
+    assert result["code"] == 1
+    number = r"-?[0-9.]+"
+    assert re.search(
+        r"result: FAILURE \(Navigate: the occupancy grid would have 6,4[0-9,]+ cells "
+        rf"\(80,0[0-9,]+ x 80,0[0-9,]+\): the world spans x {number}\.\.{number} m, "
+        rf"y {number}\.\.{number} m \(obstacles plus margin\) at a resolution of 0\.05 m, and "
+        r"bt-manip allows at most 25,000,000 cells; make the world smaller\)",
+        result["out"],
+    ), result["out"]
+
+
+def test_the_console_script_refuses_a_device_without_a_traceback(tmp_path: Path) -> None:
+    done = subprocess.run(
+        [sys.executable, "-m", "bt_manip.cli", "run", "/dev/zero"],
+        preexec_fn=_limit_memory,
+        capture_output=True,
+        text=True,
+        timeout=30,
+        env=_env(),
+        cwd=tmp_path,
+    )
+    assert done.returncode == 2
+    assert done.stderr == "/dev/zero: file is a device, not a regular file\n"
+    assert "Traceback" not in done.stdout
