@@ -297,6 +297,22 @@ def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:
         "found in statue.stl) (named in garbage_mesh.urdf:3)\n")
 
 
+def test_robot_nodes_fail_with_the_reason_on_bad_blackboard_values(tmp_path: Path) -> None:
+    tree = _tree(tmp_path / "grip.xml", '    <CloseGripper timeout="{t}"/>')
+    table = ROOT / "worlds" / "sawyer_table.yaml"
+    negative, text = run_cli(
+        tmp_path,
+        ["run", tree, "--world", table, "--quiet", "--bb", "t=-5"],
+        ["run", tree, "--world", table, "--quiet", "--bb", "t=nan"],
+    )
+    assert negative["code"] == 1
+    assert ("result: FAILURE (CloseGripper: CloseGripper (line 3): input port 'timeout' "
+            "(entry 't'): must be > 0, got -5)") in negative["out"]
+    assert text["code"] == 1
+    assert ("result: FAILURE (CloseGripper: CloseGripper (line 3): input port 'timeout' "
+            "(entry 't'): expected a finite number, got 'nan')") in text["out"]
+
+
 def test_navigate_in_a_world_too_large_for_its_grid_fails_with_the_extent(tmp_path: Path) -> None:
     world = tmp_path / "square.yaml"
     world.write_text(
@@ -332,3 +348,37 @@ def test_the_console_script_refuses_a_device_without_a_traceback(tmp_path: Path)
     assert done.returncode == 2
     assert done.stderr == "/dev/zero: file is a device, not a regular file\n"
     assert "Traceback" not in done.stdout
+
+
+def test_bb_values_are_json_scalars_or_text() -> None:
+    from bt_manip.cli import bb_value
+
+    assert [bb_value(t) for t in ("1", "2.5", "true", '"1"', "-3")] == [1, 2.5, True, "1", -3]
+    assert [bb_value(t) for t in ("kitchen", "[1, 2]", "null", "NaN", "")] == [
+        "kitchen", "[1, 2]", "null", "NaN", ""]
+
+
+def test_yaml_values_are_counted_with_aliases_expanded(tmp_path: Path) -> None:
+    import pytest
+
+    from bt_manip.errors import InputError
+    from bt_manip.sim.yaml_lines import MAX_YAML_NODES, load_yaml
+
+    # a list of n aliases to a 3-number list: 1 + n * 4 values, so n = 24,999 is the last fit
+    def aliases(n: int) -> Path:
+        path = tmp_path / f"aliases{n}.yaml"
+        path.write_text("a: &a [0, 0, 0]\nb: [" + ", ".join(["*a"] * n) + "]\n")
+        return path
+
+    fits = (MAX_YAML_NODES - 1 - 2 - 4 - 1) // 4  # mapping, key a + its list, key b, list b
+    assert len(load_yaml(aliases(fits))["b"]) == fits
+    for n, line in ((fits + 1, 1), (MAX_YAML_NODES // 4, 2)):  # the whole file; list b alone
+        with pytest.raises(InputError) as err:
+            load_yaml(aliases(n))
+        (problem,) = err.value.problems
+        assert problem.line == line and "more than 100000 values" in problem.message
+    looped = tmp_path / "looped.yaml"
+    looped.write_text("a: &a [1, *a]\n")
+    with pytest.raises(InputError) as err:
+        load_yaml(looped)
+    assert "an alias refers to a value that contains it" in str(err.value)
