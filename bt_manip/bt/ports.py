@@ -9,6 +9,7 @@ named like the port) or ``{@key}`` (a key of the root blackboard).
 from __future__ import annotations
 
 import math
+import numbers
 import typing
 from dataclasses import dataclass
 from typing import Any, get_args, get_origin
@@ -59,11 +60,14 @@ class Accepts:
         return text
 
     def allows(self, value: Any) -> bool:
+        """Whether a scalar ``value`` passes (values of other kinds are left to the node)."""
+        if not isinstance(value, numbers.Real | str) or isinstance(value, bool):
+            return True
         if value in self.also:
             return True
         if self.choices:
             return value in self.choices
-        if not isinstance(value, int | float) or isinstance(value, bool):
+        if isinstance(value, str):
             return True
         if self.low is not None and (value < self.low or (self.low_open and value == self.low)):
             return False
@@ -93,7 +97,8 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
     numeric = _carries_floats(info.data_type)
     rule = getattr(info, "accepts", None)
     for item in value if many else [value]:
-        if numeric and isinstance(item, float) and not math.isfinite(item):
+        if (numeric and isinstance(item, numbers.Real) and not isinstance(item, bool)
+                and not math.isfinite(item)):
             return f"must be a finite number, got {shown}"
         if rule is not None and not rule.allows(item):
             each = "each value " if many else ""
