@@ -146,10 +146,13 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
     huge = tmp_path / "huge.xml"
     huge.write_bytes(b"<root>" + b" " * (10 * 1024 * 1024) + b"</root>")
     bb_out = tmp_path / "bb.json"
+    fifo = tmp_path / "fifo.xml"
+    os.mkfifo(fifo)
 
     results = run_cli(
         tmp_path,
         ["run", "/dev/zero"],
+        ["validate", fifo],
         ["validate", huge],
         ["run", chain400, "--quiet"],
         ["validate", chain2000],
@@ -165,11 +168,13 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         ["run", runtime, "--quiet", "--inject", "slp:0.5"],
         ["validate", uses_model, "--models", models],
     )
-    (dev_zero, huge_r, run400, val2000, val256, run256, val_lit, run_lit, bad_bb, typo,
+    (dev_zero, fifo_r, huge_r, run400, val2000, val256, run256, val_lit, run_lit, bad_bb, typo,
      no_node, bad_kind, bad_world_kind, model_types) = results
 
     assert dev_zero["code"] == 2
     assert dev_zero["err"] == "/dev/zero: file is a device, not a regular file\n"
+    assert fifo_r["code"] == 2
+    assert fifo_r["err"] == f"{fifo}: file is a pipe, not a regular file\n"
     assert huge_r["code"] == 2
     assert huge_r["err"] == f"{huge}: file is larger than the limit of 10 MB\n"
 
