@@ -145,6 +145,18 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
     ]))
     huge = tmp_path / "huge.xml"
     huge.write_bytes(b"<root>" + b" " * (10 * 1024 * 1024) + b"</root>")
+    includes = tmp_path / "includes"
+    includes.mkdir()
+    for i in range(300):  # i.xml includes i+1.xml, 300 levels deep
+        _include_file(includes / f"{i}.xml", f"{i + 1}.xml")
+    _tree(includes / "300.xml", "    <AlwaysSuccess/>")
+    diamond = tmp_path / "diamond"
+    diamond.mkdir()
+    for i in range(40):  # 2 ** 40 reads if a file included twice were read twice
+        _include_file(diamond / f"f{i}.xml", f"a{i}.xml", f"b{i}.xml")
+        _include_file(diamond / f"a{i}.xml", f"f{i + 1}.xml")
+        _include_file(diamond / f"b{i}.xml", f"f{i + 1}.xml")
+    _tree(diamond / "f40.xml", "    <AlwaysSuccess/>")
     bb_out = tmp_path / "bb.json"
     fifo = tmp_path / "fifo.xml"
     os.mkfifo(fifo)
@@ -167,9 +179,11 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         ["run", runtime, "--quiet", "--inject", "Script:failur:0.5"],
         ["run", runtime, "--quiet", "--inject", "slp:0.5"],
         ["validate", uses_model, "--models", models],
+        ["validate", includes / "0.xml"],
+        ["run", diamond / "f0.xml", "--quiet"],
     )
     (dev_zero, fifo_r, huge_r, run400, val2000, val256, run256, val_lit, run_lit, bad_bb, typo,
-     no_node, bad_kind, bad_world_kind, model_types) = results
+     no_node, bad_kind, bad_world_kind, model_types, deep_includes, twice) = results
 
     assert dev_zero["code"] == 2
     assert dev_zero["err"] == "/dev/zero: file is a device, not a regular file\n"
@@ -233,6 +247,20 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         f"{uses_model}:4: bad value for port 'result' of Grab: an output port takes a blackboard "
         "reference like \"{result}\", got 'text'",
     ]
+
+    assert deep_includes["code"] == 2
+    assert deep_includes["err"] == (f"{includes / '256.xml'}:1: includes nested deeper than 256 "
+                                    "levels; bt-manip reads at most that many\n")
+    assert twice["code"] == 2
+    assert len(twice["err"].splitlines()) == 40
+    assert twice["err"].startswith(
+        f"{diamond / 'b0.xml'}:1: 'f1.xml' is already included (at {diamond / 'a0.xml'}:1); "
+        "include each file once, its trees would be defined twice\n")
+
+
+def _include_file(path: Path, *targets: str) -> None:
+    path.write_text('<root BTCPP_format="4">'
+                    + "".join(f'<include path="{t}"/>' for t in targets) + "</root>\n")
 
 
 def _alias_bomb(path: Path, depth: int = 9, width: int = 9) -> Path:

@@ -1,7 +1,8 @@
 """Reading BT.CPP v4 XML documents: ``<root>``, ``<include>``, trees and node models.
 
 :func:`read_document` gathers every ``<BehaviorTree>`` and ``<TreeNodesModel>`` of a file and
-of the files it includes (paths relative to the including file, recursively, cycles refused),
+of the files it includes (paths relative to the including file, recursively; cycles, a file
+included twice and includes nested deeper than :data:`MAX_INCLUDE_DEPTH` are refused),
 collecting every problem instead of stopping at the first one.
 """
 
@@ -13,6 +14,9 @@ from dataclasses import dataclass, field
 from bt_manip.bt.models import NodeSpec, read_models
 from bt_manip.bt.xml_parse import Element, XmlError, parse_xml_file, parse_xml_text
 from bt_manip.errors import Problem
+
+MAX_INCLUDE_DEPTH = 256
+"""Files including files including files...: at most this many levels (like XML nesting)."""
 
 
 @dataclass
@@ -31,6 +35,7 @@ class Document:
     root_line: int = 1
     problems: list[Problem] = field(default_factory=list)
     warnings: list[Problem] = field(default_factory=list)
+    included: dict[str, str] = field(default_factory=dict)  # real path -> where first included
 
 
 def read_document(path: str, text: str | None = None) -> Document:
@@ -129,6 +134,18 @@ def _include(doc: Document, path: str, element: Element, stack: tuple[str, ...])
         doc.problems.append(Problem(path, element.line, f"include cycle: {chain}; remove one of "
                                                         "these includes"))
         return
+    if real in doc.included:
+        first = doc.included[real]
+        doc.problems.append(Problem(path, element.line,
+                                    f"'{target}' is already included (at {first}); include each "
+                                    "file once, its trees would be defined twice"))
+        return
+    if len(stack) > MAX_INCLUDE_DEPTH:
+        doc.problems.append(Problem(path, element.line,
+                                    f"includes nested deeper than {MAX_INCLUDE_DEPTH} levels; "
+                                    "bt-manip reads at most that many"))
+        return
+    doc.included[real] = f"{path}:{element.line}"
     _read_into(doc, resolved, None, stack, top=False)
 
 
