@@ -157,6 +157,15 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         _include_file(diamond / f"a{i}.xml", f"f{i + 1}.xml")
         _include_file(diamond / f"b{i}.xml", f"f{i + 1}.xml")
     _tree(diamond / "f40.xml", "    <AlwaysSuccess/>")
+    scripts = _tree(tmp_path / "scripts.xml", "\n".join([
+        "    <Sequence>",
+        '      <Script code="x := ' + "(" * 5000 + "1" + ")" * 5000 + '"/>',  # line 4
+        '      <Script code="x := ' + "-" * 5000 + '1"/>',
+        '      <Script code="x := 1' + " + 1" * 20000 + '"/>',
+        '      <AlwaysSuccess _skipIf="' + "!" * 200 + 'true"/>',
+        '      <Script code="x := ' + "(" * 20 + "1" + " + 1" * 90 + ")" * 20 + '"/>',  # fine
+        "    </Sequence>",
+    ]))
     bb_out = tmp_path / "bb.json"
     fifo = tmp_path / "fifo.xml"
     os.mkfifo(fifo)
@@ -181,9 +190,10 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         ["validate", uses_model, "--models", models],
         ["validate", includes / "0.xml"],
         ["run", diamond / "f0.xml", "--quiet"],
+        ["validate", scripts],
     )
     (dev_zero, fifo_r, huge_r, run400, val2000, val256, run256, val_lit, run_lit, bad_bb, typo,
-     no_node, bad_kind, bad_world_kind, model_types, deep_includes, twice) = results
+     no_node, bad_kind, bad_world_kind, model_types, deep_includes, twice, deep_scripts) = results
 
     assert dev_zero["code"] == 2
     assert dev_zero["err"] == "/dev/zero: file is a device, not a regular file\n"
@@ -256,6 +266,18 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
     assert twice["err"].startswith(
         f"{diamond / 'b0.xml'}:1: 'f1.xml' is already included (at {diamond / 'a0.xml'}:1); "
         "include each file once, its trees would be defined twice\n")
+
+    unparsable = ("expression nested too deeply to parse (parentheses or operators); split it "
+                  "into several statements (column 1 of the script)")
+    too_deep = ("expression nested deeper than 100 levels; split it into several statements "
+                "(column 1 of the script)")
+    assert deep_scripts["code"] == 2
+    assert deep_scripts["err"].splitlines() == [
+        f"{scripts}:4: script syntax error in code of Script: {unparsable}",
+        f"{scripts}:5: script syntax error in code of Script: {unparsable}",
+        f"{scripts}:6: script syntax error in code of Script: {too_deep}",
+        f"{scripts}:7: script syntax error in _skipIf of AlwaysSuccess: {too_deep}",
+    ]
 
 
 def _include_file(path: Path, *targets: str) -> None:

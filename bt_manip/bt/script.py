@@ -20,6 +20,7 @@ variable, bad operand types) are :class:`ScriptRuntimeError`.
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -522,9 +523,55 @@ class _Parser:
         raise self.error("expected a value (number, 'string', true/false, name or '(')")
 
 
+MAX_SCRIPT_DEPTH = 100
+"""Expressions nested in expressions (parentheses, operators, operands): at most this deep."""
+
+
 def parse_script(code: str) -> Script:
-    """Parse ``code``; raises :class:`ScriptSyntaxError` (with column) when it is not valid."""
-    return Script(code, _Parser(code).parse())
+    """Parse ``code``; raises :class:`ScriptSyntaxError` (with column) when it is not valid.
+
+    A script nested deeper than :data:`MAX_SCRIPT_DEPTH` is refused, so that neither parsing
+    nor running it can exhaust Python's stack.
+    """
+    try:
+        statements = _parse_in_budget(code)
+    except RecursionError:
+        raise ScriptSyntaxError("expression nested too deeply to parse (parentheses or "
+                                "operators); split it into several statements", 1) from None
+    if any(_depth(statement) > MAX_SCRIPT_DEPTH for statement in statements):
+        raise ScriptSyntaxError(f"expression nested deeper than {MAX_SCRIPT_DEPTH} levels; "
+                                "split it into several statements", 1)
+    return Script(code, statements)
+
+
+PARSE_FRAMES = 4000
+"""Python frames the parser may use, whatever the process did before (so a script is accepted
+or refused the same way in every process)."""
+
+
+def _parse_in_budget(code: str) -> list[Expr]:
+    depth, frame = 0, sys._getframe()
+    while frame is not None:
+        depth, frame = depth + 1, frame.f_back
+    old = sys.getrecursionlimit()
+    sys.setrecursionlimit(depth + PARSE_FRAMES)
+    try:
+        return _Parser(code).parse()
+    finally:
+        sys.setrecursionlimit(old)
+
+
+def _depth(root: Expr) -> int:
+    """Nesting depth of an expression tree, measured without recursion."""
+    best = 0
+    stack: list[tuple[Any, int]] = [(root, 1)]
+    while stack:
+        node, level = stack.pop()
+        best = max(best, level)
+        for value in vars(node).values():
+            items = value if isinstance(value, list) else [value]
+            stack.extend((item, level + 1) for item in items if isinstance(item, Expr))
+    return best
 
 
 def run_script(code: str, env: Variables) -> Any:
