@@ -46,42 +46,54 @@ class _TooManyNodes(yaml.composer.ComposerError):
     pass
 
 
-class _Loader(yaml.SafeLoader):
-    """Safe loader that keeps line numbers, refuses duplicate keys and bounds the node count.
+_BaseLoader: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when installed
 
-    Aliases are counted once per use, as if expanded: while composing, each node's expanded
-    size (itself and everything below it) is known as soon as the node ends, and a document
-    whose expanded size passes :data:`MAX_YAML_NODES` is refused there, before any value is
-    constructed.
+
+class _Loader(_BaseLoader):  # type: ignore[misc, valid-type]
+    """Safe loader that keeps line numbers and refuses duplicate keys (libyaml's parser when
+    available: pure-Python PyYAML takes several seconds for a 1 MB file)."""
+
+
+def check_size(root: yaml.Node) -> None:
+    """Refuse a composed document whose values, aliases expanded, pass :data:`MAX_YAML_NODES`.
+
+    Composing shares the node an alias names, so the graph is as small as the file; its
+    expanded size is counted on the graph (each node once, bottom-up, without recursion) and
+    the first node whose size passes the limit is refused, before any value is constructed.
+    A value that contains itself through an alias is refused too.
     """
+    sizes: dict[int, int] = {}
+    opened: set[int] = set()  # nodes whose children are being counted
+    stack: list[tuple[yaml.Node, bool]] = [(root, False)]
+    while stack:
+        node, children_done = stack.pop()
+        key = id(node)
+        if children_done:
+            opened.discard(key)
+            size = 1 + sum(sizes[id(child)] for child in _children(node))
+            if size > MAX_YAML_NODES:
+                raise _TooManyNodes(
+                    None, None,
+                    f"more than {MAX_YAML_NODES} values (the limit of a YAML input; each use "
+                    "of an alias counts as a copy of what it names)", node.start_mark)
+            sizes[key] = size
+            continue
+        if key in sizes:
+            continue
+        if key in opened:  # reached again from below itself
+            raise yaml.composer.ComposerError(
+                None, None, "an alias refers to a value that contains it", node.start_mark)
+        opened.add(key)
+        stack.append((node, True))
+        stack.extend((child, False) for child in _children(node) if id(child) not in sizes)
 
-    def __init__(self, stream: str) -> None:
-        super().__init__(stream)
-        self._sizes: dict[int, int] = {}
 
-    def compose_node(self, parent: yaml.Node | None, index: object) -> yaml.Node:
-        alias = self.check_event(yaml.AliasEvent)
-        mark = self.peek_event().start_mark
-        node = super().compose_node(parent, index)  # type: ignore[misc]
-        size = self._sizes.get(id(node))
-        if size is None:
-            if alias:  # an alias to a node still being composed: the value contains itself
-                raise yaml.composer.ComposerError(
-                    None, None, "an alias refers to a value that contains it", mark)
-            if isinstance(node, yaml.MappingNode):
-                size = 1 + sum(self._sizes.get(id(k), 1) + self._sizes.get(id(v), 1)
-                               for k, v in node.value)
-            elif isinstance(node, yaml.SequenceNode):
-                size = 1 + sum(self._sizes.get(id(v), 1) for v in node.value)
-            else:
-                size = 1
-            self._sizes[id(node)] = size
-        if size > MAX_YAML_NODES:
-            raise _TooManyNodes(
-                None, None,
-                f"more than {MAX_YAML_NODES} values once aliases are expanded (the limit of a "
-                "YAML input; an alias counts as a copy of what it names)", mark)
-        return node
+def _children(node: yaml.Node) -> list[yaml.Node]:
+    if isinstance(node, yaml.MappingNode):
+        return [part for pair in node.value for part in pair]
+    if isinstance(node, yaml.SequenceNode):
+        return list(node.value)
+    return []
 
 
 def _construct_mapping(loader: _Loader, node: yaml.MappingNode) -> LineDict:
@@ -117,8 +129,13 @@ def load_yaml(path: str | Path) -> Any:
     path = Path(path)
     data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
     text = data.decode("utf-8", errors="replace")
+    loader = _Loader(text)
     try:
-        return yaml.load(text, Loader=_Loader)
+        root = loader.get_single_node()
+        if root is None:
+            return None
+        check_size(root)
+        return loader.construct_document(root)
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -130,6 +147,8 @@ def load_yaml(path: str | Path) -> Any:
         raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
     except yaml.YAMLError as exc:
         raise InputError([Problem(str(path), None, f"invalid YAML: {exc}")]) from None
+    finally:
+        loader.dispose()
 
 
 def is_number(value: Any) -> bool:
