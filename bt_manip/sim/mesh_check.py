@@ -2,8 +2,9 @@
 
 PyBullet refuses a URDF whose mesh has an extension it does not know (``pybullet.error``, with
 no word of which mesh), and silently loads a body without geometry when an ``.stl``, ``.obj``
-or ``.dae`` file holds something else. :func:`mesh_problem` finds both before PyBullet sees the
-file, so the message can name the URDF and the mesh.
+or ``.dae`` file holds something else. :func:`mesh_problem` finds both (and meshes larger than
+:data:`MAX_MESH_BYTES`) before PyBullet sees the file, so the message can name the URDF and the
+mesh.
 """
 
 from __future__ import annotations
@@ -11,7 +12,11 @@ from __future__ import annotations
 import struct
 from pathlib import Path
 
+from bt_manip.input_files import size_text
+
 MESH_EXTENSIONS = (".stl", ".obj", ".dae")
+MAX_MESH_BYTES = 64 * 1024 * 1024
+"""Largest mesh file accepted (PyBullet and the viewer read meshes whole)."""
 _CHUNK = 1024 * 1024
 
 
@@ -26,6 +31,8 @@ def mesh_problem(path: Path, uri: str) -> str | None:
         with open(path, "rb") as f:
             head = f.read(4096)
             size = path.stat().st_size
+            if size > MAX_MESH_BYTES:
+                return f"mesh '{uri}' is larger than the limit of {size_text(MAX_MESH_BYTES)}"
             ok = {".stl": _is_stl, ".obj": _is_obj, ".dae": _is_collada}[suffix](f, head, size)
     except OSError as exc:
         return f"mesh '{uri}' cannot be read: {exc.strerror}"
