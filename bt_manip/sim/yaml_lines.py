@@ -1,9 +1,10 @@
 """YAML loading that remembers where each value came from.
 
-World files are user input: every complaint about them names the file and line. PyYAML's
-safe loader is extended so that mappings become :class:`LineDict` (a dict that knows the line of
-itself and of each key) and sequences become :class:`LineList` (a list that knows the line of
-each item).
+World files are user input: every complaint about them names the file and line, and every
+file is bounded (:data:`MAX_YAML_BYTES`, and :data:`MAX_YAML_NODES` values once aliases are
+expanded). PyYAML's safe loader is extended so that mappings become :class:`LineDict` (a dict
+that knows the line of itself and of each key) and sequences become :class:`LineList` (a list
+that knows the line of each item).
 """
 
 from __future__ import annotations
@@ -124,13 +125,15 @@ def _construct_sequence(loader: _Loader, node: yaml.SequenceNode) -> LineList:
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
 
+
 def load_yaml(path: str | Path) -> Any:
     """Read a YAML file; syntax errors become an InputError with the file and line."""
     path = Path(path)
     data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
     text = data.decode("utf-8", errors="replace")
-    loader = _Loader(text)
+    loader = None
     try:
+        loader = _Loader(text)
         root = loader.get_single_node()
         if root is None:
             return None
@@ -145,10 +148,18 @@ def load_yaml(path: str | Path) -> Any:
         if isinstance(exc, _TooManyNodes):
             raise InputError([Problem(str(path), line, f"refused YAML: {what}")]) from None
         raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
+    except yaml.reader.ReaderError as exc:
+        line = text.count("\n", 0, exc.position) + 1
+        what = f"character #x{exc.character:04x} is not allowed ({exc.reason})"
+        if isinstance(exc.character, bytes):
+            what = f"bytes that are not UTF-8 ({exc.reason})"
+        raise InputError([Problem(str(path), line, f"invalid YAML: {what}")]) from None
     except yaml.YAMLError as exc:
-        raise InputError([Problem(str(path), None, f"invalid YAML: {exc}")]) from None
+        what = " ".join(str(exc).split())
+        raise InputError([Problem(str(path), None, f"invalid YAML: {what}")]) from None
     finally:
-        loader.dispose()
+        if loader is not None:
+            loader.dispose()
 
 
 def is_number(value: Any) -> bool:
