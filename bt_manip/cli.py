@@ -45,6 +45,27 @@ def _positive(kind: type) -> Any:
     return convert
 
 
+def _within(kind: type, low: float, high: float) -> Any:
+    """An argparse type: a ``kind`` number from ``low`` to ``high`` (both included)."""
+
+    def convert(text: str) -> Any:
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got '{text}'") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be within {low:g}..{high:g}, got {text}")
+        return value
+
+    return convert
+
+
+TICK_HZ = _within(float, 0.1, 1000.0)
+"""Tree tick rates accepted (Hz): slower would wait for ages, faster than any physics rate."""
+REALTIME = _within(float, 0.01, 1000.0)
+"""Real-time factors accepted by --realtime."""
+
+
 def _bb_pair(text: str) -> tuple[str, Any]:
     """``KEY=VALUE``; VALUE is read as a JSON scalar when it is one, else kept as text."""
     key, sep, value = text.partition("=")
@@ -133,18 +154,18 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--tick-hz",
-        type=_positive(float),
+        type=TICK_HZ,
         default=20.0,
-        help="tree tick rate (default 20 Hz; physics runs at the world's rate)",
+        help="tree tick rate, 0.1..1000 Hz (default 20 Hz; physics runs at the world's rate)",
     )
     run.add_argument(
         "--realtime",
-        type=_positive(float),
+        type=REALTIME,
         nargs="?",
         const=1.0,
         default=None,
         metavar="FACTOR",
-        help="pace the run to FACTOR x real time (default 1)",
+        help="pace the run to FACTOR x real time, 0.01..1000 (default 1)",
     )
     run.add_argument("--quiet", action="store_true", help="print only the summary")
     run.add_argument(
@@ -174,14 +195,15 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--world", required=True, help="world file (YAML)")
     bench.add_argument("--runs", type=_positive(int), default=20, help="episodes (default 20)")
     bench.add_argument("--seed", type=int, default=0, help="seed of the first episode")
-    bench.add_argument("--jobs", type=_positive(int), default=2, help="worker processes")
+    bench.add_argument("--jobs", type=_within(int, 1, 64), default=2,
+                       help="worker processes (1..64)")
     bench.add_argument("--out", default="out/bench", help="folder for JSON, CSV and PNG output")
     bench.add_argument("--tree-id")
     bench.add_argument("--models", action="append", default=[], metavar="MODELS.xml")
     bench.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE")
     bench.add_argument("--max-ticks", type=_positive(int))
     bench.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S")
-    bench.add_argument("--tick-hz", type=_positive(float), default=20.0)
+    bench.add_argument("--tick-hz", type=TICK_HZ, default=20.0)
     _add_inject(bench)
     bench.set_defaults(func=cmd_bench)
 
@@ -190,10 +212,10 @@ def build_parser() -> argparse.ArgumentParser:
     world.add_argument("--seed", type=int, default=0)
     world.add_argument(
         "--settle",
-        type=float,
+        type=_within(float, 0.0, 3600.0),
         default=0.0,
         metavar="S",
-        help="step S seconds of sim with no commands and report what moved",
+        help="step S seconds of sim (0..3600) with no commands and report what moved",
     )
     world.set_defaults(func=cmd_world)
 

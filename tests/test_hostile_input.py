@@ -215,10 +215,14 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         ["validate", includes / "0.xml"],
         ["run", diamond / "f0.xml", "--quiet"],
         ["validate", scripts],
+        ["run", runtime, "--tick-hz", "1e-300"],
+        ["run", runtime, "--realtime", "nan"],
+        ["world", "nowhere.yaml", "--settle", "inf"],
+        ["bench", runtime, "--world", "w.yaml", "--jobs", "100000"],
     )
     (dev_zero, fifo_r, huge_r, run400, val2000, val256, run256, deep_halt, val_lit, run_lit,
      bad_bb, typo, no_node, bad_kind, bad_world_kind, model_types, deep_includes, twice,
-     deep_scripts) = results
+     deep_scripts, *flags) = results
 
     assert dev_zero["code"] == 2
     assert dev_zero["err"] == "/dev/zero: file is a device, not a regular file\n"
@@ -294,6 +298,16 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         f"{diamond / 'b0.xml'}:1: 'f1.xml' is already included (at {diamond / 'a0.xml'}:1); "
         "include each file once, its trees would be defined twice\n")
 
+    assert [(f["code"], f["err"]) for f in flags] == [
+        (2, "bt-manip run: argument --tick-hz: must be within 0.1..1000, got 1e-300 "
+            "(see bt-manip run --help)\n"),
+        (2, "bt-manip run: argument --realtime: must be within 0.01..1000, got nan "
+            "(see bt-manip run --help)\n"),
+        (2, "bt-manip world: argument --settle: must be within 0..3600, got inf "
+            "(see bt-manip world --help)\n"),
+        (2, "bt-manip bench: argument --jobs: must be within 1..64, got 100000 "
+            "(see bt-manip bench --help)\n"),
+    ]
     unparsable = ("expression nested too deeply to parse (parentheses or operators); split it "
                   "into several statements (column 1 of the script)")
     too_deep = ("expression nested deeper than 100 levels; split it into several statements "
