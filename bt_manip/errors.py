@@ -9,6 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+MAX_MESSAGE = 1000
+"""Characters of a problem's message printed at most."""
+
 
 @dataclass(frozen=True)
 class Problem:
@@ -20,12 +23,15 @@ class Problem:
     column: int | None = None
 
     def __str__(self) -> str:
+        message = self.message
+        if len(message) > MAX_MESSAGE:  # a huge value quoted in a message is cut short
+            message = message[:MAX_MESSAGE] + " ... (cut short)"
         where = self.file
         if self.line is not None:
             where += f":{self.line}"
             if self.column is not None:
                 where += f":{self.column}"
-        return f"{where}: {self.message}"
+        return f"{where}: {message}"
 
 
 @dataclass

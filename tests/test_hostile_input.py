@@ -367,8 +367,12 @@ def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:
     png = _furniture_world(tmp_path, "png_mesh", "statue.png")
     garbage = _furniture_world(tmp_path, "garbage_mesh", "statue.stl")
 
+    fast = tmp_path / "fast.yaml"
+    fast.write_text("name: fast\nphysics: {rate_hz: 1000000000000, solver_iterations: 10000}\n"
+                    "poses:\n  p: [" + ", ".join(["1"] * 50_000) + "]\n")
     results = run_cli(
         tmp_path,
+        ["world", fast],
         ["world", bomb],
         ["world", many],
         ["world", big],
@@ -377,7 +381,15 @@ def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:
         ["world", png],
         ["world", garbage],
     )
-    r_bomb, r_many, r_big, r_zero, r_dir, r_png, r_garbage = results
+    r_fast, r_bomb, r_many, r_big, r_zero, r_dir, r_png, r_garbage = results
+    assert r_fast["code"] == 2
+    fast_lines = r_fast["err"].splitlines()
+    assert fast_lines[:2] == [
+        f"{fast}:2: physics.rate_hz must be within 10..10000, got 1000000000000",
+        f"{fast}:2: physics.solver_iterations must be within 1..1000, got 10000",
+    ]
+    assert fast_lines[2].startswith(f"{fast}:4: poses.p ([x, y, yaw]) must be a list of 3 numbers")
+    assert fast_lines[2].endswith(" ... (cut short)") and len(fast_lines[2]) < 1200
     assert r_bomb["code"] == 2
     assert r_bomb["err"].startswith(f"{bomb}:")
     too_many = ("refused YAML: more than 100000 values (the limit of a YAML input; each use of "

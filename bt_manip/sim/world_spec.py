@@ -221,6 +221,7 @@ class _Reader(ProblemCollector):
         default: float | None = None,
         positive: bool = False,
         non_negative: bool = False,
+        within: tuple[float, float] | None = None,
     ) -> float | None:
         if key not in d:
             if default is None:
@@ -235,6 +236,10 @@ class _Reader(ProblemCollector):
             return default
         if non_negative and value < 0:
             self.fail(d.line_of(key), f"{where}.{key} must be >= 0, got {value}")
+            return default
+        if within is not None and not within[0] <= value <= within[1]:
+            self.fail(d.line_of(key),
+                      f"{where}.{key} must be within {within[0]:g}..{within[1]:g}, got {value}")
             return default
         return float(value)
 
@@ -614,6 +619,12 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
     return out
 
 
+PHYSICS_RATES = (10.0, 10_000.0)
+"""Physics rates accepted (Hz): every tick steps rate / tick rate times."""
+SOLVER_ITERATIONS = (1.0, 1000.0)
+"""Solver iterations per physics step accepted."""
+
+
 def parse_world(path: str | Path) -> WorldSpec:
     """Read and check a world file; raise InputError listing every problem found."""
     path = Path(path)
@@ -632,12 +643,14 @@ def parse_world(path: str | Path) -> WorldSpec:
         ph = rd.mapping(data["physics"], data.line_of("physics"), "physics")
         if ph is not None:
             rd.unknown_keys(ph, PHYSICS_KEYS, "physics")
-            physics.rate_hz = rd.number(ph, "rate_hz", "physics", 240.0, positive=True) or 240.0
+            physics.rate_hz = (
+                rd.number(ph, "rate_hz", "physics", 240.0, within=PHYSICS_RATES) or 240.0
+            )
             if "gravity" in ph:
                 g = rd.vector(ph["gravity"], 3, ph.line_of("gravity"), "physics.gravity")
                 physics.gravity = g or physics.gravity  # type: ignore[assignment]
             physics.solver_iterations = int(
-                rd.number(ph, "solver_iterations", "physics", 50, positive=True) or 50
+                rd.number(ph, "solver_iterations", "physics", 50, within=SOLVER_ITERATIONS) or 50
             )
             physics.ground_friction = (
                 rd.number(ph, "ground_friction", "physics", 1.0, non_negative=True) or 0.0
