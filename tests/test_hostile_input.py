@@ -141,6 +141,9 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         '      <OpenGripper opening="-0.5"/>',
         '      <OpenGripper opening="-1"/>',  # fine: -1 means fully
         '      <Sleep msec="-3"/>',
+        '      <Navigate goal="1;2"/>',
+        '      <Navigate goal="nan;0;0"/>',
+        '      <Navigate goal="kitchen"/>',  # fine: a pose name is looked up at run time
         "    </Sequence>",
     ]))
     runtime = _tree(tmp_path / "runtime.xml", "\n".join([
@@ -256,6 +259,10 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         f"{literals}:9: bad value for port 'opening' of OpenGripper: must be >= 0 or -1, "
         "got -0.5",
         f"{literals}:11: bad value for port 'msec' of Sleep: must be >= 0, got -3",
+        f"{literals}:12: bad value for port 'goal' of Navigate: a goal written as numbers must "
+        "be three finite numbers x;y;yaw, got '1;2'",
+        f"{literals}:13: bad value for port 'goal' of Navigate: a goal written as numbers must "
+        "be three finite numbers x;y;yaw, got 'nan;0;0'",
     ]
     for result in (val_lit, run_lit):
         assert result["code"] == 2

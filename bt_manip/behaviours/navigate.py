@@ -18,7 +18,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
-from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
+from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.grid import GridTooLarge
 from bt_manip.navigation.navigator import Navigator
@@ -67,6 +67,19 @@ def parse_goal(world: Any, text: str) -> tuple[float, float, float]:
     return (values[0], values[1], values[2])
 
 
+def _goal_text(text: Any) -> str | None:
+    """What is wrong with a goal written as numbers (a pose name is checked at run time)."""
+    if not isinstance(text, str) or ";" not in text:
+        return None
+    try:
+        values = [float(v) for v in text.split(";")]
+    except ValueError:
+        values = []
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        return f"a goal written as numbers must be three finite numbers x;y;yaw, got '{text}'"
+    return None
+
+
 @registry.register
 class Navigate(RobotAction):
     """Drives the base to ``goal`` (a named pose of the world, or ``x;y;yaw``).
@@ -84,7 +97,7 @@ class Navigate(RobotAction):
     CARRIES = True
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
-        "goal": PortInformation(str, True, "named world pose, or x;y;yaw"),
+        "goal": Port(str, True, "named world pose, or x;y;yaw", accepts=Accepts(check=_goal_text)),
         "xy_tolerance": Port(
             float, False, "distance to the goal that counts (m)", 0.1, POSITIVE
         ),

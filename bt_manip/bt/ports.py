@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import numbers
 import typing
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, get_args, get_origin
 
@@ -31,7 +32,8 @@ class Accepts:
     ``low``/``high`` bound a number (inclusive, unless ``low_open``/``high_open``); ``choices``
     lists the only values allowed; ``also`` lists values allowed outside the range (such as a
     ``-1`` meaning "all"). For a list port the rule applies to each item. Numbers of a ``float``
-    port must be finite whatever the rule.
+    port must be finite whatever the rule. ``check`` is a further test of the whole value for
+    rules a range cannot say: it returns what is wrong, or None.
     """
 
     low: float | None = None
@@ -40,6 +42,7 @@ class Accepts:
     high_open: bool = False
     choices: tuple[Any, ...] = ()
     also: tuple[Any, ...] = ()
+    check: Callable[[Any], str | None] | None = None
 
     def text(self) -> str:
         """What is allowed, as the end of 'must be ...'."""
@@ -103,6 +106,8 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
         if rule is not None and not rule.allows(item):
             each = "each value " if many else ""
             return f"{each}must be {rule.text()}, got {shown}"
+    if rule is not None and rule.check is not None:
+        return rule.check(value)
     return None
 
 
