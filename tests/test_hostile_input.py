@@ -144,6 +144,7 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         '      <Navigate goal="1;2"/>',
         '      <Navigate goal="nan;0;0"/>',
         '      <Navigate goal="kitchen"/>',  # fine: a pose name is looked up at run time
+        '      <MoveToPose position="1;2" orientation="0;0;1"/>',
         "    </Sequence>",
     ]))
     runtime = _tree(tmp_path / "runtime.xml", "\n".join([
@@ -263,6 +264,10 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         "be three finite numbers x;y;yaw, got '1;2'",
         f"{literals}:13: bad value for port 'goal' of Navigate: a goal written as numbers must "
         "be three finite numbers x;y;yaw, got 'nan;0;0'",
+        f"{literals}:15: bad value for port 'position' of MoveToPose: must hold 0 or 3 values, "
+        "got 2",
+        f"{literals}:15: bad value for port 'orientation' of MoveToPose: must hold 4 values, "
+        "got 3",
     ]
     for result in (val_lit, run_lit):
         assert result["code"] == 2

@@ -19,7 +19,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
-from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
+from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
 TOLERANCE = Port(float, False, "how close each joint must get (rad)", 0.01, POSITIVE)
@@ -319,11 +319,13 @@ class MoveToPose(JointMove):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **JointMove.INPUT_PORTS,
-        "position": PortInformation(list[float], False, "target x;y;z (world)", []),
+        "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),
-        "offset": PortInformation(list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0]),
-        "orientation": PortInformation(
-            list[float], False, "quaternion x;y;z;w (world)", [0.0, 1.0, 0.0, 0.0]
+        "offset": Port(
+            list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0], count_of(3)
+        ),
+        "orientation": Port(
+            list[float], False, "quaternion x;y;z;w (world)", [0.0, 1.0, 0.0, 0.0], count_of(4)
         ),
         "match_object_yaw": PortInformation(bool, False, "turn with the object's yaw", False),
         "free_yaw": PortInformation(

@@ -10,7 +10,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
 from bt_manip.behaviours.gripper import held_object
 from bt_manip.bt import registry
-from bt_manip.bt.ports import NON_NEGATIVE, Port
+from bt_manip.bt.ports import NON_NEGATIVE, Port, count_of
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")
 
@@ -64,8 +64,8 @@ class ObjectInRegion(WorldCondition):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "object": OBJECT,
         "inside": PortInformation(str, False, "body whose bounding box is the region", ""),
-        "min": PortInformation(list[float], False, "lower corner x;y;z", []),
-        "max": PortInformation(list[float], False, "upper corner x;y;z", []),
+        "min": Port(list[float], False, "lower corner x;y;z", [], count_of(0, 3)),
+        "max": Port(list[float], False, "upper corner x;y;z", [], count_of(0, 3)),
     }
 
     def check(self) -> tuple[bool, str]:

@@ -90,6 +90,18 @@ class Port(PortInformation):
     accepts: Accepts | None = None
 
 
+def count_of(*counts: int) -> Accepts:
+    """A rule for a list port: it holds one of ``counts`` values (0 for an empty list)."""
+    allowed = " or ".join(str(n) for n in counts)
+
+    def check(value: Any) -> str | None:
+        if isinstance(value, list | tuple) and len(value) not in counts:
+            return f"must hold {allowed} values, got {len(value)}"
+        return None
+
+    return Accepts(check=check)
+
+
 def value_problem(info: PortInformation, value: Any, text: str | None = None) -> str | None:
     """Why ``value`` cannot go through the port ``info``, or None when it can.
 
