@@ -6,7 +6,7 @@ injected faults), in J worker processes, and reports:
 
 - the success rate with a 95 % Wilson score interval;
 - sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
-- failures counted by node and reason (the deepest failed node of each failed episode).
+- failures counted by node and reason (the node whose failure ended each failed episode).
 
 It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
 """
@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.episode import Episode, EpisodeSpec
+from bt_manip.outputs import make_folder
 
 
 @dataclass
@@ -41,6 +42,7 @@ class EpisodeResult:
     wall_time: float
     ticks: int
     failed_node: str = ""
+    """On FAILURE, the node whose failure ended the episode: ``name (ID)``, or its ID."""
     injected: list[dict[str, Any]] = field(default_factory=list)
     metrics: dict[str, float] = field(default_factory=dict)
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
@@ -70,8 +72,10 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             for k, v in episode.tree.blackboard.as_dict().items()
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
-    failed = [n for n in report.nodes if n.status == "FAILURE"]
-    deepest = max(failed, key=lambda n: n.path.count("/")) if failed else None
+    failed_node = ""
+    if report.status == "FAILURE" and report.cause:
+        name, node_id = report.cause["name"], report.cause["node"]
+        failed_node = node_id if name == node_id else f"{name} ({node_id})"
     return EpisodeResult(
         seed=spec.seed,
         status=report.status,
@@ -79,7 +83,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         sim_time=report.sim_time,
         wall_time=report.wall_time,
         ticks=report.ticks,
-        failed_node=deepest.node if deepest is not None and report.status != "SUCCESS" else "",
+        failed_node=failed_node,
         injected=list(report.extra.get("injected", [])),
         metrics=metrics,
     )
@@ -217,7 +221,7 @@ def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult
 
 def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
     names = sorted({k for r in results for k in r.metrics})
     with open(out / "episodes.csv", "w", newline="") as fh:

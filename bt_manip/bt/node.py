@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -54,6 +55,7 @@ POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
 IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
 
 _MISSING = object()
+_FAILURE_ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 _PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
 _BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
@@ -118,6 +120,9 @@ class BtNode(PortsMixin):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
+    failure_order: int = 0
+    """When the node last returned FAILURE, as a rank among all failures (0: never); tells the
+    failure that ended a run from older ones (see :mod:`bt_manip.failure_cause`)."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
@@ -319,6 +324,8 @@ class BtNode(PortsMixin):
             if "_post" in self._post:
                 self._run_script("_post", self._post["_post"])
         self.last_status = new
+        if new is NodeStatus.FAILURE:
+            self.failure_order = next(_FAILURE_ORDER)
         if new is not NodeStatus.SKIPPED:
             self.bt_status = new
             self.status = _PY_FROM_BT[new]
