@@ -152,6 +152,8 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     assert all(e["sim_time"] == pytest.approx(0.5, abs=0.06) for e in episodes)
     assert summary["metrics"]["blocks"]["mean"] == 3.0
     assert summary["injected"].get("failure", 0) == 4 - summary["successes"]
+    failed = [e for e in episodes if e["status"] == "FAILURE"]
+    assert [e["failed_node"] for e in failed] == ["maybe (AlwaysSuccess)"] * len(failed)
     assert (out / "episodes.csv").read_text().splitlines()[0].endswith("injected,blocks")
     assert (out / "outcomes.png").stat().st_size > 1000
     assert f"success: {summary['successes']}/4" in text
