@@ -236,38 +236,67 @@ def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path
     _plot(results, summary, out / "outcomes.png")
 
 
+STATUS_COLOURS = {
+    "SUCCESS": "tab:green",
+    "FAILURE": "tab:red",
+    "BUDGET": "tab:orange",
+    "SKIPPED": "tab:olive",
+    "ERROR": "tab:purple",
+    "INTERRUPTED": "tab:grey",
+}
+
+
 def _plot(results: list[EpisodeResult], summary: BenchSummary, path: Path) -> None:
+    """Write :func:`outcomes_figure` to ``path`` (PNG)."""
+    import matplotlib.pyplot as plt
+
+    fig = outcomes_figure(results, summary)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def outcomes_figure(results: list[EpisodeResult], summary: BenchSummary) -> Any:
+    """The figure of outcomes.png: sim time per seed (left, coloured by outcome) and a
+    histogram of the sim time per episode (right, stacked by outcome); integer ticks on the
+    seed and count axes."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
-    colours = {
-        "SUCCESS": "tab:green",
-        "FAILURE": "tab:red",
-        "BUDGET": "tab:orange",
-        "INTERRUPTED": "tab:grey",
-    }
-    for status, colour in colours.items():
+    statuses = [s for s in STATUS_COLOURS if any(r.status == s for r in results)]
+    statuses += sorted({r.status for r in results} - set(statuses))
+    colours = [STATUS_COLOURS.get(s, "black") for s in statuses]
+    for status, colour in zip(statuses, colours, strict=True):
         pts = [(r.seed, r.sim_time) for r in results if r.status == status]
-        if pts:
-            xs, ys = zip(*pts, strict=True)
-            ax1.scatter(xs, ys, c=colour, label=f"{status} ({len(pts)})", s=18)
+        xs, ys = zip(*pts, strict=True)
+        ax1.scatter(xs, ys, c=colour, label=f"{status} ({len(pts)})", s=18)
+    ax1.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax1.set_xlabel("seed")
     ax1.set_ylabel("sim time (s)")
     lo, hi = summary.ci95
     ax1.set_title(
         f"success {summary.success_rate * 100:.1f} % (95 % CI {lo * 100:.0f}-{hi * 100:.0f} %)"
     )
-    ax1.legend(fontsize=8)
-    ax2.hist(
-        [r.sim_time for r in results], bins=min(20, max(5, len(results) // 2)), color="tab:blue"
-    )
+    if statuses:
+        ax1.legend(fontsize=8)
+        ax2.hist(
+            [[r.sim_time for r in results if r.status == s] for s in statuses],
+            bins=min(20, max(5, len(results) // 2)),
+            color=colours,
+            stacked=True,
+            label=statuses,
+        )
+    ax2.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax2.set_xlabel("sim time per episode (s)")
     ax2.set_ylabel("episodes")
-    ax2.set_title(f"median real-time factor {summary.real_time_factor['median']:.1f}x")
-    fig.suptitle(f"{Path(summary.tree).name} on {Path(summary.world).name or 'no world'}")
+    ax2.set_title(f"histogram of sim time per episode ({summary.runs} episodes)")
+    rtf = summary.real_time_factor["median"]
+    fig.suptitle(
+        f"{Path(summary.tree).name} on {Path(summary.world).name or 'no world'} "
+        f"(median real-time factor {rtf:.1f}x)"
+    )
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig

@@ -157,3 +157,25 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     assert (out / "episodes.csv").read_text().splitlines()[0].endswith("injected,blocks")
     assert (out / "outcomes.png").stat().st_size > 1000
     assert f"success: {summary['successes']}/4" in text
+
+
+def test_outcomes_plot_has_integer_seed_and_count_ticks() -> None:
+    from bt_manip.bench import outcomes_figure
+
+    results = [
+        EpisodeResult(3, "SUCCESS", "", 0.8, 0.1, 16),
+        EpisodeResult(4, "FAILURE", "Sequence/x: no", 0.5, 0.1, 10, "x"),
+        EpisodeResult(5, "SUCCESS", "", 0.8, 0.1, 16),
+    ]
+    fig = outcomes_figure(results, summarise(results, EpisodeSpec(tree="t.xml", world="w.yaml")))
+    left, right = fig.axes
+    fig.canvas.draw()
+    seeds = [t for t in left.get_xticks() if left.get_xlim()[0] <= t <= left.get_xlim()[1]]
+    counts = [t for t in right.get_yticks() if right.get_ylim()[0] <= t <= right.get_ylim()[1]]
+    assert seeds and all(float(t).is_integer() for t in seeds)
+    assert counts and all(float(t).is_integer() for t in counts)
+    assert right.get_title() == "histogram of sim time per episode (3 episodes)"
+    assert right.get_xlabel() == "sim time per episode (s)"
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
