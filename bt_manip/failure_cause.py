@@ -1,15 +1,20 @@
 """The failure that ended a run: what the summary, the run report and bench name as its cause.
 
 A failed run's root returned FAILURE because one of its children did (a Sequence's child), or
-all of them did (a Fallback's last alternative), or because of its own logic (an Inverter whose
-child succeeded, a Timeout). :func:`failure_cause` walks from the root down that path: at each
-node it goes to the child whose FAILURE came last before the node's own, among children whose
-last result was FAILURE; it stops at a node none of whose children failed that way. Failures
-the tree dealt with (a Reverse under ForceSuccess, a Fallback's first alternative that a later
-one replaced, an attempt that a Retry repeated) are off that path and never named.
+all of them did (every alternative of a Fallback), or because of its own logic (an Inverter
+whose child succeeded, a Timeout). :func:`failure_cause` follows those failures down from the
+root: a node's failure was caused by the children that returned FAILURE during its last run
+(between its start and its own FAILURE). The nodes where that stops (no child failed in the
+node's last run) are the failures that ended the run; the cause is the last of them that gave a
+reason (its feedback), or the last of them when none did. So in a recovery pattern,
+``Fallback(try, Sequence(back_off, AlwaysFailure))``, the cause is what failed in ``try``, not
+the AlwaysFailure that passes the failure on.
 
-Every node stamps each FAILURE it returns with a rank (``BtNode.failure_order``), so a child's
-failure from an earlier attempt is told from the one in the attempt that failed.
+Failures the tree dealt with (a node under ForceSuccess, a Fallback's alternative when a later
+one succeeded, an attempt that a Retry repeated) are off that path and never named. Every node
+stamps when it starts and when it returns FAILURE on one counter (``BtNode.started_order`` and
+``failure_order``), so a child's failure in an earlier run of its parent is told from one in the
+run that failed.
 """
 
 from __future__ import annotations
@@ -39,19 +44,25 @@ def failure_cause(tree: Any) -> FailureCause | None:
     """The cause of the root's last FAILURE in ``tree`` (a ``bt_manip.bt.Tree``), or None when
     the root did not fail."""
     paths = {id(node): path for path, _, node in tree.walk()}
-    node = tree.root
-    if node.last_status is not NodeStatus.FAILURE:
+    root = tree.root
+    if root.last_status is not NodeStatus.FAILURE:
         return None
-    while True:
+    ends: list[Any] = []
+    stack = [root]
+    while stack:
+        node = stack.pop()
         failed = [
             child
             for child in node.bt_children()
             if child.last_status is NodeStatus.FAILURE
-            and 0 < child.failure_order < node.failure_order
+            and node.started_order < child.failure_order < node.failure_order
         ]
-        if not failed:
-            break
-        node = max(failed, key=lambda child: child.failure_order)
+        if failed:
+            stack.extend(failed)
+        else:
+            ends.append(node)
+    with_reason = [node for node in ends if node.feedback_message]
+    node = max(with_reason or ends, key=lambda n: n.failure_order)
     node_id = getattr(node, "tree_id", None) or node.NODE_ID
     reason = node.feedback_message or f"{node_id} returned FAILURE"
     return FailureCause(paths.get(id(node), node.name), node.name, node_id, reason)

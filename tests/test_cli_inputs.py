@@ -48,10 +48,9 @@ def node_module(tmp_path: Path) -> Iterator[Path]:
     """``refuse_nodes.py`` in tmp_path; the node it registers is unregistered afterwards."""
     path = tmp_path / "refuse_nodes.py"
     path.write_text(NODE_MODULE)
-    before = set(sys.modules)
     yield path
     registry.unregister("RefuseForTest")
-    for name in set(sys.modules) - before:
+    for name in [m for m in sys.modules if m.startswith(("bt_manip_user_", "refuse_nodes"))]:
         del sys.modules[name]
 
 
@@ -261,3 +260,28 @@ def test_bench_counts_failures_by_the_node_that_failed(
         {"node": "real (RefuseForTest)", "reason": f"{real}: refused on purpose", "count": 2}
     ]
     assert f"  2 x real (RefuseForTest): {real}: refused on purpose" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("body", "cause"),
+    [
+        # a recovery branch that passes the failure on: the cause is what failed in the try
+        ('<Fallback name="grasp_or_back_off">'
+         '<Sequence name="try"><AlwaysSuccess/><RefuseForTest name="grasp"/></Sequence>'
+         '<Sequence name="back_off"><AlwaysSuccess name="release"/>'
+         '<AlwaysFailure name="grasp_failed"/></Sequence></Fallback>',
+         "grasp_or_back_off/try/grasp: refused on purpose"),
+        # a failure left over from an earlier attempt is not the cause of the last one
+        ('<Sequence><Script code="n := 0"/><RetryUntilSuccessful num_attempts="2">'
+         '<Sequence name="attempt"><Script code="n := n + 1"/>'
+         '<AlwaysFailure name="gives_up" _skipIf="n == 1"/><RefuseForTest name="stale"/>'
+         "</Sequence></RetryUntilSuccessful></Sequence>",
+         "Sequence/RetryUntilSuccessful/attempt/gives_up: AlwaysFailure returned FAILURE"),
+    ],
+)
+def test_cause_follows_the_failures_of_the_last_run(
+    tmp_path: Path, node_module: Path, capsys: pytest.CaptureFixture[str], body: str, cause: str
+) -> None:
+    tree = _tree(tmp_path, body)
+    assert main(["run", str(tree), "--quiet", "--import", str(node_module)]) == 1
+    assert capsys.readouterr().out.splitlines()[0] == f"result: FAILURE ({cause})"
