@@ -143,6 +143,7 @@ def test_import_problems_name_the_flag(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
 ) -> None:
     monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sys, "path", list(sys.path))  # --import puts the working dir on it
     tree = _tree(tmp_path, "<AlwaysSuccess/>")
     (tmp_path / "broken.py").write_text("x = 1\ndef f(:\n")
     (tmp_path / "raising.py").write_text("import math\n\nraise RuntimeError('no robot here')\n")
