@@ -48,6 +48,8 @@ def import_modules(names: Iterable[str]) -> list[Problem]:
 
 def import_module(name: str) -> Problem | None:
     """Import ``name`` (a module name or a ``.py`` file); a problem if that fails."""
+    if not name.strip():
+        return Problem(FLAG, None, "needs a module name or a .py file, got ''")
     by_file = name.endswith(".py") or os.sep in name or "/" in name
     try:
         if by_file:
@@ -99,7 +101,8 @@ def _import_file(path: Path) -> None:
 def _failure(name: str, exc: BaseException) -> Problem:
     """The error of a module that raised while importing, at the frame that raised it."""
     frames = [f for f in traceback.extract_tb(exc.__traceback__)
-              if "importlib" not in f.filename and not f.filename.startswith("<frozen")]
+              if "importlib" not in f.filename and not f.filename.startswith("<frozen")
+              and f.filename != __file__]
     here = frames[-1] if frames else None
     where = f"{here.filename}:{here.lineno}: " if here is not None else ""
     return Problem(FLAG, None, f"{where}importing '{name}' raised {type(exc).__name__}: {exc}")

@@ -149,6 +149,7 @@ def test_import_problems_name_the_flag(
     (tmp_path / "raising.py").write_text("import math\n\nraise RuntimeError('no robot here')\n")
     (tmp_path / "adir").mkdir()
     cases = [
+        ("", "--import: needs a module name or a .py file, got ''"),
         ("no_such_module", f"--import: no module named 'no_such_module' (looked in {tmp_path} "
                            "and the installed packages); give a module name or a .py file"),
         ("missing.py", "--import: missing.py not found; give a Python file (.py) or a module "
