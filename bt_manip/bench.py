@@ -211,11 +211,17 @@ def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult
             results.append(run_one(spec))
             progress(results[-1])
     else:
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
+        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"))
+        try:
             futures = [pool.submit(run_one, s) for s in specs]
             for fut in as_completed(futures):
                 results.append(fut.result())
                 progress(results[-1])
+        except BaseException:
+            # Ctrl-C (or a worker's error): drop the episodes not started yet, do not wait
+            pool.shutdown(wait=False, cancel_futures=True)
+            raise
+        pool.shutdown()
     return sorted(results, key=lambda r: r.seed)
 
 
