@@ -16,10 +16,11 @@ from __future__ import annotations
 import csv
 import json
 import math
+import signal
 import sys
+import threading
 from collections import Counter
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field, replace
 from multiprocessing import get_context
 from pathlib import Path
@@ -201,6 +202,20 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
     return log
 
 
+def _worker_pool(jobs: int) -> Any:
+    """``jobs`` worker processes (spawned: each builds its own PyBullet world). They start with
+    Ctrl-C ignored, so that a Ctrl-C reaches the main process only, which then stops them;
+    otherwise a worker interrupted while it starts up prints a traceback."""
+    context = get_context("spawn")
+    if threading.current_thread() is not threading.main_thread():
+        return context.Pool(jobs)
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        return context.Pool(jobs)
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
     """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed."""
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
@@ -211,17 +226,18 @@ def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult
             results.append(run_one(spec))
             progress(results[-1])
     else:
-        pool = ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn"))
+        pool = _worker_pool(jobs)
         try:
-            futures = [pool.submit(run_one, s) for s in specs]
-            for fut in as_completed(futures):
-                results.append(fut.result())
-                progress(results[-1])
+            for result in pool.imap_unordered(run_one, specs):
+                results.append(result)
+                progress(result)
         except BaseException:
-            # Ctrl-C (or a worker's error): drop the episodes not started yet, do not wait
-            pool.shutdown(wait=False, cancel_futures=True)
+            pool.terminate()  # Ctrl-C or a worker's error: stop the episodes under way
             raise
-        pool.shutdown()
+        else:
+            pool.close()
+        finally:
+            pool.join()
     return sorted(results, key=lambda r: r.seed)
 
 

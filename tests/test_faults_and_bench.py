@@ -179,3 +179,35 @@ def test_outcomes_plot_has_integer_seed_and_count_ticks() -> None:
     import matplotlib.pyplot as plt
 
     plt.close(fig)
+
+
+def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+    tree = tmp_path / "long.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sleep msec="3600000"/>'
+        "</BehaviorTree></root>"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "bt_manip.cli", "bench", str(tree), "--world",
+         str(root / "worlds" / "sawyer_table.yaml"), "--runs", "6", "--jobs", "2",
+         "--out", str(tmp_path / "out")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        start_new_session=True,  # Ctrl-C reaches the whole process group, workers included
+    )
+    assert proc.stdout is not None
+    assert proc.stdout.readline().startswith("bench: 6 episodes")  # the workers are starting
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert err.splitlines()[-1] == "interrupted"
+    assert "Traceback" not in err
+    assert not (tmp_path / "out").exists()
