@@ -16,13 +16,16 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
+import queue
 import signal
 import sys
 import threading
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, replace
-from multiprocessing import get_context
+from multiprocessing import get_context, resource_tracker
 from pathlib import Path
 from typing import Any
 
@@ -202,41 +205,72 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
     return log
 
 
-def _worker_pool(jobs: int) -> Any:
-    """``jobs`` worker processes (spawned: each builds its own PyBullet world). They start with
-    Ctrl-C ignored, so that a Ctrl-C reaches the main process only, which then stops them;
-    otherwise a worker interrupted while it starts up prints a traceback."""
-    context = get_context("spawn")
+@contextmanager
+def _ctrl_c_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) back while the body runs; one that comes meanwhile is delivered
+    (as KeyboardInterrupt) when it ends. Processes started in the body inherit the block, so
+    they never take a Ctrl-C: the main process stops them."""
     if threading.current_thread() is not threading.main_thread():
-        return context.Pool(jobs)
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        yield
+        return
+    # multiprocessing's resource tracker unblocks SIGINT when it starts: start it first
+    resource_tracker.ensure_running()
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
-        return context.Pool(jobs)
+        yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def _worker_started(started: Any) -> None:
+    started.put(os.getpid())
+
+
+def _start_workers(jobs: int, wait: float = 20.0) -> Any:
+    """A pool of ``jobs`` spawned workers, returned once each has started (or after ``wait``
+    seconds), so that stopping them never meets one half-way through its start-up."""
+    context = get_context("spawn")
+    started = context.Queue()
+    pool = context.Pool(jobs, initializer=_worker_started, initargs=(started,))
+    try:
+        for _ in range(jobs):
+            started.get(timeout=wait)
+    except queue.Empty:
+        pass
+    return pool
 
 
 def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
-    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed."""
+    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
+
+    With ``jobs`` > 1 the episodes run in spawned worker processes (each builds its own
+    PyBullet world). The workers never take a Ctrl-C (one interrupted while it starts up would
+    print a traceback); a Ctrl-C, or an error, in the main process stops them.
+    """
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
-    progress = _progress(runs)
     results: list[EpisodeResult] = []
     if jobs <= 1:
+        progress = _progress(runs)
         for spec in specs:
             results.append(run_one(spec))
             progress(results[-1])
+        return sorted(results, key=lambda r: r.seed)
+    pool = None
+    try:
+        with _ctrl_c_held():  # before any other thread starts, so that none takes a Ctrl-C
+            pool = _start_workers(jobs)
+        progress = _progress(runs)
+        for result in pool.imap_unordered(run_one, specs):
+            results.append(result)
+            progress(result)
+    except BaseException:
+        if pool is not None:
+            pool.terminate()
+        raise
     else:
-        pool = _worker_pool(jobs)
-        try:
-            for result in pool.imap_unordered(run_one, specs):
-                results.append(result)
-                progress(result)
-        except BaseException:
-            pool.terminate()  # Ctrl-C or a worker's error: stop the episodes under way
-            raise
-        else:
-            pool.close()
-        finally:
+        pool.close()
+    finally:
+        if pool is not None:
             pool.join()
     return sorted(results, key=lambda r: r.seed)
 
