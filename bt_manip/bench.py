@@ -249,7 +249,7 @@ def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult
     """
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
     results: list[EpisodeResult] = []
-    if jobs <= 1:
+    if jobs <= 1 or runs <= 1:
         progress = _progress(runs)
         for spec in specs:
             results.append(run_one(spec))
@@ -258,7 +258,7 @@ def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult
     pool = None
     try:
         with _ctrl_c_held():  # before any other thread starts, so that none takes a Ctrl-C
-            pool = _start_workers(jobs)
+            pool = _start_workers(min(jobs, runs))
         progress = _progress(runs)
         for result in pool.imap_unordered(run_one, specs):
             results.append(result)
