@@ -311,7 +311,7 @@ def cmd_bench(args: argparse.Namespace) -> int:
     from bt_manip.episode import Episode
     from bt_manip.outputs import check_output_folder, make_folder
 
-    if args.out == DEFAULT_BENCH_OUT:
+    if args.out == DEFAULT_BENCH_OUT and not Path(DEFAULT_BENCH_OUT).parent.exists():
         make_folder(Path(DEFAULT_BENCH_OUT).parent)  # out/, bt-manip's own default folder
     check_output_folder("--out", args.out)
     base = _episode_spec(args)

@@ -103,6 +103,18 @@ def test_every_output_flag_is_checked(
     assert not missing.exists()
 
 
+def test_bench_default_output_folder_under_a_file_named_out(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "out").write_text("")
+    tree = _tree(tmp_path, "<AlwaysSuccess/>")
+    assert main(["bench", str(tree), "--world", str(TABLE)]) == 2
+    assert capsys.readouterr().err == (
+        "--out: out is not a folder, so the outputs cannot be written below it\n"
+    )
+
+
 def test_outputs_create_their_own_folder_only(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
