@@ -6,7 +6,7 @@ injected faults), in J worker processes, and reports:
 
 - the success rate with a 95 % Wilson score interval;
 - sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
-- failures counted by node and reason (the deepest failed node of each failed episode).
+- failures counted by node and reason (the node whose failure ended each failed episode).
 
 It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
 """
@@ -16,18 +16,23 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
+import queue
+import signal
 import sys
+import threading
 from collections import Counter
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field, replace
-from multiprocessing import get_context
+from multiprocessing import get_context, resource_tracker
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from bt_manip.episode import Episode, EpisodeSpec
+from bt_manip.outputs import make_folder
 
 
 @dataclass
@@ -41,6 +46,7 @@ class EpisodeResult:
     wall_time: float
     ticks: int
     failed_node: str = ""
+    """On FAILURE, the node whose failure ended the episode: ``name (ID)``, or its ID."""
     injected: list[dict[str, Any]] = field(default_factory=list)
     metrics: dict[str, float] = field(default_factory=dict)
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
@@ -70,8 +76,10 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             for k, v in episode.tree.blackboard.as_dict().items()
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
-    failed = [n for n in report.nodes if n.status == "FAILURE"]
-    deepest = max(failed, key=lambda n: n.path.count("/")) if failed else None
+    failed_node = ""
+    if report.status == "FAILURE" and report.cause:
+        name, node_id = report.cause["name"], report.cause["node"]
+        failed_node = node_id if name == node_id else f"{name} ({node_id})"
     return EpisodeResult(
         seed=spec.seed,
         status=report.status,
@@ -79,7 +87,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         sim_time=report.sim_time,
         wall_time=report.wall_time,
         ticks=report.ticks,
-        failed_node=deepest.node if deepest is not None and report.status != "SUCCESS" else "",
+        failed_node=failed_node,
         injected=list(report.extra.get("injected", [])),
         metrics=metrics,
     )
@@ -197,27 +205,79 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
     return log
 
 
+@contextmanager
+def _ctrl_c_held() -> Iterator[None]:
+    """Hold Ctrl-C (SIGINT) back while the body runs; one that comes meanwhile is delivered
+    (as KeyboardInterrupt) when it ends. Processes started in the body inherit the block, so
+    they never take a Ctrl-C: the main process stops them."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    # multiprocessing's resource tracker unblocks SIGINT when it starts: start it first
+    resource_tracker.ensure_running()
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def _worker_started(started: Any) -> None:
+    started.put(os.getpid())
+
+
+def _start_workers(jobs: int, wait: float = 20.0) -> Any:
+    """A pool of ``jobs`` spawned workers, returned once each has started (or after ``wait``
+    seconds), so that stopping them never meets one half-way through its start-up."""
+    context = get_context("spawn")
+    started = context.Queue()
+    pool = context.Pool(jobs, initializer=_worker_started, initargs=(started,))
+    try:
+        for _ in range(jobs):
+            started.get(timeout=wait)
+    except queue.Empty:
+        pass
+    return pool
+
+
 def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
-    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed."""
+    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
+
+    With ``jobs`` > 1 the episodes run in spawned worker processes (each builds its own
+    PyBullet world). The workers never take a Ctrl-C (one interrupted while it starts up would
+    print a traceback); a Ctrl-C, or an error, in the main process stops them.
+    """
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
-    progress = _progress(runs)
     results: list[EpisodeResult] = []
-    if jobs <= 1:
+    if jobs <= 1 or runs <= 1:
+        progress = _progress(runs)
         for spec in specs:
             results.append(run_one(spec))
             progress(results[-1])
+        return sorted(results, key=lambda r: r.seed)
+    pool = None
+    try:
+        with _ctrl_c_held():  # before any other thread starts, so that none takes a Ctrl-C
+            pool = _start_workers(min(jobs, runs))
+        progress = _progress(runs)
+        for result in pool.imap_unordered(run_one, specs):
+            results.append(result)
+            progress(result)
+    except BaseException:
+        if pool is not None:
+            pool.terminate()
+        raise
     else:
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=get_context("spawn")) as pool:
-            futures = [pool.submit(run_one, s) for s in specs]
-            for fut in as_completed(futures):
-                results.append(fut.result())
-                progress(results[-1])
+        pool.close()
+    finally:
+        if pool is not None:
+            pool.join()
     return sorted(results, key=lambda r: r.seed)
 
 
 def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
-    out.mkdir(parents=True, exist_ok=True)
+    make_folder(out)
     (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
     names = sorted({k for r in results for k in r.metrics})
     with open(out / "episodes.csv", "w", newline="") as fh:
@@ -232,38 +292,67 @@ def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path
     _plot(results, summary, out / "outcomes.png")
 
 
+STATUS_COLOURS = {
+    "SUCCESS": "tab:green",
+    "FAILURE": "tab:red",
+    "BUDGET": "tab:orange",
+    "SKIPPED": "tab:olive",
+    "ERROR": "tab:purple",
+    "INTERRUPTED": "tab:grey",
+}
+
+
 def _plot(results: list[EpisodeResult], summary: BenchSummary, path: Path) -> None:
+    """Write :func:`outcomes_figure` to ``path`` (PNG)."""
+    import matplotlib.pyplot as plt
+
+    fig = outcomes_figure(results, summary)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def outcomes_figure(results: list[EpisodeResult], summary: BenchSummary) -> Any:
+    """The figure of outcomes.png: sim time per seed (left, coloured by outcome) and a
+    histogram of the sim time per episode (right, stacked by outcome); integer ticks on the
+    seed and count axes."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4))
-    colours = {
-        "SUCCESS": "tab:green",
-        "FAILURE": "tab:red",
-        "BUDGET": "tab:orange",
-        "INTERRUPTED": "tab:grey",
-    }
-    for status, colour in colours.items():
+    statuses = [s for s in STATUS_COLOURS if any(r.status == s for r in results)]
+    statuses += sorted({r.status for r in results} - set(statuses))
+    colours = [STATUS_COLOURS.get(s, "black") for s in statuses]
+    for status, colour in zip(statuses, colours, strict=True):
         pts = [(r.seed, r.sim_time) for r in results if r.status == status]
-        if pts:
-            xs, ys = zip(*pts, strict=True)
-            ax1.scatter(xs, ys, c=colour, label=f"{status} ({len(pts)})", s=18)
+        xs, ys = zip(*pts, strict=True)
+        ax1.scatter(xs, ys, c=colour, label=f"{status} ({len(pts)})", s=18)
+    ax1.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax1.set_xlabel("seed")
     ax1.set_ylabel("sim time (s)")
     lo, hi = summary.ci95
     ax1.set_title(
         f"success {summary.success_rate * 100:.1f} % (95 % CI {lo * 100:.0f}-{hi * 100:.0f} %)"
     )
-    ax1.legend(fontsize=8)
-    ax2.hist(
-        [r.sim_time for r in results], bins=min(20, max(5, len(results) // 2)), color="tab:blue"
-    )
+    if statuses:
+        ax1.legend(fontsize=8)
+        ax2.hist(
+            [[r.sim_time for r in results if r.status == s] for s in statuses],
+            bins=min(20, max(5, len(results) // 2)),
+            color=colours,
+            stacked=True,
+            label=statuses,
+        )
+    ax2.yaxis.set_major_locator(MaxNLocator(integer=True))
     ax2.set_xlabel("sim time per episode (s)")
     ax2.set_ylabel("episodes")
-    ax2.set_title(f"median real-time factor {summary.real_time_factor['median']:.1f}x")
-    fig.suptitle(f"{Path(summary.tree).name} on {Path(summary.world).name or 'no world'}")
+    ax2.set_title(f"histogram of sim time per episode ({summary.runs} episodes)")
+    rtf = summary.real_time_factor["median"]
+    fig.suptitle(
+        f"{Path(summary.tree).name} on {Path(summary.world).name or 'no world'} "
+        f"(median real-time factor {rtf:.1f}x)"
+    )
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    return fig

@@ -22,7 +22,10 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError, Problem
+from bt_manip.plugins import add_import_flag
 from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions
+
+DEFAULT_BENCH_OUT = "out/bench"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -188,6 +191,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--record", metavar="FILE.html", help="write a self-contained replay page of the run"
     )
     _add_inject(run)
+    add_import_flag(run)
     run.set_defaults(func=cmd_run)
 
     bench = sub.add_parser("bench", help="run many seeded episodes and report statistics")
@@ -197,7 +201,12 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     bench.add_argument("--jobs", type=_within(int, 1, 64), default=2,
                        help="worker processes (1..64)")
-    bench.add_argument("--out", default="out/bench", help="folder for JSON, CSV and PNG output")
+    bench.add_argument(
+        "--out",
+        default=DEFAULT_BENCH_OUT,
+        help=f"folder for JSON, CSV and PNG output (default {DEFAULT_BENCH_OUT}; bt-manip creates "
+        "at most this folder, its parent must exist)",
+    )
     bench.add_argument("--tree-id")
     bench.add_argument("--models", action="append", default=[], metavar="MODELS.xml")
     bench.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE")
@@ -205,6 +214,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S")
     bench.add_argument("--tick-hz", type=TICK_HZ, default=20.0)
     _add_inject(bench)
+    add_import_flag(bench)
     bench.set_defaults(func=cmd_bench)
 
     world = sub.add_parser("world", help="load a world and print its summary")
@@ -274,12 +284,37 @@ def _episode_spec(args: argparse.Namespace) -> Any:
         blackboard=dict(args.bb),
         inject=list(args.inject),
         options=options,
+        imports=list(args.imports),
     )
+
+
+def _check_outputs(args: argparse.Namespace, flags: Sequence[str]) -> None:
+    """Check every output path given with ``flags`` before any work starts (exit 2 if bad)."""
+    from bt_manip.outputs import check_output_file
+
+    for flag in flags:
+        value = getattr(args, flag.lstrip("-").replace("-", "_"), None)
+        if value:
+            check_output_file(flag, value)
+
+
+def _write_outputs(writes: Sequence[tuple[str, str, Any]]) -> int:
+    """Run each (flag, path, write) and report the ones that fail; 0, or 2 if any failed."""
+    code = 0
+    for flag, path, write in writes:
+        try:
+            write()
+        except OSError as exc:
+            print(f"{flag}: cannot write {path}: {exc.strerror or exc}", file=sys.stderr)
+            code = EXIT_BAD_INPUT
+    return code
 
 
 def cmd_run(args: argparse.Namespace) -> int:
     from bt_manip.episode import Episode
+    from bt_manip.outputs import write_text
 
+    _check_outputs(args, ("--report", "--bb-out", "--record"))
     with Episode(_episode_spec(args)) as episode:
         tree, world = episode.tree, episode.world
         if world is not None and not args.quiet:
@@ -300,20 +335,23 @@ def cmd_run(args: argparse.Namespace) -> int:
         print(report.summary())
         if report.extra.get("injected"):
             print(f"  faults injected: {len(report.extra['injected'])}")
+        writes: list[tuple[str, str, Any]] = []
         if args.report:
-            report.write(args.report)
+            writes.append(("--report", args.report, lambda: report.write(args.report)))
         if args.bb_out:
-            Path(args.bb_out).parent.mkdir(parents=True, exist_ok=True)
-            Path(args.bb_out).write_text(
-                json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
-            )
-        return report.exit_code
+            entries = json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
+            writes.append(("--bb-out", args.bb_out, lambda: write_text(args.bb_out, entries)))
+        return _write_outputs(writes) or report.exit_code
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
     from bt_manip.bench import run_bench, summarise, write_outputs
     from bt_manip.episode import Episode
+    from bt_manip.outputs import check_output_folder, make_folder
 
+    if args.out == DEFAULT_BENCH_OUT and not Path(DEFAULT_BENCH_OUT).parent.exists():
+        make_folder(Path(DEFAULT_BENCH_OUT).parent)  # out/, bt-manip's own default folder
+    check_output_folder("--out", args.out)
     base = _episode_spec(args)
     with Episode(base):  # check the tree and world once, before starting workers
         pass
@@ -325,7 +363,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     summary = summarise(results, base)
     print(summary.text())
     out = Path(args.out)
-    write_outputs(results, summary, out)
+    if _write_outputs([("--out", str(out), lambda: write_outputs(results, summary, out))]):
+        return EXIT_BAD_INPUT
     print(f"wrote {out}/episodes.json, episodes.csv, summary.json, outcomes.png")
     return 0 if summary.successes == summary.runs else 1
 

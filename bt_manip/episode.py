@@ -27,6 +27,8 @@ class EpisodeSpec:
     blackboard: dict[str, Any] = field(default_factory=dict)
     inject: list[FaultSpec] = field(default_factory=list)
     options: RunOptions = field(default_factory=RunOptions)
+    imports: list[str] = field(default_factory=list)
+    """User modules that register nodes (``--import``), imported before the tree loads."""
 
 
 class Episode:
@@ -41,6 +43,7 @@ class Episode:
 
         self.spec = spec
         self.world: Any = None
+        _load_behaviours(spec.imports)
         if spec.world:
             from bt_manip.sim.world import World
 
@@ -51,7 +54,6 @@ class Episode:
             self.context = TreeContext(
                 clock=clock, world=self.world, services={"faults": self.faults}
             )
-            _load_behaviours()
             self.tree = load_tree(
                 spec.tree,
                 tree_id=spec.tree_id,
@@ -89,6 +91,13 @@ class Episode:
         self.close()
 
 
-def _load_behaviours() -> None:
-    """Register the robot behaviours with the node registry (importing them does it)."""
+def _load_behaviours(imports: Sequence[str] = ()) -> None:
+    """Register the robot behaviours and the user's modules' nodes with the node registry
+    (importing them does it); InputError naming ``--import`` when a user's module fails."""
     import bt_manip.behaviours  # noqa: F401
+    from bt_manip.errors import InputError
+    from bt_manip.plugins import import_modules
+
+    problems = import_modules(imports)
+    if problems:
+        raise InputError(problems)

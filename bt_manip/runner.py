@@ -25,6 +25,8 @@ from typing import Any, Protocol
 import py_trees
 
 from bt_manip.bt.node import TreeRuntimeError
+from bt_manip.failure_cause import FailureCause
+from bt_manip.outputs import write_text
 
 EXIT_SUCCESS = 0
 EXIT_FAILURE = 1
@@ -86,6 +88,9 @@ class RunReport:
     seed: int | None = None
     nodes: list[NodeRecord] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
+    cause: dict[str, str] = field(default_factory=dict)
+    """On FAILURE, the node whose failure ended the run: ``path``, ``name``, ``node`` (its ID)
+    and ``reason``; empty otherwise."""
 
     @property
     def exit_code(self) -> int:
@@ -104,8 +109,7 @@ class RunReport:
         return data
 
     def write(self, path: str | Path) -> None:
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        Path(path).write_text(json.dumps(self.to_json(), indent=2) + "\n")
+        write_text(path, json.dumps(self.to_json(), indent=2) + "\n")
 
     def summary(self) -> str:
         rtf = self.real_time_factor
@@ -115,10 +119,19 @@ class RunReport:
             f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
             f"({rtf_text}), {self.ticks} ticks",
         ]
+        cause = self.cause.get("path")
         failed = [n for n in self.nodes if "FAILURE" in (n.status, n.last_status) and n.reason]
+        failed.sort(key=lambda n: n.path != cause)  # the failure that ended the run first
         for n in failed[:10]:
-            lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}")
+            ended = " (ended the run)" if n.path == cause else ""
+            lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}{ended}")
         return "\n".join(lines)
+
+
+def _cause_json(cause: FailureCause | None) -> dict[str, str]:
+    if cause is None:
+        return {}
+    return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
 
 
 def node_records(root: py_trees.behaviour.Behaviour) -> list[NodeRecord]:
@@ -159,6 +172,8 @@ class Runner:
         self.options = options or RunOptions()
         self.on_tick = list(on_tick)
         self.ticks = 0
+        self.cause: FailureCause | None = None
+        """The node whose failure ended the run (bt_manip trees; None otherwise)."""
         if world is not None:
             ratio = world.rate_hz / self.options.tick_hz
             self.steps_per_tick = max(1, round(ratio))
@@ -216,6 +231,7 @@ class Runner:
             wall_time=wall,
             ticks=self.ticks,
             nodes=self._records(),
+            cause=_cause_json(self.cause),
         )
 
     def _advance(self, wall0: float) -> None:
@@ -239,7 +255,13 @@ class Runner:
         return node_records(self.tree.root)
 
     def _failure_reason(self) -> str:
-        """The deepest failed node's reason: what the user needs to read first."""
+        """The reason of the failure that ended the run (see :mod:`bt_manip.failure_cause`):
+        what the user needs to read first."""
+        if callable(getattr(self.tree, "walk", None)):
+            from bt_manip.failure_cause import failure_cause
+
+            self.cause = failure_cause(self.tree)
+            return self.cause.text() if self.cause is not None else ""
         failed = [
             r for r in self._records() if "FAILURE" in (r.status, r.last_status) and r.reason
         ]

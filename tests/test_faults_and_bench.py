@@ -154,6 +154,61 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     assert all(e["sim_time"] == pytest.approx(0.5, abs=0.06) for e in episodes)
     assert summary["metrics"]["blocks"]["mean"] == 3.0
     assert summary["injected"].get("failure", 0) == 4 - summary["successes"]
+    failed = [e for e in episodes if e["status"] == "FAILURE"]
+    assert [e["failed_node"] for e in failed] == ["maybe (AlwaysSuccess)"] * len(failed)
     assert (out / "episodes.csv").read_text().splitlines()[0].endswith("injected,blocks")
     assert (out / "outcomes.png").stat().st_size > 1000
     assert f"success: {summary['successes']}/4" in text
+
+
+def test_outcomes_plot_has_integer_seed_and_count_ticks() -> None:
+    from bt_manip.bench import outcomes_figure
+
+    results = [
+        EpisodeResult(3, "SUCCESS", "", 0.8, 0.1, 16),
+        EpisodeResult(4, "FAILURE", "Sequence/x: no", 0.5, 0.1, 10, "x"),
+        EpisodeResult(5, "SUCCESS", "", 0.8, 0.1, 16),
+    ]
+    fig = outcomes_figure(results, summarise(results, EpisodeSpec(tree="t.xml", world="w.yaml")))
+    left, right = fig.axes
+    fig.canvas.draw()
+    seeds = [t for t in left.get_xticks() if left.get_xlim()[0] <= t <= left.get_xlim()[1]]
+    counts = [t for t in right.get_yticks() if right.get_ylim()[0] <= t <= right.get_ylim()[1]]
+    assert seeds and all(float(t).is_integer() for t in seeds)
+    assert counts and all(float(t).is_integer() for t in counts)
+    assert right.get_title() == "histogram of sim time per episode (3 episodes)"
+    assert right.get_xlabel() == "sim time per episode (s)"
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)
+
+
+def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[1]
+    tree = tmp_path / "long.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sleep msec="3600000"/>'
+        "</BehaviorTree></root>"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "bt_manip.cli", "bench", str(tree), "--world",
+         str(root / "worlds" / "sawyer_table.yaml"), "--runs", "6", "--jobs", "2",
+         "--out", str(tmp_path / "out")],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONUNBUFFERED": "1"},
+        start_new_session=True,  # Ctrl-C reaches the whole process group, workers included
+    )
+    assert proc.stdout is not None
+    assert proc.stdout.readline().startswith("bench: 6 episodes")  # the workers are starting
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "interrupted" in err.splitlines()
+    assert not (tmp_path / "out").exists()

@@ -16,6 +16,8 @@ from bt_manip.bt.models import write_models
 from bt_manip.bt.registry import registry
 from bt_manip.bt.xml_loader import load_tree, validate
 from bt_manip.errors import InputError, Problem
+from bt_manip.outputs import check_output_file, write_text
+from bt_manip.plugins import add_import_flag, import_modules
 
 PLUGIN_PACKAGES = ("bt_manip.behaviours",)
 
@@ -23,14 +25,14 @@ PLUGIN_PACKAGES = ("bt_manip.behaviours",)
 def load_plugins(extra: Iterable[str] = ()) -> list[Problem]:
     """Import the modules that register non-built-in nodes; problems for those that fail."""
     problems = []
-    for module in (*PLUGIN_PACKAGES, *extra):
+    for module in PLUGIN_PACKAGES:
         try:
             importlib.import_module(module)
         except ModuleNotFoundError as e:
-            if module in PLUGIN_PACKAGES and e.name == module:
+            if e.name == module:
                 continue
             problems.append(Problem(module, None, f"cannot import module: {e}"))
-    return problems
+    return problems + import_modules(extra)
 
 
 def _print_problems(problems: Iterable[Problem]) -> None:
@@ -42,8 +44,7 @@ def _common(parser: argparse.ArgumentParser, models: bool = True) -> None:
     if models:
         parser.add_argument("--models", nargs="+", action="extend", default=[], metavar="FILE",
                             help="TreeNodesModel files declaring nodes not implemented here")
-    parser.add_argument("--import", dest="imports", action="append", default=[],
-                        metavar="MODULE", help="import MODULE to register its nodes")
+    add_import_flag(parser)
 
 
 def add_verbs(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
@@ -90,6 +91,12 @@ def validate_command(args: argparse.Namespace) -> int:
 
 
 def show_command(args: argparse.Namespace) -> int:
+    if args.dot:
+        try:
+            check_output_file("--dot", args.dot)
+        except InputError as e:
+            _print_problems(e.problems)
+            return 2
     failures = load_plugins(args.imports)
     if failures:
         _print_problems(failures)
@@ -103,8 +110,7 @@ def show_command(args: argparse.Namespace) -> int:
     print(render_tree(tree))
     if args.dot:
         try:
-            with open(args.dot, "w", encoding="utf-8") as f:
-                f.write(render_dot(tree))
+            write_text(args.dot, render_dot(tree))
         except OSError as e:
             _print_problems([Problem(args.dot, None, f"cannot write: {e.strerror}")])
             return 2

@@ -123,6 +123,11 @@ def _include(doc: Document, path: str, element: Element, stack: tuple[str, ...])
         return
     base = os.path.dirname(os.path.abspath(path)) if os.path.exists(path) else os.getcwd()
     resolved = os.path.normpath(os.path.join(base, target))
+    if os.path.isdir(resolved):
+        doc.problems.append(Problem(path, element.line,
+                                    f"included path '{target}' is a directory ({resolved}); "
+                                    "include an XML file, e.g. <include path=\"subtrees.xml\"/>"))
+        return
     if not os.path.isfile(resolved):
         doc.problems.append(Problem(path, element.line,
                                     f"included file '{target}' not found (looked for "

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import copy
 import difflib
+import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -55,6 +56,7 @@ POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
 IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
 
 _MISSING = object()
+_ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 _PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
 _BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
@@ -119,6 +121,11 @@ class BtNode(PortsMixin):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
+    started_order: int = 0
+    failure_order: int = 0
+    """When the node last started (was ticked while IDLE) and last returned FAILURE, as ranks
+    on one counter (0: never); they tell the failures of a node's last run from older ones
+    (see :mod:`bt_manip.failure_cause`)."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
@@ -320,6 +327,8 @@ class BtNode(PortsMixin):
 
     def execute_tick(self) -> NodeStatus:
         """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
+        if self.bt_status is NodeStatus.IDLE:
+            self.started_order = next(_ORDER)
         new = self._check_preconditions() if self._pre else None
         if new is None and self.bt_status is NodeStatus.IDLE and self._fault_injected():
             new = NodeStatus.FAILURE
@@ -333,6 +342,8 @@ class BtNode(PortsMixin):
             if "_post" in self._post:
                 self._run_script("_post", self._post["_post"])
         self.last_status = new
+        if new is NodeStatus.FAILURE:
+            self.failure_order = next(_ORDER)
         if new is not NodeStatus.SKIPPED:
             self.bt_status = new
             self.status = _PY_FROM_BT[new]

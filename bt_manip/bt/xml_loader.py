@@ -142,7 +142,8 @@ class _Checker:
             if self.need_implementation:
                 check.errors.append(
                     (f"node '{spec.node_id}' is declared in a TreeNodesModel but has no "
-                     "implementation; import the Python module that registers it", None))
+                     "implementation; import the Python module that registers it with "
+                     "--import MODULE", None))
         for message, column in check.errors:
             if column is not None:
                 message = f"{message} (column {column} of the script)"

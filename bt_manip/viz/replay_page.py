@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.outputs import write_text
 from bt_manip.viz.recorder import Recording
 from bt_manip.viz.scene import ROOT, column_major
 from bt_manip.viz.tree_page import STATIC_DIR, meshcat_bundle, render_page
@@ -176,6 +177,5 @@ def write_replay(path: str | Path, rec: Recording, title: str = "") -> int:
     page = render_page(f"{title} (replay)", {"format": FORMAT_VERSION}, scripts, view,
                        timeline=timeline, follow=True)
     out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(page)
+    write_text(out, page)
     return out.stat().st_size

@@ -3,8 +3,9 @@ setup, not an action), and a way to run a snippet of tree XML against a world.""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TypeVar
 
 import pybullet as pb
 import pytest
@@ -33,6 +34,27 @@ def run_xml(world: World, body: str, max_sim_time: float = 60.0) -> tuple[RunRep
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
     tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
     return Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run(), tree
+
+
+T = TypeVar("T")
+
+
+def sample_every_step(world: World, probe: Callable[[], T]) -> list[T]:
+    """A list that receives ``probe()`` after every physics step of ``world`` from now on.
+
+    Tests assert on extremes of this list, not on 20 Hz tick samples: a peak can fall between
+    two ticks, and where it falls depends on the machine's floating-point path.
+    """
+    samples: list[T] = []
+    step = world.step
+
+    def stepping(n: int = 1) -> None:
+        for _ in range(n):
+            step(1)
+            samples.append(probe())
+
+    world.step = stepping  # type: ignore[method-assign]
+    return samples
 
 
 def reasons(report: RunReport) -> dict[str, str]:
