@@ -16,6 +16,7 @@ from bt_manip.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 from bt_manip.viz.replay_page import read_replay
+from bt_manip.viz.tree_page import PortUnavailable
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -111,7 +112,7 @@ def test_server_lost_mid_run_warns_once(capsys: pytest.CaptureFixture) -> None:
     assert capsys.readouterr().err.count("warning:") == 1
 
 
-def test_taken_port_keeps_the_3d_view(capsys: pytest.CaptureFixture) -> None:
+def test_taken_port_is_refused_before_anything_starts() -> None:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         s.listen()
@@ -119,9 +120,14 @@ def test_taken_port_keeps_the_3d_view(capsys: pytest.CaptureFixture) -> None:
         world = World(ROOM, seed=3)
         live = LiveViewer(world, DriveTree(world), LiveOptions(port=port), say=lambda s: None)
         try:
-            assert live.start()
-            assert live.page is None and live.link is not None
-            assert f"port {port}" in capsys.readouterr().err
+            with pytest.raises(PortUnavailable) as caught:
+                live.start()
+            assert caught.value.in_use and caught.value.flag == "--port"
+            assert caught.value.strerror == (
+                f"port {port} is in use on 127.0.0.1 (another bt-manip --viz?); choose another "
+                "port, or 0 for any free one"
+            )
+            assert live.page is None and live.link is None  # no meshcat server was started
         finally:
             live.close()
             world.close()

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
-from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -12,6 +11,7 @@ import pytest
 from drive_tree import ROOM, DriveTree
 
 from bt_manip.runner import Runner, RunOptions
+from bt_manip.sim.events import Attached, Detached
 from bt_manip.sim.world import World
 from bt_manip.viz.recorder import Recorder, RecordOptions
 from bt_manip.viz.replay_page import read_replay, track_samples
@@ -76,13 +76,17 @@ def test_replay_holds_status_changes_with_reasons(tmp_path: Path) -> None:
 
 
 def test_replay_holds_overlays_and_highlights(tmp_path: Path) -> None:
-    held: list[str] = []
+    held: list[bool] = []
 
     def grab_at_one_second(runner: Any) -> None:
-        # stand-in for an attach joint: report the crate as held from t = 1 s to 2 s
+        # stand-in for an attach joint: announce the crate held from t = 1 s to 2 s
         world = runner.world
-        held[:] = ["crate"] if 1.0 <= world.time < 2.0 else []
-        world.attachments.all = lambda: [SimpleNamespace(object_name=n) for n in held]
+        holding = 1.0 <= world.time < 2.0
+        if holding != bool(held and held[-1]):
+            event = Attached if holding else Detached
+            args = ("crate", "husky", "tool0") if holding else ("crate", "husky")
+            world.events.announce(event(world.time, *args))
+            held.append(holding)
 
     _, header, _, world = _record(tmp_path / "run.html", hooks=[grab_at_one_second])
     world.close()

@@ -1,0 +1,158 @@
+"""Where the 3D views put their camera: behind and above the robot, with no wall in between.
+
+Both pages look at the first robot (the live page and the replay's "follow robot" keep it in
+the middle as it moves) from a fixed offset. :func:`clear_offset` picks that offset among a few
+candidates, in order of preference (behind the robot and not too steep first, then from the
+sides, then from higher up), by casting rays in the World from points on the robot (low, middle,
+top) to each candidate camera position, at the robot's positions in the frames that matter.
+A candidate is penalised by how many rays a wall or piece of furniture blocks, the first and
+last frames counting most. Casting rays only reads the simulation.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pybullet as pb
+
+from bt_manip.viz.scene import ROOT
+
+DISTANCE = 3.6
+"""Camera distance (m) from the robot's ground point."""
+ELEVATIONS_DEG = (32.0, 48.0, 64.0, 80.0)
+AZIMUTHS_DEG = (0.0, -35.0, 35.0, -70.0, 70.0, -110.0, 110.0, 180.0)
+"""Directions around the robot, 0 = straight behind it (against its heading)."""
+HEIGHT_FRACTIONS = (0.3, 0.65, 0.95)
+"""Where on the robot the rays start, as fractions of its height."""
+END_WEIGHT = 10
+"""How much more a blocked view of the first or last frame counts than one in between."""
+MIDDLE_FRAMES = 24
+
+
+@dataclass(frozen=True)
+class CameraView:
+    """A camera that looks at ``target`` from ``target + offset`` (world frame, metres)."""
+
+    target: tuple[float, float, float]
+    offset: tuple[float, float, float]
+    follow: str = ""
+    """Scene path of the body the view follows ('' when none)."""
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "target": [round(v, 4) for v in self.target],
+            "offset": [round(v, 4) for v in self.offset],
+            "follow": self.follow,
+        }
+
+
+DEFAULT_OFFSET = (-2.4, -2.0, 1.9)
+
+
+def candidate_offsets(yaw: float) -> list[tuple[float, float, float]]:
+    """Camera offsets in order of preference for a robot heading ``yaw`` (rad)."""
+    out = []
+    for elevation in ELEVATIONS_DEG:
+        el = math.radians(elevation)
+        for azimuth in AZIMUTHS_DEG:
+            a = yaw + math.pi + math.radians(azimuth)
+            horizontal = DISTANCE * math.cos(el)
+            out.append(
+                (horizontal * math.cos(a), horizontal * math.sin(a), DISTANCE * math.sin(el))
+            )
+    return out
+
+
+def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int]) -> np.ndarray:
+    """Which of the segments start -> end cross a blocker (other bodies are seen through)."""
+    c = world.client
+    out = np.zeros(len(starts), dtype=bool)
+    todo = list(range(len(starts)))
+    origin = starts.copy()
+    for _ in range(4):  # look past up to three bodies that are not blockers
+        if not todo:
+            break
+        hits = pb.rayTestBatch(origin[todo].tolist(), ends[todo].tolist(), physicsClientId=c)
+        again = []
+        for k, hit in zip(todo, hits, strict=True):
+            body = hit[0]
+            if body < 0:
+                continue
+            if body in blockers:
+                out[k] = True
+                continue
+            direction = ends[k] - starts[k]
+            origin[k] = np.asarray(hit[3]) + 1e-3 * direction / np.linalg.norm(direction)
+            again.append(k)
+        todo = again
+    return out
+
+
+def clear_offset(
+    world: Any, robot_body: int, positions: Sequence[np.ndarray], yaw: float,
+    weights: Sequence[int] | None = None,
+) -> tuple[float, float, float]:
+    """The most preferred offset from which the robot at ``positions`` (its base, world x, y)
+    is least hidden by walls and furniture (see the module docstring)."""
+    lo, hi = pb.getAABB(robot_body, physicsClientId=world.client)
+    height = max(0.2, hi[2] - max(0.0, lo[2]))
+    blockers = set(world.obstacle_body_ids())
+    weights = list(weights) if weights is not None else [1] * len(positions)
+    starts = np.array(
+        [[p[0], p[1], f * height] for p in positions for f in HEIGHT_FRACTIONS], dtype=float
+    )
+    w = np.repeat(weights, len(HEIGHT_FRACTIONS))
+    best, best_score = DEFAULT_OFFSET, math.inf
+    for rank, offset in enumerate(candidate_offsets(yaw)):
+        ends = np.array([[s[0] + offset[0], s[1] + offset[1], offset[2]] for s in starts])
+        score = float(w[_blocked(world, starts, ends, blockers)].sum()) * 1000 + rank
+        if score < best_score:
+            best, best_score = offset, score
+        if score < 1000:  # nothing blocked: the most preferred clear view
+            break
+    return best
+
+
+def _first_robot(world: Any) -> tuple[str, Any] | None:
+    robots = getattr(world, "robots", None) or {}
+    if not robots:
+        return None
+    name = next(iter(robots))
+    return name, robots[name]
+
+
+def live_camera(world: Any) -> CameraView:
+    """The live page's view: the first robot where it stands now, from a clear offset."""
+    first = _first_robot(world) if world is not None else None
+    if first is None:
+        return CameraView((0.0, 0.0, 0.0), DEFAULT_OFFSET)
+    name, robot = first
+    x, y, yaw = robot.base_pose2d()
+    offset = clear_offset(world, robot.body, [np.array([x, y])], yaw)
+    return CameraView((float(x), float(y), 0.0), offset, f"{ROOT}/{name}")
+
+
+def replay_camera(world: Any, rec: Any) -> dict[str, Any]:
+    """The replay's view: the first robot, from an offset clear at its first and last frames
+    (and as clear as can be in between)."""
+    first = _first_robot(world)
+    if first is None or not rec.times:
+        return CameraView((0.0, 0.0, 0.0), DEFAULT_OFFSET).to_json()
+    name, robot = first
+    path = f"{ROOT}/{name}"
+    try:
+        _, samples = rec.track_samples(path)
+    except KeyError:
+        return CameraView((0.0, 0.0, 0.0), DEFAULT_OFFSET).to_json()
+    n = len(samples)
+    picks = sorted({0, n - 1, *np.linspace(0, n - 1, MIDDLE_FRAMES).round().astype(int)})
+    weights = [END_WEIGHT if k in (0, n - 1) else 1 for k in picks]
+    q = samples[0][3:7]
+    yaw = math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
+    offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], float(yaw), weights)
+    target = (float(samples[0][0]), float(samples[0][1]), 0.0)
+    return CameraView(target, offset, path).to_json()
