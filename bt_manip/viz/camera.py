@@ -2,11 +2,12 @@
 
 Both pages look at the first robot (the live page and the replay's "follow robot" keep it in
 the middle as it moves) from a fixed offset. :func:`clear_offset` picks that offset among a few
-candidates, in order of preference (behind the robot and not too steep first, then from the
-sides, then from higher up), by casting rays in the World from points on the robot (low, middle,
-top) to each candidate camera position, at the robot's positions in the frames that matter.
-A candidate is penalised by how many rays a wall or piece of furniture blocks, the first and
-last frames counting most. Casting rays only reads the simulation.
+candidates, in order of preference (behind the robot and to one side, not too steep, first;
+then from other sides; then from higher up), by casting rays in the World from points on the
+robot (low and high, at its centre and around its outline) to each candidate camera position,
+at the robot's positions in the frames that matter. A candidate is penalised by how many rays
+a wall or piece of furniture blocks, the first and last frames counting most. Casting rays only
+reads the simulation.
 """
 
 from __future__ import annotations
@@ -21,13 +22,17 @@ import pybullet as pb
 
 from bt_manip.viz.scene import ROOT
 
-DISTANCE = 3.6
+DISTANCE = 3.0
 """Camera distance (m) from the robot's ground point."""
-ELEVATIONS_DEG = (32.0, 48.0, 64.0, 80.0)
-AZIMUTHS_DEG = (0.0, -35.0, 35.0, -70.0, 70.0, -110.0, 110.0, 180.0)
-"""Directions around the robot, 0 = straight behind it (against its heading)."""
-HEIGHT_FRACTIONS = (0.3, 0.65, 0.95)
-"""Where on the robot the rays start, as fractions of its height."""
+ELEVATIONS_DEG = (38.0, 52.0, 66.0, 80.0)
+AZIMUTHS_DEG = (-40.0, 40.0, 0.0, -80.0, 80.0, -120.0, 120.0, 180.0)
+"""Directions around the robot, 0 = straight behind it (against its heading); behind and to
+one side first, so that the robot does not hide what it works on."""
+HEIGHT_FRACTIONS = (0.3, 0.95)
+"""Where on the robot the rays start, as fractions of its height ..."""
+SPREAD_FRACTIONS = ((0.0, 0.0), (1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0))
+"""... and around its base (its centre and four points on its outline), so that no part of it
+is hidden."""
 END_WEIGHT = 10
 """How much more a blocked view of the first or last frame counts than one in between."""
 MIDDLE_FRAMES = 24
@@ -92,20 +97,32 @@ def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int
     return out
 
 
+def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned box around every link of a body."""
+    boxes = [
+        pb.getAABB(body, link, physicsClientId=client)
+        for link in range(-1, pb.getNumJoints(body, physicsClientId=client))
+    ]
+    return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+
+
 def clear_offset(
     world: Any, robot_body: int, positions: Sequence[np.ndarray], yaw: float,
     weights: Sequence[int] | None = None,
 ) -> tuple[float, float, float]:
     """The most preferred offset from which the robot at ``positions`` (its base, world x, y)
     is least hidden by walls and furniture (see the module docstring)."""
-    lo, hi = pb.getAABB(robot_body, physicsClientId=world.client)
+    lo, hi = _extent(world.client, robot_body)
     height = max(0.2, hi[2] - max(0.0, lo[2]))
+    radius = 0.5 * max(hi[0] - lo[0], hi[1] - lo[1]) / math.sqrt(2.0)
     blockers = set(world.obstacle_body_ids())
     weights = list(weights) if weights is not None else [1] * len(positions)
     starts = np.array(
-        [[p[0], p[1], f * height] for p in positions for f in HEIGHT_FRACTIONS], dtype=float
+        [[p[0] + sx * radius, p[1] + sy * radius, f * height]
+         for p in positions for sx, sy in SPREAD_FRACTIONS for f in HEIGHT_FRACTIONS],
+        dtype=float,
     )
-    w = np.repeat(weights, len(HEIGHT_FRACTIONS))
+    w = np.repeat(weights, len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS))
     best, best_score = DEFAULT_OFFSET, math.inf
     for rank, offset in enumerate(candidate_offsets(yaw)):
         ends = np.array([[s[0] + offset[0], s[1] + offset[1], offset[2]] for s in starts])

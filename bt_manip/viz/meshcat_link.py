@@ -129,6 +129,8 @@ class MeshcatLink:
 
     def _exchange(self, requests: list[list[bytes]]) -> list[bytes]:
         """Send every request, then collect one answer per request (in order)."""
+        if self._socket is None:
+            raise ViewerUnavailable("the meshcat connection is closed")
         try:
             for frames in requests:
                 self._socket.send_multipart([b"", *frames])
