@@ -106,26 +106,48 @@ def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 
 
+def _ray_starts(
+    world: Any, robot_body: int, positions: Sequence[np.ndarray]
+) -> np.ndarray:
+    """Points on the robot (see :data:`HEIGHT_FRACTIONS`, :data:`SPREAD_FRACTIONS`) at each
+    of ``positions``: rows x, y, z, one block of rows per position."""
+    lo, hi = _extent(world.client, robot_body)
+    height = max(0.2, hi[2] - max(0.0, lo[2]))
+    radius = 0.5 * max(hi[0] - lo[0], hi[1] - lo[1]) / math.sqrt(2.0)
+    return np.array(
+        [[p[0] + sx * radius, p[1] + sy * radius, f * height]
+         for p in positions for sx, sy in SPREAD_FRACTIONS for f in HEIGHT_FRACTIONS],
+        dtype=float,
+    )
+
+
+def hidden_rays(
+    world: Any, robot_body: int, positions: Sequence[np.ndarray], offset: Sequence[float]
+) -> int:
+    """How many rays from points on the robot at ``positions`` to the camera at ``offset``
+    from it a wall or piece of furniture blocks (0: the robot is in full view)."""
+    starts = _ray_starts(world, robot_body, positions)
+    per_position = len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS)
+    centres = np.repeat(np.array([[p[0], p[1]] for p in positions]), per_position, axis=0)
+    ends = np.column_stack([centres + np.asarray(offset[:2]), np.full(len(starts), offset[2])])
+    return int(_blocked(world, starts, ends, set(world.obstacle_body_ids())).sum())
+
+
 def clear_offset(
     world: Any, robot_body: int, positions: Sequence[np.ndarray], yaw: float,
     weights: Sequence[int] | None = None,
 ) -> tuple[float, float, float]:
     """The most preferred offset from which the robot at ``positions`` (its base, world x, y)
     is least hidden by walls and furniture (see the module docstring)."""
-    lo, hi = _extent(world.client, robot_body)
-    height = max(0.2, hi[2] - max(0.0, lo[2]))
-    radius = 0.5 * max(hi[0] - lo[0], hi[1] - lo[1]) / math.sqrt(2.0)
     blockers = set(world.obstacle_body_ids())
     weights = list(weights) if weights is not None else [1] * len(positions)
-    starts = np.array(
-        [[p[0] + sx * radius, p[1] + sy * radius, f * height]
-         for p in positions for sx, sy in SPREAD_FRACTIONS for f in HEIGHT_FRACTIONS],
-        dtype=float,
-    )
-    w = np.repeat(weights, len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS))
+    starts = _ray_starts(world, robot_body, positions)
+    per_position = len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS)
+    w = np.repeat(weights, per_position)
+    centres = np.repeat(np.array([[p[0], p[1]] for p in positions]), per_position, axis=0)
     best, best_score = DEFAULT_OFFSET, math.inf
     for rank, offset in enumerate(candidate_offsets(yaw)):
-        ends = np.array([[s[0] + offset[0], s[1] + offset[1], offset[2]] for s in starts])
+        ends = np.column_stack([centres + np.asarray(offset[:2]), np.full(len(starts), offset[2])])
         score = float(w[_blocked(world, starts, ends, blockers)].sum()) * 1000 + rank
         if score < best_score:
             best, best_score = offset, score

@@ -233,7 +233,9 @@ class Recorder:
         self._closed = True
         if self._unsubscribe is not None:
             self._unsubscribe()
-        if self.world is not None and self.world.client >= 0:
+        if self.world is None:
+            self._sample(self._last_time)
+        elif self.world.client >= 0:  # a closed world has no poses left to read
             self._take_events(self._last_time)
             self._sample(self._last_time)
             from bt_manip.viz.camera import replay_camera

@@ -357,3 +357,43 @@ def test_live_view_shows_spawned_blocks_moving_with_the_gripper(browser: Any) ->
     assert np.linalg.norm(offsets - offsets[0], axis=1).max() < 0.01  # with the fingers
     assert np.linalg.norm(offsets[0]) < 0.06  # between them
     assert drawn_before == 1 and gone
+
+
+DEEP_FAILURE = """<root BTCPP_format="4"><BehaviorTree ID="M">
+  <Sequence name="carry_wall_panel_to_the_goal_in_the_living_room">
+    <Fallback name="carry_or_back_off_and_try_again_from_where_it_stands">
+      <AlwaysFailure name="carry_to_goal_through_the_narrow_doorway_of_the_kitchen"
+                     _onFailure="why := 'x'"/>
+      <Sequence name="clear_and_retry_after_backing_up_half_a_metre">
+        <Sleep name="back_up" msec="20"/>
+        <AlwaysFailure name="carry_failed_for_good_after_every_retry_of_the_route"/>
+      </Sequence>
+    </Fallback>
+  </Sequence>
+</BehaviorTree></root>"""
+
+
+def test_failed_leaves_stay_red_and_long_failure_lines_wrap(browser: Any, tmp_path: Path) -> None:
+    from bt_manip.bt import load_tree_string
+
+    tree = load_tree_string(DEEP_FAILURE)
+    page_file = tmp_path / "fail.html"
+    recorder = Recorder(page_file, None, tree)
+    report = Runner(tree, None, RunOptions(tick_hz=200), on_tick=[recorder]).run()
+    recorder.close()
+    assert report.status == "FAILURE"
+    page = browser.new_page(viewport=VIEWPORT)
+    page.goto(page_file.as_uri())
+    page.wait_for_function("window.btReplay !== undefined", timeout=30000)
+    page.evaluate("btReplay.seek(btReplay.duration)")
+    shown = _statuses(page)
+    assert set(shown.values()) == {"FAILURE"} | ({"SUCCESS"} if "back_up" in shown else set())
+    assert shown["carry_to_goal_through_the_narrow_doorway_of_the_kitchen"] == "FAILURE"
+    assert shown["carry_failed_for_good_after_every_retry_of_the_route"] == "FAILURE"
+    details = page.inner_text("#details")
+    assert "carry_failed_for_good_after_every_retry_of_the_route" in details
+    overflow = page.evaluate(
+        "[...document.querySelectorAll('#details .fail')].map(e => e.scrollWidth - e.clientWidth)"
+    )
+    assert overflow and max(overflow) <= 0, overflow  # wrapped, not cut off at the edge
+    page.close()
