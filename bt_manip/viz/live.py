@@ -304,7 +304,7 @@ class LiveViewer:
 
     def show_last(self) -> None:
         """Send what changed since the last update (the run's end state)."""
-        if self.link is None:
+        if self.link is None or (self.world is not None and self.world.client < 0):
             return
         try:
             self._take_events()
