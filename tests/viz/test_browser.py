@@ -119,7 +119,7 @@ def test_replay_page_plays_offline(browser: Any, tmp_path: Path) -> None:
 
 def test_live_page_follows_the_run(browser: Any) -> None:
     world = World(ROOM, seed=3)
-    tree = DriveTree(world, drive_s=2.5)
+    tree = DriveTree(world, drive_s=3.5)
     live = LiveViewer(world, tree, LiveOptions(port=0), say=lambda s: None)
     assert live.start()
     go = threading.Event()
@@ -144,8 +144,8 @@ def test_live_page_follows_the_run(browser: Any) -> None:
         go.set()
         seen = [first]
         page.wait_for_timeout(1200)
+        seen.append(_statuses(page))  # before the screenshot, which is slow on a busy machine
         middle = _image(page.screenshot())
-        seen.append(_statuses(page))
         while not done.is_set():
             page.wait_for_timeout(250)
             seen.append(_statuses(page))
