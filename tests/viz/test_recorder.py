@@ -129,3 +129,46 @@ def test_replay_page_is_self_contained(tmp_path: Path) -> None:
     # nothing is fetched: no external scripts, styles, images or frames
     assert not re.search(r"<(script|link|img|iframe)[^>]+(src|href)=", text)
     assert "MeshCat" in text and 'id="bt-replay"' in text
+
+
+def test_bodies_added_and_removed_during_the_run_keep_their_times(tmp_path: Path) -> None:
+    from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D
+
+    def crate(name: str) -> BodySpec:
+        return BodySpec(
+            name=name, movable=True, parts=[Part("box", (0.3, 0.3, 0.3))], urdf=None,
+            pose=Pose3D((-1.5, 1.5, 0.6)), planar=False, mass=2.0, friction=0.8,
+            colour=(0.5, 0.3, 0.1, 1.0), randomize=Range2D(), line=0,
+        )
+
+    changes: dict[str, float] = {}
+
+    def drop_and_take_crates(runner: Any) -> None:
+        # what a block fault does (a crate falls), then DeleteModel, then the same name again
+        world = runner.world
+        for key, at, change in (("drop", 1.0, "spawn"), ("take", 2.0, "remove"),
+                                ("again", 3.0, "spawn")):
+            if key not in changes and world.time >= at:
+                changes[key] = world.time
+                if change == "spawn":
+                    world.spawn(crate("crate_drop"))
+                else:
+                    world.remove("crate_drop")
+
+    _, header, blobs, world = _record(tmp_path / "run.html", hooks=[drop_and_take_crates])
+    world.close()
+    bodies = {b["name"]: b for b in header["scene"]["bodies"]}
+    first, second = bodies["crate_drop"], bodies["crate_drop~2"]
+    assert first["appear"] == pytest.approx(changes["drop"], abs=1e-9)
+    assert first["disappear"] == pytest.approx(changes["take"], abs=1e-9)
+    assert second["appear"] == pytest.approx(changes["again"], abs=1e-9)
+    assert second["disappear"] is None and bodies["husky"]["appear"] == 0.0
+    assert f"{ROOT}/crate_drop~2/v0" in [o["path"] for o in header["scene"]["objects"]]
+    times = np.frombuffer(blobs[header["frames"]["times"]["offset"]:][
+        : header["frames"]["times"]["length"]], np.float32)
+    track = next(t for t in header["scene"]["tracks"] if t["path"] == f"{ROOT}/crate_drop")
+    # sampled from the tick it appeared at to the last sample before it was removed
+    assert times[track["first"]] == pytest.approx(changes["drop"], abs=1e-6)
+    assert times[track["first"] + track["count"] - 1] < changes["take"]
+    fall = track_samples(header, blobs, f"{ROOT}/crate_drop")[:, 2]
+    assert fall[0] == pytest.approx(0.6, abs=1e-6) and fall[-1] == pytest.approx(0.15, abs=0.01)
