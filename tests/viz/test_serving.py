@@ -209,3 +209,25 @@ def test_keep_serving_keeps_the_page_after_the_run_until_sigterm(tmp_path: Path)
     assert process.returncode == 0, out  # the run's own result
     time.sleep(0.2)
     assert _free(ports["tree page"]) and _free(ports["meshcat view"])
+
+
+def test_a_taken_default_port_falls_back_to_a_free_one(monkeypatch: pytest.MonkeyPatch) -> None:
+    from types import SimpleNamespace
+
+    import bt_manip.viz.hooks as hooks
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        s.listen()
+        taken = s.getsockname()[1]
+        monkeypatch.setattr(hooks, "DEFAULT_PORT", taken)
+        said: list[str] = []
+        args = SimpleNamespace(viz=True, port=None, bind=None, zmq_url=None, record=None)
+        viz = hooks.setup_viz(args, None, _Tiny(), say=said.append)
+        try:
+            assert viz.viewing and viz.viewer.page is not None
+            assert viz.viewer.page.port != taken
+            assert f"port {taken} is in use; serving the tree page on a free port instead" in said
+        finally:
+            viz.close()
+    assert viz.viewer.page is None and not viz.viewer.active
