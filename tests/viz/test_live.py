@@ -8,6 +8,7 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 from drive_tree import ROOM, DriveTree
 
@@ -53,10 +54,11 @@ def test_live_viewer_draws_and_serves_statuses() -> None:
         state = _get(live.page.url + "state.json")
         assert state["ticks"] == ticks and state["result"] == "SUCCESS"
         assert state["statuses"][names.index("drive")] == 2
-        # plan_a failed for one tick and is IDLE again; the page still lists why
+        # plan_a failed for one tick and was reset; the page still lists why
         (t, index, reason), = state["failures"]
         assert names[index] == "plan_a" and "doorway is blocked" in reason and t > 3.0
         assert "doorway is blocked" in state["reasons"][names.index("plan_a")]
+        assert state["statuses"][names.index("plan_a")] == 3  # shown FAILURE, not IDLE
         with urllib.request.urlopen(live.page.url, timeout=5) as res:
             page = res.read().decode()
         assert live.link.web_url in page and "static/live.js" in page
@@ -146,3 +148,31 @@ def test_cli_record_and_unreachable_viewer(tmp_path: Path, capsys: pytest.Captur
     assert header["result"] == "SUCCESS"
     assert header["info"]["tree"] == tree
     assert {n["id"] for n in header["tree"]["nodes"]} >= {"Sequence", "Script", "Sleep"}
+
+
+def test_the_live_view_keeps_the_robot_in_the_middle() -> None:
+    world = World(ROOM, seed=3)
+    tree = DriveTree(world)
+    live = LiveViewer(world, tree, LiveOptions(port=None, max_fps=1e6), say=lambda s: None)
+    shifts: list[list[float]] = []
+    try:
+        assert live.start() and live.link is not None
+        send_many = live.link.send_many
+
+        def spy(commands: list[dict[str, Any]]) -> None:
+            shifts.extend(c["matrix"] for c in commands
+                          if c["type"] == "set_transform" and c["path"] == "/meshcat")
+            send_many(commands)
+
+        live.link.send_many = spy  # type: ignore[method-assign]
+        start = world.robots["husky"].base_pose2d()[:2]
+        report = Runner(tree, world, RunOptions(), on_tick=[live]).run()
+        assert report.status == "SUCCESS"
+        end = world.robots["husky"].base_pose2d()[:2]
+    finally:
+        live.close()
+        world.close()
+    assert len(shifts) > 20  # re-centred again and again while it drove
+    last = shifts[-1]  # column-major 4x4: the translation is elements 12, 13
+    assert [-last[12], -last[13]] == pytest.approx(list(end), abs=0.006)
+    assert np.hypot(end[0] - start[0], end[1] - start[1]) > 1.0
