@@ -87,12 +87,11 @@ class LiveViewer:
         self.scene: Scene | None = None
         self.camera: CameraView | None = None
         self._sent: dict[str, np.ndarray] = {}
-        self._pending: list[WorldEvent] = []
+        self._pending: list[tuple[str, Any]] = []
         self._unsubscribe: Callable[[], None] | None = None
         self._centre: np.ndarray | None = None
         self._overlay_version = -1
         self._overlay_items: dict[str, Any] = {}
-        self._held: set[str] = set()
         self._last_publish = 0.0
         self._failures: list[tuple[float, int, str]] = []
         self.updates = 0
@@ -137,7 +136,7 @@ class LiveViewer:
             return
         self.scene = build_scene(self.world)
         self._send_bodies(list(self.scene.bodies.values()))
-        self._unsubscribe = self.world.events.subscribe(self._pending.append)
+        self._unsubscribe = self.world.events.subscribe(self._on_world_event)
         # meshcat's orbit controls always look at the world origin: shift the drawing so that
         # the first robot sits there, and put the camera behind and above it
         self.camera = live_camera(self.world)
@@ -163,26 +162,39 @@ class LiveViewer:
                 self._sent.pop(path, None)
         self._send_poses(moving)
 
+    def _on_world_event(self, event: WorldEvent) -> None:
+        """Listener of the World: note the change now (a new body is read from PyBullet while
+        it exists), send it after the tick."""
+        scene = self.scene
+        if scene is None:
+            return
+        if isinstance(event, BodyAdded):
+            self._pending.append(("add", scene.add_body(self.world, event)))
+        elif isinstance(event, BodyRemoved):
+            body = scene.remove_body(event.name)
+            if body is not None:
+                self._pending.append(("remove", body))
+        elif isinstance(event, Attached | Detached):
+            self._pending.append(("held" if isinstance(event, Attached) else "let go",
+                                  event.object_name))
+
     def _take_events(self) -> None:
-        """Draw what the World added since the last tick, delete what it removed."""
+        """Draw the bodies added since the last tick, delete the removed ones, highlight what
+        is held."""
         scene, link = self.scene, self.link
         if not self._pending or scene is None or link is None:
             return
-        events, self._pending[:] = list(self._pending), []
-        for event in events:
-            if isinstance(event, BodyAdded):
-                if event.name in scene.bodies:  # removed and added again within one tick
-                    link.delete(scene.bodies[event.name].path)
-                self._send_bodies([scene.add_body(self.world, event)])
-            elif isinstance(event, BodyRemoved):
-                body = scene.remove_body(event.name)
-                if body is not None:
-                    link.delete(body.path)
-                    for path in body.tracks:
-                        self._sent.pop(path, None)
-                self._held.discard(event.name)
-            elif isinstance(event, Attached | Detached):
-                self._set_highlight(event.object_name, isinstance(event, Attached))
+        pending, self._pending[:] = list(self._pending), []
+        for change, what in pending:
+            if change == "add":
+                if scene.bodies.get(what.name) is what:  # still there (not gone in the tick)
+                    self._send_bodies([what])
+            elif change == "remove":
+                link.delete(what.path)
+                for path in what.tracks:
+                    self._sent.pop(path, None)
+            else:
+                self._set_highlight(what, change == "held")
 
     def _follow(self, force: bool = False) -> None:
         """Keep the first robot in the middle of the view (the drawing moves under the
@@ -256,10 +268,6 @@ class LiveViewer:
         link, scene = self.link, self.scene
         if link is None or scene is None or name not in scene.bodies:
             return
-        if on:
-            self._held.add(name)
-        else:
-            self._held.discard(name)
         for obj in scene.bodies[name].objects:
             if obj.rgba is not None:
                 link.set_property(obj.path, "color", list(HIGHLIGHT_RGBA if on else obj.rgba))

@@ -112,7 +112,7 @@ class Recorder:
         self._scene: Scene | None = None
         self._present: dict[str, RecordedBody] = {}
         self._keys: dict[str, int] = {}
-        self._pending: list[WorldEvent] = []
+        self._appeared = False
         self._unsubscribe: Any = None
         self._next_sample = 0.0
         self._overlay_version = -1
@@ -124,7 +124,7 @@ class Recorder:
             for info_ in world.infos.values():
                 if info_.kind != "ground":
                     self._add_body(world, info_, 0.0)
-            self._unsubscribe = world.events.subscribe(self._pending.append)
+            self._unsubscribe = world.events.subscribe(self._on_world_event)
         self._sample(0.0)
         self._track_overlay(0.0)
 
@@ -143,28 +143,23 @@ class Recorder:
         self.rec.bodies.append(body)
         self._present[info.name] = body
 
-    def _take_events(self, t_now: float) -> bool:
-        """Apply what the World announced since the last tick; True when a body appeared."""
-        appeared = False
-        events, self._pending[:] = list(self._pending), []
-        for event in events:
-            t = min(float(event.time) - self._t0, t_now)
-            if isinstance(event, BodyAdded):
-                self._add_body(self.world, event, t)
-                appeared = True
-            elif isinstance(event, BodyRemoved):
-                body = self._present.pop(event.name, None)
-                if body is not None:
-                    body.disappear = t
-                    assert self._scene is not None
-                    self._scene.remove_body(event.name)
-            elif isinstance(event, Attached | Detached):
-                body = self._present.get(event.object_name)
-                if body is not None:
-                    self.rec.highlight_events.append(
-                        (t, body.key, isinstance(event, Attached))
-                    )
-        return appeared
+    def _on_world_event(self, event: WorldEvent) -> None:
+        """Listener of the World: a body is drawn when it appears (read from PyBullet while
+        it exists) and stops being sampled when it is removed."""
+        t = float(event.time) - self._t0
+        if isinstance(event, BodyAdded):
+            self._add_body(self.world, event, t)
+            self._appeared = True
+        elif isinstance(event, BodyRemoved):
+            body = self._present.pop(event.name, None)
+            if body is not None:
+                body.disappear = t
+                assert self._scene is not None
+                self._scene.remove_body(event.name)
+        elif isinstance(event, Attached | Detached):
+            body = self._present.get(event.object_name)
+            if body is not None:
+                self.rec.highlight_events.append((t, body.key, isinstance(event, Attached)))
 
     # -- sampling ---------------------------------------------------------------------------
     def _now(self, runner: Any) -> float:
@@ -215,10 +210,10 @@ class Recorder:
         is due (or a body just appeared)."""
         t = self._now(runner)
         self._last_time = t
-        appeared = self._take_events(t)
         for index, code, reason in self.watcher.update():
             self.rec.status_events.append((t, index, code, reason))
-        if t >= self._next_sample or appeared:
+        if t >= self._next_sample or self._appeared:
+            self._appeared = False
             self._sample(t)
         self._track_overlay(t)
         root = self.watcher.statuses[0] if self.watcher.statuses else 0
@@ -236,7 +231,6 @@ class Recorder:
         if self.world is None:
             self._sample(self._last_time)
         elif self.world.client >= 0:  # a closed world has no poses left to read
-            self._take_events(self._last_time)
             self._sample(self._last_time)
             from bt_manip.viz.camera import replay_camera
 

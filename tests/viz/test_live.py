@@ -176,3 +176,35 @@ def test_the_live_view_keeps_the_robot_in_the_middle() -> None:
     last = shifts[-1]  # column-major 4x4: the translation is elements 12, 13
     assert [-last[12], -last[13]] == pytest.approx(list(end), abs=0.006)
     assert np.hypot(end[0] - start[0], end[1] - start[1]) > 1.0
+
+
+def test_a_body_that_comes_and_goes_within_one_tick_breaks_nothing(tmp_path: Path) -> None:
+    from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D
+    from bt_manip.viz.recorder import Recorder
+
+    spec = BodySpec(
+        name="blink", movable=True, parts=[Part("box", (0.2, 0.2, 0.2))], urdf=None,
+        pose=Pose3D((-1.5, 1.5, 0.3)), planar=False, mass=1.0, friction=0.8,
+        colour=(0.5, 0.3, 0.1, 1.0), randomize=Range2D(), line=0,
+    )
+
+    def blink(runner: Any) -> None:
+        if runner.ticks == 5:  # spawned and deleted by one tick (a Sequence of both)
+            runner.world.spawn(spec)
+            runner.world.remove("blink")
+
+    world = World(ROOM, seed=3)
+    tree = DriveTree(world)
+    live = LiveViewer(world, tree, LiveOptions(port=None, max_fps=1e6), say=lambda s: None)
+    recorder = Recorder(tmp_path / "r.html", world, tree)
+    try:
+        assert live.start()
+        report = Runner(tree, world, RunOptions(), on_tick=[blink, live, recorder]).run()
+        assert report.status == "SUCCESS" and live.active
+        assert "blink" not in live.scene.bodies  # type: ignore[union-attr]
+    finally:
+        recorder.close()
+        live.close()
+        world.close()
+    header, _ = read_replay(tmp_path / "r.html")
+    assert "blink" not in {b["name"] for b in header["scene"]["bodies"]}  # never in a frame
