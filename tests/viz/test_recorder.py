@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -17,6 +18,7 @@ from bt_manip.viz.recorder import Recorder, RecordOptions
 from bt_manip.viz.replay_page import read_replay, track_samples
 from bt_manip.viz.scene import ROOT
 
+REPO = Path(__file__).resolve().parents[2]
 STATUS = {"IDLE": 0, "RUNNING": 1, "SUCCESS": 2, "FAILURE": 3}
 
 
@@ -172,3 +174,33 @@ def test_bodies_added_and_removed_during_the_run_keep_their_times(tmp_path: Path
     assert times[track["first"] + track["count"] - 1] < changes["take"]
     fall = track_samples(header, blobs, f"{ROOT}/crate_drop")[:, 2]
     assert fall[0] == pytest.approx(0.6, abs=1e-6) and fall[-1] == pytest.approx(0.15, abs=0.01)
+
+
+def test_a_block_fault_crate_is_in_the_replay(tmp_path: Path) -> None:
+    import bt_manip.behaviours  # noqa: F401  (registers Navigate)
+    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.faults import FaultInjector, FaultSpec
+
+    with World(REPO / "worlds" / "tb3_house.yaml", seed=0) as world:
+        faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)
+        xml = ('<root BTCPP_format="4"><BehaviorTree ID="M"><Navigate goal="goal"/>'
+               "</BehaviorTree></root>")
+        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        tree = load_tree_string(xml, context=context)
+        recorder = Recorder(tmp_path / "crate.html", world, tree)
+        dropped_at = None
+        for _ in range(80):  # until the crate has been falling for a second
+            tree.tick()
+            recorder(SimpleNamespace(world=world))
+            world.step(12)
+            if dropped_at is None and "dropped_crate_0" in world.movable:
+                dropped_at = world.time
+            if dropped_at is not None and world.time > dropped_at + 1.0:
+                break
+        tree.halt()
+        recorder.close()
+    header, blobs = read_replay(tmp_path / "crate.html")
+    crate = next(b for b in header["scene"]["bodies"] if b["name"] == "dropped_crate_0")
+    assert crate["disappear"] is None and crate["path"] == f"{ROOT}/dropped_crate_0"
+    z = track_samples(header, blobs, f"{ROOT}/dropped_crate_0")[:, 2]
+    assert z[0] > z[-1] + 0.1  # it fell onto the route
