@@ -29,7 +29,7 @@ from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
 from bt_manip.viz.overlay import FrameItem
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
-from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer
+from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
 from bt_manip.viz.tree_state import FAILURE, STATUS_NAMES, TreeWatcher
 
 OVERLAY_ROOT = "/meshcat/bt_manip_overlay"
@@ -121,7 +121,7 @@ class LiveViewer:
             self._drop(str(exc))
             self.close()
             return False
-        self.say(f"meshcat view: {self.link.web_url}")
+        self.say(f"meshcat view: {reachable(self.link.web_url)}")
         if self.page is not None:
             self.state.config = {"meshcat_url": self.link.web_url, "poll_ms": 200}
             self.say(f"tree page: {self.page.url}")

@@ -140,6 +140,18 @@ class _Handler(BaseHTTPRequestHandler):
             pass
 
 
+WILDCARDS = {"//0.0.0.0:": "127.0.0.1", "//[::]:": "[::1]"}
+
+
+def reachable(url: str, host: str = "") -> str:
+    """``url`` of a server listening on every interface (0.0.0.0, ::) as a browser reaches
+    it: at ``host`` (the name the browser used for the page), else at the loopback address."""
+    for wildcard, loopback in WILDCARDS.items():
+        if wildcard in url:
+            return url.replace(wildcard, f"//{host or loopback}:")
+    return url
+
+
 class PortUnavailable(OSError):
     """The page cannot listen where asked (port taken, or an address not on this machine).
 
@@ -189,10 +201,7 @@ class _Server(ThreadingHTTPServer):
         scripts = (
             '<script src="static/common.js"></script>\n<script src="static/live.js"></script>'
         )
-        url = str(self.state.config.get("meshcat_url", ""))
-        for wildcard in ("//0.0.0.0:", "//[::]:"):
-            if wildcard in url and request_host:
-                url = url.replace(wildcard, f"//{request_host}:")
+        url = reachable(str(self.state.config.get("meshcat_url", "")), request_host)
         src = html.escape(url, quote=True)
         view = f'<iframe id="meshcat-frame" src="{src}" title="3D view"></iframe>'
         return render_page(self.state.title, self.state.config, scripts, view).encode()
@@ -220,8 +229,9 @@ class TreePageServer:
 
     @property
     def url(self) -> str:
+        """Where to open the page on this machine (loopback when serving every interface)."""
         host = f"[{self.host}]" if ":" in self.host else self.host
-        return f"http://{host}:{self.port}/"
+        return reachable(f"http://{host}:{self.port}/")
 
     def close(self) -> None:
         self._server.shutdown()

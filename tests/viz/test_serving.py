@@ -47,6 +47,28 @@ def _free(port: int) -> bool:
         return s.connect_ex(("127.0.0.1", port)) != 0
 
 
+def _children(pid: int) -> list[int]:
+    """Processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            out.append(int(stat.parent.name))
+    return out
+
+
+def _gone(pid: int) -> bool:
+    """The process has exited (and is not a zombie waiting to be reaped)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return True
+    return state == "Z"
+
+
 def test_a_second_server_serves_at_once_on_a_port_in_time_wait() -> None:
     first = TreePageServer(PageState(), port=0)
     port = first.port
@@ -73,11 +95,15 @@ def test_every_server_listens_on_the_bind_address_only(bind: str) -> None:
         assert _listening(live.page.port) == {bind}
         assert _listening(web) == {bind}  # meshcat's own command would listen on 0.0.0.0
         assert _listening(zmq) == {bind}
+        assert live.page.url == f"http://127.0.0.1:{live.page.port}/"
+        with urllib.request.urlopen(live.page.url, timeout=5) as res:
+            page = res.read().decode()
+        # the 3D view's frame points where the browser can reach it, never at 0.0.0.0
+        assert f'src="http://127.0.0.1:{web}/static/"' in page
         server = live.link.server
     finally:
         live.close()
     assert server is not None and server.poll() is not None  # stopped and reaped
-    assert _free(web) and _free(zmq)
 
 
 class _Tiny:
@@ -183,6 +209,8 @@ def test_sigterm_stops_the_run_and_every_server(tmp_path: Path) -> None:
     try:
         page = f"http://127.0.0.1:{ports['tree page']}/"
         assert _get(page + "tree.json")["nodes"][0]["name"] == "long_wait"
+        servers = _children(process.pid)  # the meshcat server
+        assert servers
         process.send_signal(signal.SIGTERM)
         out, _ = process.communicate(timeout=30)
     finally:
@@ -190,8 +218,8 @@ def test_sigterm_stops_the_run_and_every_server(tmp_path: Path) -> None:
             process.kill()
     assert process.returncode == 130, out
     assert "result: INTERRUPTED" in out and "Traceback" not in out
-    time.sleep(0.2)
-    assert _free(ports["tree page"]) and _free(ports["meshcat view"])
+    assert all(_gone(pid) for pid in servers)  # no meshcat server left behind
+    assert _free(ports["tree page"])
 
 
 def test_keep_serving_keeps_the_page_after_the_run_until_sigterm(tmp_path: Path) -> None:
@@ -200,15 +228,16 @@ def test_keep_serving_keeps_the_page_after_the_run_until_sigterm(tmp_path: Path)
         _wait_line(process, "serving the live view until Ctrl-C")
         state = _get(f"http://127.0.0.1:{ports['tree page']}/state.json")
         assert state["result"] == "SUCCESS"
-        assert not _free(ports["meshcat view"])
+        servers = _children(process.pid)
+        assert servers and not any(_gone(pid) for pid in servers)  # still serving
         process.send_signal(signal.SIGTERM)
         out, _ = process.communicate(timeout=30)
     finally:
         if process.poll() is None:
             process.kill()
     assert process.returncode == 0, out  # the run's own result
-    time.sleep(0.2)
-    assert _free(ports["tree page"]) and _free(ports["meshcat view"])
+    assert all(_gone(pid) for pid in servers)
+    assert _free(ports["tree page"])
 
 
 def test_a_taken_default_port_falls_back_to_a_free_one(monkeypatch: pytest.MonkeyPatch) -> None:
