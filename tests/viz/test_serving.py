@@ -260,3 +260,20 @@ def test_a_taken_default_port_falls_back_to_a_free_one(monkeypatch: pytest.Monke
         finally:
             viz.close()
     assert viz.viewer.page is None and not viz.viewer.active
+
+
+def test_a_killed_run_leaves_no_meshcat_server(tmp_path: Path) -> None:
+    tree = tmp_path / "long.xml"
+    tree.write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="M">'
+        '<Sleep name="long_wait" msec="120000"/></BehaviorTree></root>'
+    )
+    process, _ = _start([str(tree)], tmp_path)
+    servers = _children(process.pid)
+    assert servers
+    process.kill()  # SIGKILL: no clean-up runs in the run itself
+    process.communicate(timeout=30)
+    deadline = time.monotonic() + 10
+    while not all(_gone(pid) for pid in servers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert all(_gone(pid) for pid in servers)  # the server noticed and exited
