@@ -20,6 +20,7 @@ recorder only reads the simulation, so a recorded run ends exactly like an unrec
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -113,7 +114,7 @@ class Recorder:
         self._present: dict[str, RecordedBody] = {}
         self._keys: dict[str, int] = {}
         self._appeared = False
-        self._unsubscribe: Any = None
+        self._unsubscribe: Callable[[], None] | None = None
         self._next_sample = 0.0
         self._overlay_version = -1
         self._overlay_items: dict[str, Any] = {}
