@@ -65,12 +65,18 @@ def _address(text: str) -> str:
     if host == "localhost":
         return host
     try:
-        return str(ipaddress.ip_address(host))
+        address = ipaddress.ip_address(host)
     except ValueError:
         raise argparse.ArgumentTypeError(
             f"'{text}' is not an IP address; e.g. 127.0.0.1 (this machine only) or 0.0.0.0 "
             "(every interface)"
         ) from None
+    if address.version != 4:
+        raise argparse.ArgumentTypeError(
+            f"'{text}': the meshcat server listens on IPv4 only; use an IPv4 address such as "
+            "127.0.0.1 or 0.0.0.0"
+        )
+    return str(address)
 
 
 def _bb_pair(text: str) -> tuple[str, str]:

@@ -123,6 +123,7 @@ class _Tiny:
         ("--port", "-1", "argument --port: -1 is not a port"),
         ("--port", "http", "argument --port: expected a port number, got 'http'"),
         ("--bind", "999.1.1.1", "argument --bind: '999.1.1.1' is not an IP address"),
+        ("--bind", "::1", "argument --bind: '::1': the meshcat server listens on IPv4 only"),
     ],
 )
 def test_bad_port_and_bind_values_are_bad_input(
