@@ -52,8 +52,8 @@ class VizSetup:
         viewer = self.viewer
         if viewer is None or not viewer.active:
             return
-        say("the run has ended; serving the live view until Ctrl-C")
         try:
+            say("the run has ended; serving the live view until Ctrl-C")
             while viewer.active:
                 time.sleep(0.2)
         except KeyboardInterrupt:
