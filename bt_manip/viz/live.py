@@ -117,6 +117,7 @@ class LiveViewer:
                 self.options.zmq_url, timeout=self.options.timeout, host=self.options.bind
             )
             self._draw_world()
+            self.link.settle()
         except ViewerUnavailable as exc:
             self._drop(str(exc))
             self.close()

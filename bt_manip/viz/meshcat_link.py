@@ -42,6 +42,9 @@ def _drain(process: subprocess.Popen[bytes]) -> None:
             threading.Thread(target=read, args=(stream,), daemon=True).start()
 
 
+STARTUP_PATIENCE = 10.0
+"""Seconds a server started here may take to answer its first requests (the URL, the world's
+first drawing with every mesh) on a busy machine; later requests wait ``timeout``."""
 SERVER_START_TIMEOUT = 20.0
 """Seconds a new meshcat server may take to print its addresses (importing tornado, zmq)."""
 
@@ -99,24 +102,34 @@ class MeshcatLink:
         if zmq_url is None:
             self.server, zmq_url = _start_server(host, timeout)
         self.zmq_url: str = zmq_url
-        self._connect()
+        # a server started here has just said it listens: give it time to answer on a busy
+        # machine; a server someone else runs gets ``timeout``
+        first = max(timeout, STARTUP_PATIENCE) if self.server is not None else timeout
+        self._connect(first)
         try:
             self.web_url = self._request(b"url").decode()
         except ViewerUnavailable:
             self.close()
             raise
         # meshcat reconnects after asking for the URL; do the same
-        self._connect()
+        self._connect(first)
 
-    def _connect(self) -> None:
+    def settle(self) -> None:
+        """From now on wait ``timeout`` for each answer (after the first drawing, which a
+        server started here gets :data:`STARTUP_PATIENCE` for)."""
+        if self._socket is not None:
+            self._connect(self.timeout)
+
+    def _connect(self, timeout: float | None = None) -> None:
+        timeout = self.timeout if timeout is None else timeout
         if self._socket is not None:
             self._socket.close(linger=0)
         # a DEALER talks to meshcat's REP socket like a REQ, but can have several requests in
         # flight: a batch of commands costs one round trip instead of one each
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
-        sock.setsockopt(zmq.RCVTIMEO, int(self.timeout * 1000))
-        sock.setsockopt(zmq.SNDTIMEO, int(self.timeout * 1000))
+        sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000))
+        sock.setsockopt(zmq.SNDTIMEO, int(timeout * 1000))
         try:
             sock.connect(self.zmq_url)
         except zmq.ZMQError as exc:
