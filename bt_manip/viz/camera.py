@@ -33,6 +33,9 @@ HEIGHT_FRACTIONS = (0.3, 0.95)
 SPREAD_FRACTIONS = ((0.0, 0.0), (1.0, 1.0), (1.0, -1.0), (-1.0, 1.0), (-1.0, -1.0))
 """... and around its base (its centre and four points on its outline), so that no part of it
 is hidden."""
+LOOK_FRACTION = 0.45
+"""The views look at this fraction of the robot's height above its base (its middle, not its
+wheels)."""
 END_WEIGHT = 10
 """How much more a blocked view of the first or last frame counts than one in between."""
 MIDDLE_FRAMES = 24
@@ -40,7 +43,8 @@ MIDDLE_FRAMES = 24
 
 @dataclass(frozen=True)
 class CameraView:
-    """A camera that looks at ``target`` from ``target + offset`` (world frame, metres)."""
+    """A camera that looks at ``target`` from ``target + offset`` (world frame, metres);
+    ``target`` is at the robot's look height (:data:`LOOK_FRACTION`)."""
 
     target: tuple[float, float, float]
     offset: tuple[float, float, float]
@@ -106,6 +110,22 @@ def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 
 
+def look_height(world: Any, robot_body: int) -> float:
+    """Height (m) above the floor that the views look at: the middle of the robot."""
+    lo, hi = _extent(world.client, robot_body)
+    return LOOK_FRACTION * max(0.2, hi[2] - max(0.0, lo[2]))
+
+
+def _ray_ends(world: Any, robot_body: int, positions: Sequence[np.ndarray],
+              offset: Sequence[float], per_position: int) -> np.ndarray:
+    """The camera position for each ray: the look point above each position, plus offset."""
+    look = look_height(world, robot_body)
+    centres = np.repeat(np.array([[p[0], p[1]] for p in positions]), per_position, axis=0)
+    return np.column_stack(
+        [centres + np.asarray(offset[:2]), np.full(len(centres), look + offset[2])]
+    )
+
+
 def _ray_starts(
     world: Any, robot_body: int, positions: Sequence[np.ndarray]
 ) -> np.ndarray:
@@ -128,8 +148,7 @@ def hidden_rays(
     from it a wall or piece of furniture blocks (0: the robot is in full view)."""
     starts = _ray_starts(world, robot_body, positions)
     per_position = len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS)
-    centres = np.repeat(np.array([[p[0], p[1]] for p in positions]), per_position, axis=0)
-    ends = np.column_stack([centres + np.asarray(offset[:2]), np.full(len(starts), offset[2])])
+    ends = _ray_ends(world, robot_body, positions, offset, per_position)
     return int(_blocked(world, starts, ends, set(world.obstacle_body_ids())).sum())
 
 
@@ -144,10 +163,9 @@ def clear_offset(
     starts = _ray_starts(world, robot_body, positions)
     per_position = len(HEIGHT_FRACTIONS) * len(SPREAD_FRACTIONS)
     w = np.repeat(weights, per_position)
-    centres = np.repeat(np.array([[p[0], p[1]] for p in positions]), per_position, axis=0)
     best, best_score = DEFAULT_OFFSET, math.inf
     for rank, offset in enumerate(candidate_offsets(yaw)):
-        ends = np.column_stack([centres + np.asarray(offset[:2]), np.full(len(starts), offset[2])])
+        ends = _ray_ends(world, robot_body, positions, offset, per_position)
         score = float(w[_blocked(world, starts, ends, blockers)].sum()) * 1000 + rank
         if score < best_score:
             best, best_score = offset, score
@@ -172,7 +190,8 @@ def live_camera(world: Any) -> CameraView:
     name, robot = first
     x, y, yaw = robot.base_pose2d()
     offset = clear_offset(world, robot.body, [np.array([x, y])], yaw)
-    return CameraView((float(x), float(y), 0.0), offset, f"{ROOT}/{name}")
+    look = look_height(world, robot.body)
+    return CameraView((float(x), float(y), look), offset, f"{ROOT}/{name}")
 
 
 def replay_camera(world: Any, rec: Any) -> dict[str, Any]:
@@ -193,5 +212,5 @@ def replay_camera(world: Any, rec: Any) -> dict[str, Any]:
     q = samples[0][3:7]
     yaw = math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
     offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], float(yaw), weights)
-    target = (float(samples[0][0]), float(samples[0][1]), 0.0)
+    target = (float(samples[0][0]), float(samples[0][1]), look_height(world, robot.body))
     return CameraView(target, offset, path).to_json()

@@ -138,10 +138,14 @@ class LiveViewer:
         self.scene = build_scene(self.world)
         self._send_bodies(list(self.scene.bodies.values()))
         self._unsubscribe = self.world.events.subscribe(self._on_world_event)
-        # meshcat's orbit controls always look at the world origin: shift the drawing so that
-        # the first robot sits there, and put the camera behind and above it
+        # meshcat's orbit controls always look at the world origin: shift the drawing (and the
+        # floor grid) so that the middle of the first robot sits there, and put the camera
+        # behind and above it
         self.camera = live_camera(self.world)
         self._follow(force=True)
+        down = np.eye(4)  # the node holding meshcat's (already turned) grid
+        down[2, 3] = -self.camera.target[2]
+        link.set_transform("/Grid", column_major(down))
         d = self.camera.offset
         link.set_property("/Cameras/default/rotated/<object>", "position", [d[0], d[2], -d[1]])
 
@@ -213,7 +217,7 @@ class LiveViewer:
             return
         self._centre = centre
         shift = np.eye(4)
-        shift[:2, 3] = -centre
+        shift[:3, 3] = (-centre[0], -centre[1], -camera.target[2])
         link.set_transform("/meshcat", column_major(shift))
 
     def _send_poses(self, bodies: list[SceneBody] | None = None) -> None:
