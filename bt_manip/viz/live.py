@@ -143,9 +143,10 @@ class LiveViewer:
         # behind and above it
         self.camera = live_camera(self.world)
         self._follow(force=True)
-        down = np.eye(4)  # the node holding meshcat's (already turned) grid
+        down = np.eye(4)  # the nodes holding meshcat's floor grid (already turned) and axes
         down[2, 3] = -self.camera.target[2]
         link.set_transform("/Grid", column_major(down))
+        link.set_transform("/Axes", column_major(down))
         d = self.camera.offset
         link.set_property("/Cameras/default/rotated/<object>", "position", [d[0], d[2], -d[1]])
 

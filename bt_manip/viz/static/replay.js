@@ -77,9 +77,9 @@
   const camera = scene.camera;
   const drawing = viewer.scene_tree.find(split(header.root).slice(0, 1)).object;
   const followTrack = tracks.find((t) => t.path === camera.follow);
-  // and down by the look height, the floor grid with it
+  // and down by the look height, the floor grid and the axes with it
   const lookHeight = camera.target[2] || 0;
-  viewer.scene_tree.find(["Grid"]).object.position.set(0, 0, -lookHeight);
+  for (const helper of ["Grid", "Axes"]) viewer.scene_tree.find([helper]).object.position.set(0, 0, -lookHeight);
   function centreOn(x, y) {
     drawing.position.set(-x, -y, -lookHeight);
   }
