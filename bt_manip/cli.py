@@ -22,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError, Problem
+from bt_manip.interrupts import terminate_as_interrupt
 from bt_manip.plugins import add_import_flag
 from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions
 
@@ -67,6 +68,39 @@ TICK_HZ = _within(float, 0.1, 1000.0)
 """Tree tick rates accepted (Hz): slower would wait for ages, faster than any physics rate."""
 REALTIME = _within(float, 0.01, 1000.0)
 """Real-time factors accepted by --realtime."""
+
+
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got '{text}'") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(
+            f"{value} is not a port; use 1..65535, or 0 for any free port"
+        )
+    return value
+
+
+def _address(text: str) -> str:
+    import ipaddress
+
+    host = text.strip()
+    if host == "localhost":
+        return host
+    try:
+        address = ipaddress.ip_address(host)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"'{text}' is not an IP address; e.g. 127.0.0.1 (this machine only) or 0.0.0.0 "
+            "(every interface)"
+        ) from None
+    if address.version != 4:
+        raise argparse.ArgumentTypeError(
+            f"'{text}': the meshcat server listens on IPv4 only; use an IPv4 address such as "
+            "127.0.0.1 or 0.0.0.0"
+        )
+    return str(address)
 
 
 def _bb_pair(text: str) -> tuple[str, Any]:
@@ -183,9 +217,22 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--port",
-        type=int,
+        type=_port,
         default=None,
-        help="localhost port of the tree page (default 7080; 0 picks a free one)",
+        help="port of the tree page (default 7080, or a free one if taken; 0 picks a free one)",
+    )
+    run.add_argument(
+        "--bind",
+        type=_address,
+        default=None,
+        metavar="ADDR",
+        help="address the tree page and the meshcat server listen on (default 127.0.0.1; "
+        "0.0.0.0 serves every interface)",
+    )
+    run.add_argument(
+        "--keep-serving",
+        action="store_true",
+        help="with --viz: keep the tree page and the 3D view up after the run, until Ctrl-C",
     )
     run.add_argument(
         "--record", metavar="FILE.html", help="write a self-contained replay page of the run"
@@ -325,13 +372,18 @@ def cmd_run(args: argparse.Namespace) -> int:
         viz = setup_viz(args, world, tree)
         hooks += viz.hooks
         episode.spec.options.realtime = viz.realtime
+        keep = bool(args.keep_serving and viz.viewing)
         try:
             report = episode.run(hooks)
+        except BaseException:
+            viz.close()
+            raise
         finally:
             for hook in hooks:
                 close = getattr(hook, "close", None)
-                if callable(close):
+                if hook not in viz.hooks and callable(close):
                     close()
+        viz.close(keep_viewer=keep)
         print(report.summary())
         if report.extra.get("injected"):
             print(f"  faults injected: {len(report.extra['injected'])}")
@@ -341,7 +393,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         if args.bb_out:
             entries = json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
             writes.append(("--bb-out", args.bb_out, lambda: write_text(args.bb_out, entries)))
-        return _write_outputs(writes) or report.exit_code
+        status = _write_outputs(writes) or report.exit_code
+        if keep:
+            viz.serve_until_interrupted()
+        return status
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
@@ -382,8 +437,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``bt-manip`` console script; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    if getattr(args, "keep_serving", False) and not (args.viz or args.zmq_url):
+        parser.exit(EXIT_BAD_INPUT, "--keep-serving: only with --viz (or --zmq-url)\n")
     try:
-        return int(args.func(args))
+        with terminate_as_interrupt():
+            return int(args.func(args))
     except InputError as exc:
         _print_problems(exc.problems)
         return EXIT_BAD_INPUT

@@ -12,7 +12,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.bt import registry
 from bt_manip.bt.node import AttributeCheck, closest
-from bt_manip.bt.ports import Literal
+from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Literal, Port, count_of
 from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
 SHAPE_SIZES = {"box": 3, "cylinder": 2, "sphere": 1}
@@ -20,37 +20,13 @@ SHAPE_SIZES = {"box": 3, "cylinder": 2, "sphere": 1}
 _SIZE_MEANING = {"box": "x;y;z extents", "cylinder": "radius;height", "sphere": "radius"}
 
 
-def _finite(values: list[float]) -> bool:
-    return all(math.isfinite(v) for v in values)
-
-
-def spawn_value_problem(port: str, value: Any, shape: str | None) -> str | None:
-    """What is wrong with ``value`` for SpawnModel's ``port`` (None if nothing); ``shape`` is
-    the primitive's shape when known (for the number of ``size`` values)."""
-    if port == "model" and not str(value).strip():
-        return "model needs a name"
-    if port == "shape" and value not in SHAPE_SIZES:
-        return f"shape must be box, cylinder or sphere, got '{value}'"
-    if port == "size" and value:
-        size = list(value)
-        need = SHAPE_SIZES.get(shape or "")
-        if need is not None and len(size) != need:
-            return (f"a {shape} takes {need} size value{'s' if need > 1 else ''} "
-                    f"({_SIZE_MEANING[shape or '']}), got {len(size)}: {size}")
-        if not _finite(size) or any(v <= 0 for v in size):
-            return f"size values must be positive finite metres, got {size}"
-    if port == "pose" and value:
-        pose = list(value)
-        if len(pose) != 4 or not _finite(pose):
-            return f"pose takes 4 finite numbers x;y;z;yaw, got {pose}"
-    if port in ("mass", "friction"):
-        number = float(value)
-        if not math.isfinite(number) or number < 0:
-            what = "kg, 0 for a static model" if port == "mass" else "a coefficient"
-            return f"{port} must be a finite number >= 0 ({what}), got {value}"
-    if port == "colour" and value not in COLOURS:
-        return f"unknown colour '{value}'; known: {', '.join(sorted(COLOURS))}"
-    return None
+def size_count_problem(shape: str, size: list[float]) -> str | None:
+    """What is wrong with the number of ``size`` values for ``shape`` (None if nothing)."""
+    need = SHAPE_SIZES.get(shape)
+    if need is None or not size or len(size) == need:
+        return None
+    return (f"a {shape} takes {need} size value{'s' if need > 1 else ''} "
+            f"({_SIZE_MEANING[shape]}), got {len(size)}: {size}")
 
 
 @registry.register
@@ -71,40 +47,34 @@ class SpawnModel(RobotAction):
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "model": PortInformation(str, True, "a model of the world file, or a new name"),
-        "shape": PortInformation(str, False, "box, cylinder or sphere", "box"),
-        "size": PortInformation(
-            list[float], False, "box x;y;z, cylinder radius;height, sphere radius", []
+        "shape": Port(str, False, "box, cylinder or sphere", "box",
+                      Accepts(choices=tuple(SHAPE_SIZES))),
+        "size": Port(list[float], False, "box x;y;z, cylinder radius;height, sphere radius", [],
+                     POSITIVE),
+        "pose": Port(list[float], False, "x;y;z;yaw of its centre", [], count_of(0, 4)),
+        "mass": Port(float, False, "kg; 0 for a static model", 0.1, NON_NEGATIVE),
+        "colour": Port(
+            str, False, "colour name", "orange", Accepts(choices=tuple(sorted(COLOURS)))
         ),
-        "pose": PortInformation(list[float], False, "x;y;z;yaw of its centre", []),
-        "mass": PortInformation(float, False, "kg; 0 for a static model", 0.1),
-        "colour": PortInformation(str, False, "colour name", "orange"),
-        "friction": PortInformation(float, False, "lateral friction", 0.8),
+        "friction": Port(float, False, "lateral friction coefficient", 0.8, NON_NEGATIVE),
     }
 
     @classmethod
     def check_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
-        """The ports' own checks, then the range of every literal value."""
+        """The ports' own rules, then the number of literal ``size`` values for the shape."""
         check = super().check_attributes(attributes)
-        shape_binding = check.bindings.get("shape", Literal("box"))
-        shape = shape_binding.value if isinstance(shape_binding, Literal) else None
-        for port, binding in check.bindings.items():
-            if isinstance(binding, Literal):
-                problem = spawn_value_problem(port, binding.value, shape)
-                if problem is not None:
-                    check.errors.append(
-                        (f"bad value for port '{port}' of {cls.NODE_ID}: {problem}", None)
-                    )
+        shape = check.bindings.get("shape", Literal("box"))
+        size = check.bindings.get("size")
+        if isinstance(shape, Literal) and isinstance(size, Literal):
+            problem = size_count_problem(shape.value, list(size.value))
+            if problem is not None:
+                check.errors.append(
+                    (f"bad value for port 'size' of {cls.NODE_ID}: {problem}", None)
+                )
         return check
 
-    def _input(self, port: str, shape: str | None = None) -> Any:
-        value = self.get_input(port)
-        problem = spawn_value_problem(port, value, shape)
-        if problem is not None:
-            raise ActionFailed(problem)
-        return value
-
     def step(self) -> Status:
-        name = self._input("model")
+        name = self.get_input("model")
         world = self.world
         if name in world.models:
             try:
@@ -118,8 +88,11 @@ class SpawnModel(RobotAction):
                 f"no model named '{name}' in {world.path.name}{closest(name, set(world.models))}"
                 f"; its models: {known}; for a new primitive give shape, size and pose"
             )
-        shape = self._input("shape")
-        size = list(self._input("size", shape))
+        shape = self.get_input("shape")
+        size = list(self.get_input("size"))
+        problem = size_count_problem(shape, size)
+        if problem is not None:
+            raise ActionFailed(problem)
         if not size:
             raise ActionFailed(f"a {shape} needs size=\"{_SIZE_MEANING[shape]}\"")
         dims = {
@@ -127,11 +100,11 @@ class SpawnModel(RobotAction):
             "cylinder": lambda: (size[0], size[0], size[1]),
             "sphere": lambda: (size[0], size[0], 2 * size[0]),
         }[shape]()
-        pose = list(self._input("pose"))
+        pose = list(self.get_input("pose"))
         if not pose:
             raise ActionFailed('a new primitive needs pose="x;y;z;yaw" (z of its centre)')
-        colour = self._input("colour")
-        mass = float(self._input("mass"))
+        colour = self.get_input("colour")
+        mass = float(self.get_input("mass"))
         half = math.sin(pose[3] / 2), math.cos(pose[3] / 2)
         spec = BodySpec(
             name=name,
@@ -141,7 +114,7 @@ class SpawnModel(RobotAction):
             pose=Pose3D((pose[0], pose[1], pose[2]), (0.0, 0.0, half[0], half[1])),
             planar=False,
             mass=mass,
-            friction=float(self._input("friction")),
+            friction=float(self.get_input("friction")),
             colour=COLOURS[colour],
             randomize=Range2D(),
             line=self.xml_line or 0,

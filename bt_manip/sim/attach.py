@@ -17,6 +17,8 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
+from bt_manip.sim.events import Attached, Detached
+
 DEFAULT_MAX_DISTANCE = 0.01
 """Farthest an object may be from a finger (m) and still be attached."""
 
@@ -86,7 +88,8 @@ class Attachments:
         link: str | None = None,
         max_distance: float = DEFAULT_MAX_DISTANCE,
     ) -> AttachResult:
-        """Hold ``object_name`` to a link of ``robot_name`` if it is at the fingers.
+        """Hold ``object_name`` to a link of ``robot_name`` if it is at the fingers (announced
+        as :class:`~bt_manip.sim.events.Attached`).
 
         Fails (nothing changes) when the robot or object is unknown, the object is already
         attached, or it is farther than ``max_distance`` from every finger.
@@ -141,15 +144,18 @@ class Attachments:
             for pt in pb.getContactPoints(bodyA=body, physicsClientId=self.client)
             if pt[2] != robot.body
         }
+        world.events.announce(Attached(world.time, object_name, robot_name, link_name))
         return AttachResult(True, "", distance)
 
     def detach(self, object_name: str) -> AttachResult:
-        """Remove the attach joint of ``object_name``; fails if it is not attached."""
+        """Remove the attach joint of ``object_name`` (announced as
+        :class:`~bt_manip.sim.events.Detached`); fails if it is not attached."""
         held = self._by_object.pop(object_name, None)
         if held is None:
             return AttachResult(False, f"'{object_name}' is not attached")
         self._supports.pop(object_name, None)
         pb.removeConstraint(held.constraint_id, physicsClientId=self.client)
+        self.world.events.announce(Detached(self.world.time, object_name, held.robot_name))
         return AttachResult(True)
 
     def _static_names(self) -> dict[int, str]:

@@ -25,6 +25,7 @@ import pybullet as pb
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError, Problem
 from bt_manip.sim.attach import Attachments
+from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
 from bt_manip.sim.world_spec import (
     BodySpec,
     Part,
@@ -107,6 +108,8 @@ class World:
         self.robots: dict[str, Any] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
         self.models: dict[str, BodySpec] = {m.name: m for m in self.spec.models}
+        self.events = WorldEvents()
+        """Bodies added and removed, attach and detach, announced while the world runs."""
         self.attachments = Attachments(self)
         try:
             self._setup_physics()
@@ -359,28 +362,31 @@ class World:
 
     def spawn(self, spec: BodySpec, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> int:
         """Add a body while the world runs (movable if ``spec.movable``), moved by ``offset``
-        (x, y, yaw); returns its id.
+        (x, y, yaw); returns its id and announces :class:`~bt_manip.sim.events.BodyAdded`.
 
-        Raises ValueError when the name is taken or the body would start inside another.
+        Raises ValueError when the name is taken or the body would start inside another
+        (nothing is added then, and nothing is announced).
         """
         if spec.name in self.infos:
             raise ValueError(f"a body named '{spec.name}' already exists")
         kind = "object" if spec.movable else "furniture"
         body = self._make_body(spec, offset)
-        self._add(spec.name, body, kind, spec, spec.line)
         for info in list(self.infos.values()):
-            if info.kind == "ground" or info.name == spec.name:
+            if info.kind == "ground":
                 continue
             depth = self._penetration(body, info.body_id)
             if depth < -OVERLAP_TOLERANCE:
-                self.remove(spec.name)
+                pb.removeBody(body, physicsClientId=self.client)
                 raise ValueError(
                     f"'{spec.name}' would start {-depth * 1000:.0f} mm inside '{info.name}'"
                 )
+        self._add(spec.name, body, kind, spec, spec.line)
+        self.events.announce(BodyAdded(self.time, spec.name, body, kind, spec))
         return body
 
     def remove(self, name: str) -> None:
-        """Take a movable object or piece of furniture out of the world (and out of the hand)."""
+        """Take a movable object or piece of furniture out of the world (and out of the hand);
+        announces :class:`~bt_manip.sim.events.BodyRemoved` (after the detach, if held)."""
         info = self.infos.get(name)
         if info is None or info.kind not in ("object", "furniture"):
             known = sorted(i.name for i in self.infos.values() if i.kind in ("object", "furniture"))
@@ -389,6 +395,7 @@ class World:
             self.attachments.detach(name)
         pb.removeBody(info.body_id, physicsClientId=self.client)
         del self.infos[name]
+        self.events.announce(BodyRemoved(self.time, name, info.body_id, info.kind))
 
     # -- queries ------------------------------------------------------------------------------
     def body_id(self, name: str) -> int:

@@ -1,19 +1,28 @@
-"""The run hooks behind ``bt-manip run --viz / --zmq-url / --port / --record``.
+"""The run hooks behind ``bt-manip run --viz / --zmq-url / --port / --bind / --record /
+--keep-serving``.
 
 :func:`setup_viz` reads those options, starts what was asked for and returns the hooks to give
 the :class:`~bt_manip.runner.Runner` and the pacing to use: a live view runs at real time
 unless ``--realtime FACTOR`` says otherwise; a recording alone does not slow the run down.
-A viewer that cannot start has already warned once; the run goes on headless.
+A meshcat viewer that cannot start has already warned once; the run goes on headless. A tree
+page that cannot listen where it was asked to (``--port`` taken, ``--bind`` not an address of
+this machine) is bad input: :class:`~bt_manip.errors.InputError` naming the flag. Without
+``--port``, a taken default port falls back to any free port.
+
+:meth:`VizSetup.serve_until_interrupted` keeps the live page and the 3D view up after the run
+(``--keep-serving``) until Ctrl-C or SIGTERM.
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from bt_manip.viz.tree_page import DEFAULT_PORT
+from bt_manip.errors import InputError
+from bt_manip.viz.tree_page import DEFAULT_PORT, PortUnavailable
 
 
 @dataclass
@@ -23,28 +32,51 @@ class VizSetup:
     hooks: list[Any] = field(default_factory=list)
     viewing: bool = False
     realtime: float | None = None
+    viewer: Any = None
+    """The live viewer, when one runs."""
+
+    def close(self, keep_viewer: bool = False) -> None:
+        """Close every hook (write the replay, stop the servers); with ``keep_viewer`` the
+        live viewer stays up, showing the end of the run."""
+        for hook in self.hooks:
+            if keep_viewer and hook is self.viewer:
+                hook.show_last()
+                continue
+            close = getattr(hook, "close", None)
+            if callable(close):
+                close()
+
+    def serve_until_interrupted(self, say: Callable[[str], None] = print) -> None:
+        """Keep serving the live view until Ctrl-C or SIGTERM (KeyboardInterrupt), then stop
+        it. Returns at once when no live view runs."""
+        viewer = self.viewer
+        if viewer is None or not viewer.active:
+            return
+        try:
+            say("the run has ended; serving the live view until Ctrl-C")
+            while viewer.active:
+                time.sleep(0.2)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            viewer.close()
 
 
 def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = print) -> VizSetup:
-    """Hooks for the ``run`` options ``viz``, ``zmq_url``, ``port``, ``record``, ``realtime``."""
+    """Hooks for the ``run`` options ``viz``, ``zmq_url``, ``port``, ``bind``, ``record``,
+    ``realtime``."""
     out = VizSetup(realtime=getattr(args, "realtime", None))
     title = Path(getattr(args, "tree", "") or "bt-manip").name
     if getattr(args, "viz", False) or getattr(args, "zmq_url", None):
         from bt_manip.viz.live import LiveOptions, LiveViewer
 
         port = getattr(args, "port", None)
-        viewer = LiveViewer(
-            world,
-            tree,
-            LiveOptions(
-                zmq_url=getattr(args, "zmq_url", None),
-                port=DEFAULT_PORT if port is None else port,
-            ),
-            title=title,
-            say=say,
-        )
-        if viewer.start():
+        bind = getattr(args, "bind", None) or "127.0.0.1"
+        viewer = _start_viewer(LiveViewer, LiveOptions, world, tree, title, say, port, bind,
+                               getattr(args, "zmq_url", None))
+        if viewer is not None:
             out.hooks.append(viewer)
+            out.viewer = viewer
             out.viewing = True
             if out.realtime is None:
                 out.realtime = 1.0
@@ -59,3 +91,22 @@ def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = pri
         }
         out.hooks.append(Recorder(record, world, tree, RecordOptions(title=title), info=info))
     return out
+
+
+def _start_viewer(viewer_class: Any, options_class: Any, world: Any, tree: Any, title: str,
+                  say: Callable[[str], None], port: int | None, bind: str,
+                  zmq_url: str | None) -> Any:
+    """Start the live viewer on ``port`` (the default one, or any free one when the default
+    is taken); None when meshcat cannot run. Raises InputError for ``--port``/``--bind``."""
+    chosen = DEFAULT_PORT if port is None else port
+    while True:
+        viewer = viewer_class(world, tree, options_class(zmq_url=zmq_url, port=chosen, bind=bind),
+                              title=title, say=say)
+        try:
+            return viewer if viewer.start() else None
+        except PortUnavailable as exc:
+            if port is None and chosen != 0 and exc.in_use:
+                say(f"port {chosen} is in use; serving the tree page on a free port instead")
+                chosen = 0
+                continue
+            raise InputError.single(exc.flag, None, exc.strerror or str(exc)) from None

@@ -2,9 +2,12 @@
 
 :class:`LiveViewer` is a run hook (``hook(runner)`` after each tick, ``close()`` at the end).
 On :meth:`LiveViewer.start` it starts a meshcat server (or attaches to ``zmq_url``), draws the
-world once (:mod:`bt_manip.viz.scene`) and serves the tree page (:mod:`bt_manip.viz.tree_page`).
-After each tick it sends the poses that changed, the overlay items (planned paths, target
-frames) that changed, highlights objects while a robot holds them, and publishes the tree's
+world as it is (:mod:`bt_manip.viz.scene`), listens to the World's announcements
+(:mod:`bt_manip.sim.events`) and serves the tree page (:mod:`bt_manip.viz.tree_page`). After
+each tick it draws the bodies added since (spawned models, a ``block`` fault's crates) and
+deletes the removed ones, sends the poses that changed, the overlay items (planned paths,
+target frames) that changed, highlights objects while a robot holds them, keeps the first
+robot in the middle of the view (:mod:`bt_manip.viz.camera`), and publishes the tree's
 statuses to the page.
 
 The viewer only reads the simulation. If it cannot start, or the meshcat server stops
@@ -21,20 +24,23 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
+from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
 from bt_manip.viz.overlay import FrameItem
-from bt_manip.viz.scene import ROOT, Scene, build_scene, column_major, pose_matrix
-from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer
-from bt_manip.viz.tree_state import STATUS_NAMES, TreeWatcher
+from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
+from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
+from bt_manip.viz.tree_state import FAILURE, STATUS_NAMES, TreeWatcher
 
 OVERLAY_ROOT = "/meshcat/bt_manip_overlay"
 HIGHLIGHT_RGBA = (0.15, 0.95, 0.55, 1.0)
 """Colour of an object while a robot holds it."""
 MAX_FAILURES = 12
 """Recent failures listed on the page."""
-FAILURE = 3
 POSE_EPS = 1e-5
 """Pose changes below this (m, or quaternion units) are not sent again."""
+FOLLOW_EPS = 0.005
+"""The view re-centres on the robot when it has moved this far (m)."""
 
 
 @dataclass
@@ -44,23 +50,12 @@ class LiveOptions:
     zmq_url: str | None = None
     """Attach to this meshcat server; None starts one."""
     port: int | None = DEFAULT_PORT
-    """Port of the tree page on localhost (0: any free port; None: no tree page)."""
+    """Port of the tree page (0: any free port; None: no tree page)."""
+    bind: str = "127.0.0.1"
+    """Address the tree page and a meshcat server started here listen on."""
     max_fps: float = 30.0
     """At most this many scene updates per wall-clock second (the page shows every tick)."""
     timeout: float = 3.0
-
-
-def camera_for(world: Any, scene: Scene) -> dict[str, list[float]]:
-    """A first view: a few metres behind and above the first robot, or over the world."""
-    target = np.zeros(3)
-    if world is not None and getattr(world, "robots", None):
-        name = next(iter(world.robots))
-        path = f"{ROOT}/{name}"
-        if path in scene.tracks:
-            target = scene.read_poses()[scene.tracks.index(path)][:3].copy()
-            target[2] = 0.5
-    position = target + np.array([-2.6, -2.2, 2.0])
-    return {"target": target.round(3).tolist(), "position": position.round(3).tolist()}
 
 
 def _warn(message: str) -> None:
@@ -90,10 +85,13 @@ class LiveViewer:
         self.state = PageState(title=title)
         self.watcher = TreeWatcher(tree)
         self.scene: Scene | None = None
-        self._sent: np.ndarray | None = None
+        self.camera: CameraView | None = None
+        self._sent: dict[str, np.ndarray] = {}
+        self._pending: list[tuple[str, Any]] = []
+        self._unsubscribe: Callable[[], None] | None = None
+        self._centre: np.ndarray | None = None
         self._overlay_version = -1
         self._overlay_items: dict[str, Any] = {}
-        self._held: set[str] = set()
         self._last_publish = 0.0
         self._failures: list[tuple[float, int, str]] = []
         self.updates = 0
@@ -103,37 +101,32 @@ class LiveViewer:
         return self.link is not None
 
     def start(self) -> bool:
-        """Start the viewer; on failure warn once and return False (the run goes on)."""
+        """Start the viewer; if meshcat cannot run, warn once and return False (the run goes
+        on headless).
+
+        Raises :class:`~bt_manip.viz.tree_page.PortUnavailable` when the tree page cannot
+        listen on its port (nothing is left running then).
+        """
+        if self.options.port is not None:
+            self.state.nodes = self.watcher.structure()
+            self.state.config = {"meshcat_url": "", "poll_ms": 200}
+            self._publish_state()
+            self.page = TreePageServer(self.state, port=self.options.port, host=self.options.bind)
         try:
-            self.link = MeshcatLink(self.options.zmq_url, timeout=self.options.timeout)
-        except ViewerUnavailable as exc:
-            _warn(str(exc))
-            return False
-        try:
+            self.link = MeshcatLink(
+                self.options.zmq_url, timeout=self.options.timeout, host=self.options.bind
+            )
             self._draw_world()
+            self.link.settle()
         except ViewerUnavailable as exc:
             self._drop(str(exc))
+            self.close()
             return False
-        self.say(f"meshcat view: {self.link.web_url}")
-        if self.options.port is not None:
-            self._start_page()
+        self.say(f"meshcat view: {reachable(self.link.web_url)}")
+        if self.page is not None:
+            self.state.config = {"meshcat_url": self.link.web_url, "poll_ms": 200}
+            self.say(f"tree page: {self.page.url}")
         return True
-
-    def _start_page(self) -> None:
-        assert self.link is not None
-        self.state.nodes = self.watcher.structure()
-        self.state.config = {"meshcat_url": self.link.web_url, "poll_ms": 200}
-        self._publish_state()
-        try:
-            self.page = TreePageServer(self.state, port=self.options.port or 0)
-        except OSError as exc:
-            print(
-                f"warning: cannot serve the tree page on port {self.options.port} ({exc}); "
-                "the meshcat view still runs (choose another port with --port)",
-                file=sys.stderr,
-            )
-            return
-        self.say(f"tree page: {self.page.url}")
 
     def _draw_world(self) -> None:
         link = self.link
@@ -143,48 +136,107 @@ class LiveViewer:
         if self.world is None:
             return
         self.scene = build_scene(self.world)
-        data = {path: path.read_bytes() for path in self.scene.mesh_files()}
-        link.send_many(
-            [
-                {"type": "set_object", "path": o.path, "object": self.scene.lowered(o, data)}
-                for o in self.scene.objects
-            ]
-            + [
-                {"type": "set_transform", "path": path, "matrix": column_major(matrix)}
-                for path, matrix in self.scene.static
-            ]
-        )
-        self._send_poses(force=True)
-        # meshcat's orbit controls always look at the world origin: shift the drawing so that
-        # the first robot sits there, and put the camera behind and above it
-        camera = camera_for(self.world, self.scene)
-        target, position = np.array(camera["target"]), np.array(camera["position"])
-        shift = np.eye(4)
-        shift[:2, 3] = -target[:2]
-        link.set_transform("/meshcat", column_major(shift))
-        d = position - np.array([target[0], target[1], 0.0])
+        self._send_bodies(list(self.scene.bodies.values()))
+        self._unsubscribe = self.world.events.subscribe(self._on_world_event)
+        # meshcat's orbit controls always look at the world origin: shift the drawing (and the
+        # floor grid) so that the middle of the first robot sits there, and put the camera
+        # behind and above it
+        self.camera = live_camera(self.world)
+        self._follow(force=True)
+        down = np.eye(4)  # the nodes holding meshcat's floor grid (already turned) and axes
+        down[2, 3] = -self.camera.target[2]
+        link.set_transform("/Grid", column_major(down))
+        link.set_transform("/Axes", column_major(down))
+        d = self.camera.offset
         link.set_property("/Cameras/default/rotated/<object>", "position", [d[0], d[2], -d[1]])
 
-    def _send_poses(self, force: bool = False) -> None:
-        scene, link = self.scene, self.link
-        if scene is None or link is None or not scene.tracks:
-            return
-        poses = scene.read_poses()
-        if self._sent is None or force:
-            changed = np.arange(len(poses))
-        else:
-            changed = np.flatnonzero(np.abs(poses - self._sent).max(axis=1) > POSE_EPS)
+    def _send_bodies(self, bodies: list[SceneBody]) -> None:
+        """Draw bodies (their objects, static placements and current poses)."""
+        link, scene = self.link, self.scene
+        assert link is not None and scene is not None
+        objects = [o for b in bodies for o in b.objects]
+        data = {path: path.read_bytes() for path in {o.mesh for o in objects if o.mesh}}
         link.send_many(
-            [
-                {"type": "set_transform", "path": scene.tracks[k],
-                 "matrix": column_major(pose_matrix(poses[k]))}
-                for k in changed
-            ]
+            [{"type": "set_object", "path": o.path, "object": scene.lowered(o, data)}
+             for o in objects]
+            + [{"type": "set_transform", "path": path, "matrix": column_major(matrix)}
+               for b in bodies for path, matrix in b.static]
         )
-        if self._sent is None or force:
-            self._sent = poses
-        else:
-            self._sent[changed] = poses[changed]
+        moving = [b for b in bodies if b.tracks]
+        for body in moving:
+            for path in body.tracks:
+                self._sent.pop(path, None)
+        self._send_poses(moving)
+
+    def _on_world_event(self, event: WorldEvent) -> None:
+        """Listener of the World: note the change now (a new body is read from PyBullet while
+        it exists), send it after the tick."""
+        scene = self.scene
+        if scene is None:
+            return
+        if isinstance(event, BodyAdded):
+            self._pending.append(("add", scene.add_body(self.world, event)))
+        elif isinstance(event, BodyRemoved):
+            body = scene.remove_body(event.name)
+            if body is not None:
+                self._pending.append(("remove", body))
+        elif isinstance(event, Attached | Detached):
+            self._pending.append(("held" if isinstance(event, Attached) else "let go",
+                                  event.object_name))
+
+    def _take_events(self) -> None:
+        """Draw the bodies added since the last tick, delete the removed ones, highlight what
+        is held."""
+        scene, link = self.scene, self.link
+        if not self._pending or scene is None or link is None:
+            return
+        pending, self._pending[:] = list(self._pending), []
+        for change, what in pending:
+            if change == "add":
+                if scene.bodies.get(what.name) is what:  # still there (not gone in the tick)
+                    self._send_bodies([what])
+            elif change == "remove":
+                link.delete(what.path)
+                for path in what.tracks:
+                    self._sent.pop(path, None)
+            else:
+                self._set_highlight(what, change == "held")
+
+    def _follow(self, force: bool = False) -> None:
+        """Keep the first robot in the middle of the view (the drawing moves under the
+        camera, since meshcat's orbit controls look at the origin)."""
+        link, camera, scene = self.link, self.camera, self.scene
+        if link is None or camera is None:
+            return
+        centre = np.array(camera.target[:2])
+        body = scene.bodies.get(camera.follow.rsplit("/", 1)[-1]) if scene else None
+        if body is not None and body.frames is not None:
+            centre = np.array(body.read_poses(scene.client)[0][:2])  # type: ignore[union-attr]
+        if not force and self._centre is not None and (
+            np.abs(centre - self._centre).max() < FOLLOW_EPS
+        ):
+            return
+        self._centre = centre
+        shift = np.eye(4)
+        shift[:3, 3] = (-centre[0], -centre[1], -camera.target[2])
+        link.set_transform("/meshcat", column_major(shift))
+
+    def _send_poses(self, bodies: list[SceneBody] | None = None) -> None:
+        scene, link = self.scene, self.link
+        if scene is None or link is None:
+            return
+        commands = []
+        for body in bodies if bodies is not None else list(scene.bodies.values()):
+            if not body.tracks:
+                continue
+            for path, row in zip(body.tracks, body.read_poses(scene.client), strict=True):
+                sent = self._sent.get(path)
+                if sent is not None and np.abs(row - sent).max() <= POSE_EPS:
+                    continue
+                self._sent[path] = row
+                commands.append({"type": "set_transform", "path": path,
+                                 "matrix": column_major(pose_matrix(row))})
+        link.send_many(commands)
 
     def _send_overlay(self) -> None:
         link = self.link
@@ -218,22 +270,13 @@ class LiveViewer:
                     link.set_object(f"{OVERLAY_ROOT}/{name}", obj)
             self._overlay_items[name] = item
 
-    def _send_highlights(self) -> None:
+    def _set_highlight(self, name: str, on: bool) -> None:
         link, scene = self.link, self.scene
-        if link is None or scene is None:
+        if link is None or scene is None or name not in scene.bodies:
             return
-        held = held_objects(self.world)
-        if held == self._held:
-            return
-        for name in held ^ self._held:
-            on = name in held
-            for k in scene.body_objects.get(name, []):
-                obj = scene.objects[k]
-                if obj.rgba is None:
-                    continue
-                rgba = HIGHLIGHT_RGBA if on else obj.rgba
-                link.set_property(obj.path, "color", list(rgba))
-        self._held = held
+        for obj in scene.bodies[name].objects:
+            if obj.rgba is not None:
+                link.set_property(obj.path, "color", list(HIGHLIGHT_RGBA if on else obj.rgba))
 
     def _publish_state(self, runner: Any = None) -> None:
         sim_time = float(getattr(runner, "sim_time", 0.0)) if runner is not None else 0.0
@@ -260,42 +303,41 @@ class LiveViewer:
         self._publish_state(runner)
         if self.link is None:
             return
-        now = time.perf_counter()
-        if now - self._last_publish < 1.0 / self.options.max_fps:
-            return
-        self._last_publish = now
         try:
+            self._take_events()
+            now = time.perf_counter()
+            if now - self._last_publish < 1.0 / self.options.max_fps:
+                return
+            self._last_publish = now
             self._send_poses()
             self._send_overlay()
-            self._send_highlights()
+            self._follow()
             self.updates += 1
+        except ViewerUnavailable as exc:
+            self._drop(str(exc))
+
+    def show_last(self) -> None:
+        """Send what changed since the last update (the run's end state)."""
+        if self.link is None or (self.world is not None and self.world.client < 0):
+            return
+        try:
+            self._take_events()
+            self._send_poses()
+            self._send_overlay()
+            self._follow()
         except ViewerUnavailable as exc:
             self._drop(str(exc))
 
     def close(self) -> None:
         """Show the last poses, stop serving and disconnect (stops the meshcat server this
         viewer started)."""
-        if self.link is not None:
-            try:
-                self._send_poses()
-                self._send_overlay()
-                self._send_highlights()
-            except ViewerUnavailable:
-                pass
+        self.show_last()
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+            self._unsubscribe = None
         if self.page is not None:
             self.page.close()
             self.page = None
         if self.link is not None:
             self.link.close()
             self.link = None
-
-
-def held_objects(world: Any) -> set[str]:
-    """Names of the objects attached to a robot right now."""
-    attachments = getattr(world, "attachments", None)
-    if attachments is None:
-        return set()
-    try:
-        return {a.object_name for a in attachments.all()}
-    except Exception:
-        return set()

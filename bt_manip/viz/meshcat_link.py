@@ -1,18 +1,22 @@
 """A guarded connection to a meshcat server: start one or attach to one, never hang.
 
 meshcat's own ``Visualizer`` waits forever for a server that is not there. :class:`MeshcatLink`
-talks the same ZeroMQ protocol with time-outs: it either starts a server in a subprocess (the
-``meshcat.servers.zmqserver`` module of the installed package, which picks free ports) or
-attaches to ``zmq_url``; when the server does not answer within ``timeout`` it raises
-:class:`ViewerUnavailable` and the caller goes on without a viewer.
+talks the same ZeroMQ protocol with time-outs: it either starts a server in a subprocess
+(:mod:`bt_manip.viz.meshcat_server`: meshcat's server listening on one address, which picks
+free ports and exits with its run) or attaches to ``zmq_url``; when the server does not answer
+within ``timeout`` it raises :class:`ViewerUnavailable` and the caller goes on without a
+viewer. :meth:`MeshcatLink.close` stops a server it started (and waits for it to exit).
 """
 
 from __future__ import annotations
 
 import contextlib
+import os
 import subprocess
+import sys
 import threading
-import warnings
+import time
+from pathlib import Path
 from typing import Any
 
 import umsgpack
@@ -38,48 +42,94 @@ def _drain(process: subprocess.Popen[bytes]) -> None:
             threading.Thread(target=read, args=(stream,), daemon=True).start()
 
 
+STARTUP_PATIENCE = 10.0
+"""Seconds a server started here may take to answer its first requests (the URL, the world's
+first drawing with every mesh) on a busy machine; later requests wait ``timeout``."""
+SERVER_START_TIMEOUT = 20.0
+"""Seconds a new meshcat server may take to print its addresses (importing tornado, zmq)."""
+
+
+def _start_server(host: str, timeout: float) -> tuple[subprocess.Popen[bytes], str]:
+    """Start :mod:`bt_manip.viz.meshcat_server`; its process and ZeroMQ address."""
+    env = dict(os.environ)
+    package_root = str(Path(__file__).resolve().parents[2])
+    env["PYTHONPATH"] = os.pathsep.join(
+        p for p in (package_root, env.get("PYTHONPATH", "")) if p
+    )
+    try:
+        process = subprocess.Popen(
+            [sys.executable, "-u", "-m", "bt_manip.viz.meshcat_server", "--host", host],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, stdin=subprocess.DEVNULL, env=env,
+            start_new_session=True,  # Ctrl-C reaches the run, which then stops the server
+        )
+    except OSError as exc:
+        raise ViewerUnavailable(f"could not start a meshcat server ({exc})") from None
+    lines: list[str] = []
+
+    def read_two() -> None:
+        assert process.stdout is not None
+        for _ in range(2):
+            lines.append(process.stdout.readline().decode(errors="replace").strip())
+
+    reader = threading.Thread(target=read_two, daemon=True)
+    reader.start()
+    reader.join(max(timeout, SERVER_START_TIMEOUT))
+    zmq_url = lines[0].partition("zmq_url=")[2] if lines else ""
+    if not zmq_url or reader.is_alive():
+        process.kill()
+        _, err = process.communicate(timeout=5)
+        last = err.decode(errors="replace").strip().splitlines()[-1:] or ["no output"]
+        raise ViewerUnavailable(f"could not start a meshcat server on {host} ({last[0]})")
+    _drain(process)
+    return process, zmq_url
+
+
 class MeshcatLink:
     """Send meshcat commands (lowered dicts) to a meshcat server.
 
     Args:
         zmq_url: attach to the server listening there; None starts a private server.
         timeout: seconds to wait for any answer before giving up.
+        host: the address a server started here listens on.
     """
 
-    def __init__(self, zmq_url: str | None = None, timeout: float = DEFAULT_TIMEOUT) -> None:
+    def __init__(self, zmq_url: str | None = None, timeout: float = DEFAULT_TIMEOUT,
+                 host: str = "127.0.0.1") -> None:
         self.timeout = timeout
         self.server: subprocess.Popen[bytes] | None = None
         self._context = zmq.Context.instance()
         self._socket: Any = None
         if zmq_url is None:
-            try:
-                with warnings.catch_warnings():  # meshcat imports a deprecated pyzmq module
-                    warnings.simplefilter("ignore", DeprecationWarning)
-                    from meshcat.servers.zmqserver import start_zmq_server_as_subprocess
-
-                self.server, zmq_url, _ = start_zmq_server_as_subprocess()
-                _drain(self.server)
-            except Exception as exc:  # the server could not start: no viewer
-                raise ViewerUnavailable(f"could not start a meshcat server ({exc})") from None
+            self.server, zmq_url = _start_server(host, timeout)
         self.zmq_url: str = zmq_url
-        self._connect()
+        # a server started here has just said it listens: give it time to answer on a busy
+        # machine; a server someone else runs gets ``timeout``
+        first = max(timeout, STARTUP_PATIENCE) if self.server is not None else timeout
+        self._connect(first)
         try:
             self.web_url = self._request(b"url").decode()
         except ViewerUnavailable:
             self.close()
             raise
         # meshcat reconnects after asking for the URL; do the same
-        self._connect()
+        self._connect(first)
 
-    def _connect(self) -> None:
+    def settle(self) -> None:
+        """From now on wait ``timeout`` for each answer (after the first drawing, which a
+        server started here gets :data:`STARTUP_PATIENCE` for)."""
+        if self._socket is not None:
+            self._connect(self.timeout)
+
+    def _connect(self, timeout: float | None = None) -> None:
+        timeout = self.timeout if timeout is None else timeout
         if self._socket is not None:
             self._socket.close(linger=0)
         # a DEALER talks to meshcat's REP socket like a REQ, but can have several requests in
         # flight: a batch of commands costs one round trip instead of one each
         sock = self._context.socket(zmq.DEALER)
         sock.setsockopt(zmq.LINGER, 0)
-        sock.setsockopt(zmq.RCVTIMEO, int(self.timeout * 1000))
-        sock.setsockopt(zmq.SNDTIMEO, int(self.timeout * 1000))
+        sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000))
+        sock.setsockopt(zmq.SNDTIMEO, int(timeout * 1000))
         try:
             sock.connect(self.zmq_url)
         except zmq.ZMQError as exc:
@@ -92,6 +142,8 @@ class MeshcatLink:
 
     def _exchange(self, requests: list[list[bytes]]) -> list[bytes]:
         """Send every request, then collect one answer per request (in order)."""
+        if self._socket is None:
+            raise ViewerUnavailable("the meshcat connection is closed")
         try:
             for frames in requests:
                 self._socket.send_multipart([b"", *frames])
@@ -134,7 +186,20 @@ class MeshcatLink:
             self._socket.close(linger=0)
             self._socket = None
         if self.server is not None:
-            with contextlib.suppress(Exception):
-                self.server.kill()
-                self.server.wait(timeout=5)
+            stop_process(self.server)
             self.server = None
+
+
+def stop_process(process: subprocess.Popen[bytes], grace: float = 2.0) -> None:
+    """Terminate a child process, kill it if it has not exited after ``grace`` s, reap it."""
+    if process.poll() is None:
+        with contextlib.suppress(ProcessLookupError):
+            process.terminate()
+        deadline = time.monotonic() + grace
+        while process.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        if process.poll() is None:
+            with contextlib.suppress(ProcessLookupError):
+                process.kill()
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        process.wait(timeout=5)

@@ -1,12 +1,17 @@
-"""Record a run for the replay page: scene once, poses at a fixed rate, tree status changes.
+"""Record a run for the replay page: the bodies as they come and go, poses at a fixed rate,
+tree status changes.
 
-:class:`Recorder` is a run hook. On creation it captures the scene (:mod:`bt_manip.viz.scene`)
-and a first frame at the current sim time. After every tick it
+:class:`Recorder` is a run hook. On creation it draws the world as it is
+(:mod:`bt_manip.viz.scene`), takes a first frame at the current sim time and listens to the
+World's announcements (:mod:`bt_manip.sim.events`): a body added later (a spawned model, a
+``block`` fault's crate) is drawn from then on, a removed one is hidden from then on (each body
+keeps its appear and disappear times), and an attached object is highlighted while held.
+After every tick it
 
 - records each node whose status or reason changed (exact tick time),
 - samples every moving frame when ``1 / sample_hz`` of sim time has passed since the last
-  sample (and always on the last tick),
-- records overlay items (planned paths, target frames) and held-object highlights that changed.
+  sample (and always on the last tick, and when a body has just appeared),
+- records overlay items (planned paths, target frames) that changed.
 
 :meth:`Recorder.close` writes the self-contained page (:mod:`bt_manip.viz.replay_page`). The
 recorder only reads the simulation, so a recorded run ends exactly like an unrecorded one.
@@ -15,15 +20,16 @@ recorder only reads the simulation, so a recorded run ends exactly like an unrec
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from bt_manip.viz.live import held_objects
+from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.overlay import FrameItem, item_json
-from bt_manip.viz.scene import Scene, build_scene
+from bt_manip.viz.scene import ROOT, Scene, SceneBody, SceneObject
 from bt_manip.viz.tree_state import TreeWatcher
 
 
@@ -37,20 +43,50 @@ class RecordOptions:
 
 
 @dataclass
+class RecordedBody:
+    """One body in a recording: its drawing, when it was in the world, and its samples.
+
+    ``key`` names it in the recording (its name; ``name~2`` for the second body of that name,
+    when a model is spawned again after being deleted). ``samples[j]`` belongs to frame
+    ``first_frame + j``; a body without moving frames has no samples.
+    """
+
+    key: str
+    drawing: SceneBody
+    appear: float
+    disappear: float | None = None
+    first_frame: int = 0
+    samples: list[np.ndarray] = field(default_factory=list)
+
+
+@dataclass
 class Recording:
     """Everything a replay page needs, in memory."""
 
-    scene: Scene | None
+    bodies: list[RecordedBody]
     nodes: list[dict[str, Any]]
     times: list[float] = field(default_factory=list)
-    poses: list[np.ndarray] = field(default_factory=list)
     status_events: list[tuple[float, int, int, str]] = field(default_factory=list)
     overlay_events: list[tuple[float, str, dict[str, Any] | None, list[float] | None]] = field(
         default_factory=list
     )
     highlight_events: list[tuple[float, str, bool]] = field(default_factory=list)
+    """(time, body key, held)"""
     result: str = ""
     info: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def objects(self) -> list[SceneObject]:
+        """Every drawable of every body that was ever in the world."""
+        return [o for b in self.bodies for o in b.drawing.objects]
+
+    def track_samples(self, path: str) -> tuple[int, np.ndarray]:
+        """First frame and samples (rows x, y, z, qx, qy, qz, qw) of one moving frame."""
+        for body in self.bodies:
+            if path in body.drawing.tracks:
+                k = body.drawing.tracks.index(path)
+                return body.first_frame, np.array([s[k] for s in body.samples])
+        raise KeyError(path)
 
 
 class Recorder:
@@ -69,20 +105,62 @@ class Recorder:
         self.world = world
         self.options = options or RecordOptions()
         self.watcher = TreeWatcher(tree)
-        scene = build_scene(world) if world is not None else None
         details = dict(info or {})
         if world is not None:
             details.setdefault("robots", list(getattr(world, "robots", {}) or {}))
-        self.rec = Recording(scene, self.watcher.structure(), info=details)
+        self.rec = Recording([], self.watcher.structure(), info=details)
         self._t0 = float(world.time) if world is not None else 0.0
+        self._scene: Scene | None = None
+        self._present: dict[str, RecordedBody] = {}
+        self._keys: dict[str, int] = {}
+        self._appeared = False
+        self._unsubscribe: Callable[[], None] | None = None
         self._next_sample = 0.0
         self._overlay_version = -1
         self._overlay_items: dict[str, Any] = {}
-        self._held: set[str] = set()
         self._last_time = 0.0
         self._closed = False
+        if world is not None:
+            self._scene = Scene(client=world.client)
+            for info_ in world.infos.values():
+                if info_.kind != "ground":
+                    self._add_body(world, info_, 0.0)
+            self._unsubscribe = world.events.subscribe(self._on_world_event)
         self._sample(0.0)
         self._track_overlay(0.0)
+
+    # -- bodies ------------------------------------------------------------------------------
+    def _add_body(self, world: Any, info: Any, t: float) -> None:
+        assert self._scene is not None
+        n = self._keys.get(info.name, 0) + 1
+        self._keys[info.name] = n
+        key = info.name if n == 1 else f"{info.name}~{n}"
+        drawing = self._scene.add_body(world, info, path=f"{ROOT}/{key}")
+        body = RecordedBody(key, drawing, appear=t, first_frame=len(self.rec.times))
+        if drawing.tracks and self.rec.times and self.rec.times[-1] >= t:
+            # it is there in the frame already taken at this time
+            body.first_frame = len(self.rec.times) - 1
+            body.samples.append(drawing.read_poses(self._scene.client).astype(np.float32))
+        self.rec.bodies.append(body)
+        self._present[info.name] = body
+
+    def _on_world_event(self, event: WorldEvent) -> None:
+        """Listener of the World: a body is drawn when it appears (read from PyBullet while
+        it exists) and stops being sampled when it is removed."""
+        t = float(event.time) - self._t0
+        if isinstance(event, BodyAdded):
+            self._add_body(self.world, event, t)
+            self._appeared = True
+        elif isinstance(event, BodyRemoved):
+            body = self._present.pop(event.name, None)
+            if body is not None:
+                body.disappear = t
+                assert self._scene is not None
+                self._scene.remove_body(event.name)
+        elif isinstance(event, Attached | Detached):
+            body = self._present.get(event.object_name)
+            if body is not None:
+                self.rec.highlight_events.append((t, body.key, isinstance(event, Attached)))
 
     # -- sampling ---------------------------------------------------------------------------
     def _now(self, runner: Any) -> float:
@@ -91,15 +169,14 @@ class Recorder:
         return float(getattr(runner, "sim_time", 0.0))
 
     def _sample(self, t: float) -> None:
-        scene = self.rec.scene
-        if scene is None or not scene.tracks:
-            if not self.rec.times or t > self.rec.times[-1]:
-                self.rec.times.append(t)
-            return
         if self.rec.times and t <= self.rec.times[-1]:
             return
         self.rec.times.append(t)
-        self.rec.poses.append(scene.read_poses().astype(np.float32))
+        if self._scene is not None:
+            for body in self._present.values():
+                if body.drawing.tracks:
+                    poses = body.drawing.read_poses(self._scene.client)
+                    body.samples.append(poses.astype(np.float32))
         self._next_sample = t + 1.0 / self.options.sample_hz - 1e-9
 
     def _track_overlay(self, t: float) -> None:
@@ -129,24 +206,17 @@ class Recorder:
                 self.rec.overlay_events.append((t, name, obj, matrix))
             self._overlay_items[name] = item
 
-    def _track_highlights(self, t: float) -> None:
-        if self.world is None:
-            return
-        held = held_objects(self.world)
-        for name in sorted(held ^ self._held):
-            self.rec.highlight_events.append((t, name, name in held))
-        self._held = held
-
     def __call__(self, runner: Any) -> None:
-        """After a tick: status changes, and a pose sample when one is due."""
+        """After a tick: bodies added or removed, status changes, and a pose sample when one
+        is due (or a body just appeared)."""
         t = self._now(runner)
         self._last_time = t
         for index, code, reason in self.watcher.update():
             self.rec.status_events.append((t, index, code, reason))
-        if t >= self._next_sample:
+        if t >= self._next_sample or self._appeared:
+            self._appeared = False
             self._sample(t)
         self._track_overlay(t)
-        self._track_highlights(t)
         root = self.watcher.statuses[0] if self.watcher.statuses else 0
         if root in (2, 3):
             self.rec.result = "SUCCESS" if root == 2 else "FAILURE"
@@ -157,7 +227,15 @@ class Recorder:
         if self._closed:
             return
         self._closed = True
-        self._sample(self._last_time)
+        if self._unsubscribe is not None:
+            self._unsubscribe()
+        if self.world is None:
+            self._sample(self._last_time)
+        elif self.world.client >= 0:  # a closed world has no poses left to read
+            self._sample(self._last_time)
+            from bt_manip.viz.camera import replay_camera
+
+            self.rec.info["camera"] = replay_camera(self.world, self.rec)
         from bt_manip.viz.replay_page import write_replay
 
         try:

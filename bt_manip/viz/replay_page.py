@@ -7,10 +7,12 @@ gzip-compressed, base64-encoded container:
 ``BTRP`` (4 bytes), header length (uint32, little-endian), header (JSON), binary blobs.
 
 The header lists the scene objects (three.js JSON; a mesh file is stored once and referred to
-as ``{"$mesh": k}``), the static placements, the moving frames and where their samples are,
-the tree's nodes and status changes, the overlay items and the highlights, each with its sim
-time. Each frame's samples are stored as float32, component by component (x of every sample,
-then y, ...), which compresses well; a frame that never moves keeps a single sample.
+as ``{"$mesh": k}``), the static placements, the bodies with the sim times at which they
+appeared and disappeared (models spawned and deleted by the tree), the moving frames and where
+their samples are, the tree's nodes and status changes, the overlay items and the highlights,
+each with its sim time. A moving frame has samples from its body's first frame on (``first``,
+``count``), stored as float32, component by component (x of every sample, then y, ...), which
+compresses well; a frame that never moves keeps a single sample.
 The browser unpacks it with ``DecompressionStream`` and plays it on a timeline.
 """
 
@@ -28,13 +30,13 @@ import numpy as np
 
 from bt_manip.outputs import write_text
 from bt_manip.viz.recorder import Recording
-from bt_manip.viz.scene import ROOT, column_major
+from bt_manip.viz.scene import ROOT, column_major, mesh_files
 from bt_manip.viz.tree_page import STATIC_DIR, meshcat_bundle, render_page
 
 MAGIC = b"BTRP"
 STILL = 1e-6
 """A frame whose samples all stay this close to the first (m, quaternion units) is stored once."""
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 
 
 class _Blobs:
@@ -49,44 +51,31 @@ class _Blobs:
         return ref
 
 
-def _camera(rec: Recording) -> dict[str, Any]:
-    scene = rec.scene
-    target = [0.0, 0.0, 0.0]
-    follow = ""
-    if scene is not None:
-        robots = [p for p in scene.tracks if p.count("/") == 3 and _is_robot(rec, p)]
-        if robots and rec.poses:
-            follow = robots[0]
-            k = scene.tracks.index(follow)
-            target = [float(rec.poses[0][k][0]), float(rec.poses[0][k][1]), 0.0]
-    return {"target": target, "offset": [-2.4, -2.0, 1.9], "follow": follow}
-
-
-def _is_robot(rec: Recording, path: str) -> bool:
-    return path.rsplit("/", 1)[-1] in rec.info.get("robots", [])
-
-
 def build_container(rec: Recording, title: str = "") -> bytes:
     """The uncompressed container of a recording (see the module docstring)."""
     blobs = _Blobs()
-    scene = rec.scene
+    duration = float(rec.times[-1]) if rec.times else 0.0
     header: dict[str, Any] = {
         "format": FORMAT_VERSION,
         "title": title,
-        "info": rec.info,
+        "info": {k: v for k, v in rec.info.items() if k != "camera"},
         "result": rec.result,
-        "duration": float(rec.times[-1]) if rec.times else 0.0,
+        "duration": duration,
         "root": ROOT,
     }
-    objects, meshes, static, tracks, body_objects = [], [], [], [], {}
-    if scene is not None:
-        mesh_index: dict[Path, int] = {}
-        for path in scene.mesh_files():
-            data = path.read_bytes()
-            fmt = next(o.mesh_format for o in scene.objects if o.mesh == path)
-            mesh_index[path] = len(meshes)
-            meshes.append({"format": fmt, "name": path.name, **blobs.add(data)})
-        for obj in scene.objects:
+    objects, meshes, static, tracks, bodies = [], [], [], [], []
+    body_objects: dict[str, list[list[Any]]] = {}
+    mesh_index: dict[Path, int] = {}
+    all_objects = rec.objects
+    for path in mesh_files(all_objects):
+        fmt = next(o.mesh_format for o in all_objects if o.mesh == path)
+        mesh_index[path] = len(meshes)
+        meshes.append({"format": fmt, "name": path.name, **blobs.add(path.read_bytes())})
+    for body in rec.bodies:
+        drawing = body.drawing
+        if drawing.tracks and not body.samples:
+            continue  # came and went between two frames: never seen
+        for obj in drawing.objects:
             json_obj = copy.deepcopy(obj.json)
             if obj.mesh is not None:
                 ref = {"$mesh": mesh_index[obj.mesh]}
@@ -95,29 +84,32 @@ def build_container(rec: Recording, title: str = "") -> bytes:
                 else:
                     json_obj["geometries"][0]["data"] = ref
             objects.append({"path": obj.path, "json": json_obj})
-        static = [[path, column_major(m)] for path, m in scene.static]
-        for body, indices in scene.body_objects.items():
-            body_objects[body] = [
-                [scene.objects[k].path, list(scene.objects[k].rgba)]
-                for k in indices
-                if scene.objects[k].rgba is not None
-            ]
-        if rec.poses:
-            samples = np.stack(rec.poses).astype(np.float32)  # (frames, tracks, 7)
-            for k, path in enumerate(scene.tracks):
-                series = samples[:, k, :]
-                constant = bool(np.abs(series - series[0]).max() < STILL)
-                data = series[0] if constant else series.T  # component-major
-                tracks.append({"path": path, "const": constant,
-                               **blobs.add(np.ascontiguousarray(data).tobytes())})
+        static += [[path, column_major(m)] for path, m in drawing.static]
+        body_objects[body.key] = [[o.path, list(o.rgba)] for o in drawing.objects
+                                  if o.rgba is not None]
+        bodies.append({"name": body.key, "path": drawing.path, "appear": float(body.appear),
+                       "disappear": None if body.disappear is None else float(body.disappear)})
+        if not body.samples:
+            continue
+        samples = np.stack(body.samples).astype(np.float32)  # (samples, tracks, 7)
+        for k, path in enumerate(drawing.tracks):
+            series = samples[:, k, :]
+            constant = bool(np.abs(series - series[0]).max() < STILL)
+            data = series[0] if constant else series.T  # component-major
+            tracks.append({"path": path, "const": constant, "first": body.first_frame,
+                           "count": len(series),
+                           **blobs.add(np.ascontiguousarray(data).tobytes())})
     times = np.asarray(rec.times, dtype=np.float32)
+    camera = rec.info.get("camera") or {"target": [0.0, 0.0, 0.0],
+                                        "offset": [-2.4, -2.0, 1.9], "follow": ""}
     header["scene"] = {
         "objects": objects,
         "meshes": meshes,
         "static": static,
+        "bodies": bodies,
         "tracks": tracks,
         "body_objects": body_objects,
-        "camera": _camera(rec),
+        "camera": camera,
     }
     header["frames"] = {"count": len(rec.times), "times": blobs.add(times.tobytes())}
     reasons: dict[str, int] = {"": 0}
@@ -152,9 +144,10 @@ def read_replay(path: str | Path) -> tuple[dict[str, Any], bytes]:
 
 
 def track_samples(header: dict[str, Any], blobs: bytes, path: str) -> np.ndarray:
-    """The samples of one moving frame: rows (x, y, z, qx, qy, qz, qw), one per frame."""
-    n = header["frames"]["count"]
+    """The samples of one moving frame: rows (x, y, z, qx, qy, qz, qw), one per frame from
+    the frame its body appeared in (``first`` of the track) on."""
     track = next(t for t in header["scene"]["tracks"] if t["path"] == path)
+    n = track["count"]
     raw = np.frombuffer(blobs[track["offset"] : track["offset"] + track["length"]], np.float32)
     if track["const"]:
         return np.tile(raw, (n, 1))

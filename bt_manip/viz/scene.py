@@ -9,9 +9,14 @@
 - walls, furniture and objects made of primitives draw their parts with the colours of the
   world file.
 
-The live viewer sends :meth:`Scene.set_object_commands` once and then, after each tick, the
-poses of :attr:`Scene.tracks` read by :meth:`Scene.read_poses`; the replay recorder embeds the
-same objects (each mesh file once) and samples the same poses. Reading poses never changes the
+Each body is one :class:`SceneBody` (its objects, static placements and moving frames), so a
+body that the World announces later (:mod:`bt_manip.sim.events`) is drawn with
+:meth:`Scene.add_body` and taken away with :meth:`Scene.remove_body`, from the same visual
+shapes (primitives and meshes) as the bodies of the world file.
+
+The live viewer sends the objects once and then, after each tick, the poses of
+:attr:`Scene.tracks` read by :meth:`Scene.read_poses`; the replay recorder embeds the same
+objects (each mesh file once) and samples the same poses. Reading poses never changes the
 simulation: it evaluates forward kinematics of the current joint state (the tests check that a
 run gives bit-identical states with and without a viewer).
 """
@@ -61,68 +66,134 @@ class _BodyFrames:
     body_id: int
     base_offset: np.ndarray  # URDF root frame in the base centre-of-mass frame (4x4)
     link_ids: list[int]
-    first_track: int
+
+
+@dataclass
+class SceneBody:
+    """The drawing of one body: node ``path``, its objects, and where it is placed.
+
+    A fixed body has only :attr:`static` placements; a moving one has :attr:`tracks` (its own
+    frame first, then its drawn links relative to it) read by :meth:`read_poses`.
+    """
+
+    name: str
+    path: str
+    objects: list[SceneObject] = field(default_factory=list)
+    static: list[tuple[str, np.ndarray]] = field(default_factory=list)
+    tracks: list[str] = field(default_factory=list)
+    frames: _BodyFrames | None = None
+
+    def read_poses(self, client: int) -> np.ndarray:
+        """Current pose of every track: rows (x, y, z, qx, qy, qz, qw).
+
+        The body's track is its URDF root frame in the world; a link's track is the link frame
+        relative to the body's track.
+        """
+        out = np.empty((len(self.tracks), 7))
+        body = self.frames
+        if body is None:
+            return out
+        pos, quat = pb.getBasePositionAndOrientation(body.body_id, physicsClientId=client)
+        base = _matrix(pos, quat) @ body.base_offset
+        out[0] = _pose_row(base)
+        if body.link_ids:
+            states = pb.getLinkStates(
+                body.body_id, body.link_ids, computeForwardKinematics=1, physicsClientId=client
+            )
+            inv = _inverse(base)
+            for k, state in enumerate(states):
+                out[1 + k] = _pose_row(inv @ _matrix(state[4], state[5]))
+        return out
 
 
 @dataclass
 class Scene:
-    """The drawable objects of a world and the frames that move."""
+    """The drawable bodies of a world, by name, in the order they were added."""
 
-    objects: list[SceneObject] = field(default_factory=list)
-    static: list[tuple[str, np.ndarray]] = field(default_factory=list)
-    """Paths placed once (walls, furniture, link frames of fixed bodies)."""
-    tracks: list[str] = field(default_factory=list)
-    """Paths whose pose changes; :meth:`read_poses` returns one row per track."""
-    body_objects: dict[str, list[int]] = field(default_factory=dict)
-    """Indices into :attr:`objects` by body name (to highlight a held object)."""
     client: int = -1
-    _bodies: list[_BodyFrames] = field(default_factory=list)
+    bodies: dict[str, SceneBody] = field(default_factory=dict)
+
+    @property
+    def objects(self) -> list[SceneObject]:
+        """Every drawable of every body."""
+        return [o for body in self.bodies.values() for o in body.objects]
+
+    @property
+    def static(self) -> list[tuple[str, np.ndarray]]:
+        """Paths placed once (walls, furniture, link frames of fixed bodies)."""
+        return [p for body in self.bodies.values() for p in body.static]
+
+    @property
+    def tracks(self) -> list[str]:
+        """Paths whose pose changes; :meth:`read_poses` returns one row per track."""
+        return [t for body in self.bodies.values() for t in body.tracks]
+
+    @property
+    def body_objects(self) -> dict[str, list[int]]:
+        """Indices into :attr:`objects` by body name (to highlight a held object)."""
+        out: dict[str, list[int]] = {}
+        k = 0
+        for name, body in self.bodies.items():
+            out[name] = list(range(k, k + len(body.objects)))
+            k += len(body.objects)
+        return out
 
     def read_poses(self) -> np.ndarray:
-        """Current pose of every track: rows (x, y, z, qx, qy, qz, qw).
+        """Current pose of every track (see :meth:`SceneBody.read_poses`), bodies in order."""
+        rows = [b.read_poses(self.client) for b in self.bodies.values() if b.tracks]
+        return np.concatenate(rows) if rows else np.empty((0, 7))
 
-        A body's track is its URDF root frame in the world; a link's track is the link frame
-        relative to its body's track.
-        """
-        out = np.empty((len(self.tracks), 7))
-        c = self.client
-        for body in self._bodies:
-            pos, quat = pb.getBasePositionAndOrientation(body.body_id, physicsClientId=c)
-            base = _matrix(pos, quat) @ body.base_offset
-            row = body.first_track
-            out[row] = _pose_row(base)
-            if not body.link_ids:
-                continue
-            states = pb.getLinkStates(
-                body.body_id, body.link_ids, computeForwardKinematics=1, physicsClientId=c
-            )
-            inv = _inverse(base)
-            for k, state in enumerate(states):
-                out[row + 1 + k] = _pose_row(inv @ _matrix(state[4], state[5]))
-        return out
+    def add_body(self, world: Any, info: Any, path: str | None = None) -> SceneBody:
+        """Draw one body of ``world`` at node ``path`` (default ``ROOT/<name>``): ``info`` has
+        ``name``, ``body_id``, ``kind`` and ``spec`` (a World's BodyInfo, or the BodyAdded
+        event announcing the body)."""
+        urdf = _urdf_of(info, world)
+        movable = info.kind in ("robot", "object")
+        body = SceneBody(info.name, path or f"{ROOT}/{info.name}")
+        if urdf is not None:
+            scale = float(getattr(info.spec, "scale", 1.0) or 1.0)
+            _add_urdf_body(body, self.client, info.body_id, urdf, scale, movable)
+        else:
+            _add_primitive_body(body, self.client, info, movable)
+        self.bodies[info.name] = body
+        return body
+
+    def remove_body(self, name: str) -> SceneBody | None:
+        """Forget a body that left the world; returns its drawing (None if it had none)."""
+        return self.bodies.pop(name, None)
 
     def mesh_files(self) -> list[Path]:
         """Every mesh file the scene uses, each once, in first-use order."""
-        seen: dict[Path, None] = {}
-        for obj in self.objects:
-            if obj.mesh is not None:
-                seen.setdefault(obj.mesh, None)
-        return list(seen)
+        return mesh_files(self.objects)
 
     def lowered(self, obj: SceneObject, mesh_data: dict[Path, bytes]) -> dict[str, Any]:
         """The object JSON with its mesh content filled in, ready for msgpack."""
-        import umsgpack
+        return lowered(obj, mesh_data)
 
-        if obj.mesh is None:
-            return obj.json
-        data = mesh_data[obj.mesh]
-        content: Any = umsgpack.Ext(0x12, data) if obj.mesh_format == "stl" else data.decode()
-        json = dict(obj.json)
-        if json["object"]["type"] == "_meshfile_object":
-            json["object"] = {**json["object"], "data": content}
-        else:
-            json["geometries"] = [{**json["geometries"][0], "data": content}]
-        return json
+
+def mesh_files(objects: list[SceneObject]) -> list[Path]:
+    """Every mesh file of ``objects``, each once, in first-use order."""
+    seen: dict[Path, None] = {}
+    for obj in objects:
+        if obj.mesh is not None:
+            seen.setdefault(obj.mesh, None)
+    return list(seen)
+
+
+def lowered(obj: SceneObject, mesh_data: dict[Path, bytes]) -> dict[str, Any]:
+    """The object JSON with its mesh content filled in, ready for msgpack."""
+    import umsgpack
+
+    if obj.mesh is None:
+        return obj.json
+    data = mesh_data[obj.mesh]
+    content: Any = umsgpack.Ext(0x12, data) if obj.mesh_format == "stl" else data.decode()
+    json = dict(obj.json)
+    if json["object"]["type"] == "_meshfile_object":
+        json["object"] = {**json["object"], "data": content}
+    else:
+        json["geometries"] = [{**json["geometries"][0], "data": content}]
+    return json
 
 
 def _matrix(pos: Any, quat: Any) -> np.ndarray:
@@ -271,18 +342,11 @@ def _visual_object(path: str, body: str, visual: Visual, scale: float) -> SceneO
 
 
 def build_scene(world: Any) -> Scene:
-    """The scene of a loaded world (see the module docstring)."""
+    """The scene of a loaded world as it is now (see the module docstring)."""
     scene = Scene(client=world.client)
     for info in world.infos.values():
-        if info.kind == "ground":
-            continue
-        urdf = _urdf_of(info, world)
-        movable = info.kind in ("robot", "object")
-        if urdf is not None:
-            scale = float(getattr(info.spec, "scale", 1.0) or 1.0)
-            _add_urdf_body(scene, world, info.name, info.body_id, urdf, scale, movable)
-        else:
-            _add_primitive_body(scene, world, info, movable)
+        if info.kind != "ground":
+            scene.add_body(world, info)
     return scene
 
 
@@ -297,48 +361,38 @@ def _urdf_of(info: Any, world: Any) -> Path | None:
 
 
 def _add_urdf_body(
-    scene: Scene, world: Any, name: str, body_id: int, urdf: Path, scale: float, movable: bool
+    body: SceneBody, c: int, body_id: int, urdf: Path, scale: float, movable: bool
 ) -> None:
-    c = world.client
     root_link = pb.getBodyInfo(body_id, physicsClientId=c)[0].decode()
     links = {root_link: -1}
     for j in range(pb.getNumJoints(body_id, physicsClientId=c)):
         links[pb.getJointInfo(body_id, j, physicsClientId=c)[12].decode()] = j
     dyn = pb.getDynamicsInfo(body_id, -1, physicsClientId=c)
     base_offset = _inverse(_matrix(dyn[3], dyn[4]))
-    body_path = f"{ROOT}/{name}"
     visuals = [v for v in read_visuals(urdf) if v.link in links]
     drawn_links = sorted({links[v.link] for v in visuals if links[v.link] >= 0})
-    indices = scene.body_objects.setdefault(name, [])
     counts: dict[str, int] = {}
     for visual in visuals:
         k = counts.get(visual.link, 0)
         counts[visual.link] = k + 1
-        obj = _visual_object(f"{body_path}/{visual.link}/v{k}", name, visual, scale)
+        obj = _visual_object(f"{body.path}/{visual.link}/v{k}", body.name, visual, scale)
         if obj is not None:
-            indices.append(len(scene.objects))
-            scene.objects.append(obj)
+            body.objects.append(obj)
     link_names = {j: n for n, j in links.items()}
-    frames = _BodyFrames(body_id, base_offset, drawn_links, len(scene.tracks))
-    scene.tracks.append(body_path)
-    scene.tracks += [f"{body_path}/{link_names[j]}" for j in drawn_links]
-    scene._bodies.append(frames)
+    body.frames = _BodyFrames(body_id, base_offset, drawn_links)
+    body.tracks = [body.path] + [f"{body.path}/{link_names[j]}" for j in drawn_links]
     if not movable:
         # fixed bodies: read once, then place statically
-        rows = scene.read_poses()[frames.first_track : frames.first_track + 1 + len(drawn_links)]
-        paths = scene.tracks[frames.first_track :]
-        scene.static += [(p, pose_matrix(r)) for p, r in zip(paths, rows, strict=True)]
-        del scene.tracks[frames.first_track :]
-        scene._bodies.pop()
+        rows = body.read_poses(c)
+        body.static = [(p, pose_matrix(r)) for p, r in zip(body.tracks, rows, strict=True)]
+        body.tracks = []
+        body.frames = None
 
 
-def _add_primitive_body(scene: Scene, world: Any, info: Any, movable: bool) -> None:
-    c = world.client
-    body_path = f"{ROOT}/{info.name}"
+def _add_primitive_body(body: SceneBody, c: int, info: Any, movable: bool) -> None:
     spec = info.spec
     parts = list(getattr(spec, "parts", None) or [])
     default_rgba = tuple(getattr(spec, "colour", None) or DEFAULT_RGBA)
-    indices = scene.body_objects.setdefault(info.name, [])
     shapes = pb.getVisualShapeData(info.body_id, physicsClientId=c)
     for k, shape in enumerate(s for s in shapes if s[1] == -1):
         geom_type, dims = shape[2], shape[3]
@@ -353,15 +407,14 @@ def _add_primitive_body(scene: Scene, world: Any, info: Any, movable: bool) -> N
             kind, size = "sphere", (dims[0],)
         else:
             continue
-        indices.append(len(scene.objects))
-        scene.objects.append(
+        body.objects.append(
             SceneObject(
-                f"{body_path}/v{k}", primitive_json(kind, size, rgba, local), info.name, rgba
+                f"{body.path}/v{k}", primitive_json(kind, size, rgba, local), info.name, rgba
             )  # type: ignore[arg-type]
         )
     if movable:
-        scene._bodies.append(_BodyFrames(info.body_id, np.eye(4), [], len(scene.tracks)))
-        scene.tracks.append(body_path)
+        body.frames = _BodyFrames(info.body_id, np.eye(4), [])
+        body.tracks = [body.path]
     else:
         pos, quat = pb.getBasePositionAndOrientation(info.body_id, physicsClientId=c)
-        scene.static.append((body_path, _matrix(pos, quat)))
+        body.static = [(body.path, _matrix(pos, quat))]

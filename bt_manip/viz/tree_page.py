@@ -7,14 +7,19 @@
 ``/state.json``  sim time, tick count, every node's status and reason, the run's result
 ``/static/...``  the page's own scripts and style
 
-The 3D view is the meshcat server's own page in a frame (its websocket only accepts pages it
-served). The page polls ``/state.json`` a few times a second; the run thread only swaps in a new
-snapshot after each tick (:meth:`PageState.publish`), so serving never slows the run down.
+The server listens on 127.0.0.1 unless told another address (``--bind``), and reuses its
+address (SO_REUSEADDR), so a second run soon after the first can serve on the same port while
+the old connections wait out TIME_WAIT. The 3D view is the meshcat server's own page in a frame
+(its websocket only accepts pages it served). The page polls ``/state.json`` a few times a
+second; the run thread only swaps in a new snapshot after each tick
+(:meth:`PageState.publish`), so serving never slows the run down.
 """
 
 from __future__ import annotations
 
+import errno
 import json
+import socket
 import threading
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -114,7 +119,8 @@ class _Handler(BaseHTTPRequestHandler):
         route = self.path.split("?", 1)[0]
         try:
             if route in ("/", "/index.html"):
-                self._send(self.server.page(), "text/html; charset=utf-8")
+                host = (self.headers.get("Host") or "").rsplit(":", 1)[0]
+                self._send(self.server.page(host), "text/html; charset=utf-8")
             elif route == "/state.json":
                 self._send(state.state_bytes(), "application/json")
             elif route == "/tree.json":
@@ -134,21 +140,69 @@ class _Handler(BaseHTTPRequestHandler):
             pass
 
 
+WILDCARDS = {"//0.0.0.0:": "127.0.0.1", "//[::]:": "[::1]"}
+
+
+def reachable(url: str, host: str = "") -> str:
+    """``url`` of a server listening on every interface (0.0.0.0, ::) as a browser reaches
+    it: at ``host`` (the name the browser used for the page), else at the loopback address."""
+    for wildcard, loopback in WILDCARDS.items():
+        if wildcard in url:
+            return url.replace(wildcard, f"//{host or loopback}:")
+    return url
+
+
+class PortUnavailable(OSError):
+    """The page cannot listen where asked (port taken, or an address not on this machine).
+
+    ``strerror`` says why and what to do; ``flag`` is the option to change (``--port`` or
+    ``--bind``); ``in_use`` tells a taken port from the other reasons.
+    """
+
+    @property
+    def in_use(self) -> bool:
+        return self.errno == errno.EADDRINUSE
+
+    @property
+    def flag(self) -> str:
+        bad_address = self.errno in (errno.EADDRNOTAVAIL, errno.EAFNOSUPPORT, None) or (
+            self.errno is not None and self.errno < 0  # getaddrinfo failed
+        )
+        return "--bind" if bad_address else "--port"
+
+
+def bind_problem(host: str, port: int, exc: OSError) -> str:
+    """Why ``host:port`` cannot be listened on, and what to do, in one line."""
+    if exc.errno == errno.EADDRINUSE:
+        return (f"port {port} is in use on {host} (another bt-manip --viz?); choose another "
+                "port, or 0 for any free one")
+    if isinstance(exc, socket.gaierror) or exc.errno in (errno.EADDRNOTAVAIL, errno.EAFNOSUPPORT):
+        return f"cannot listen on {host}: not an address of this machine ({exc.strerror or exc})"
+    if exc.errno == errno.EACCES:
+        return f"no permission to listen on port {port} (ports below 1024 need root)"
+    return f"cannot listen on {host}:{port}: {exc.strerror or exc}"
+
+
 class _Server(ThreadingHTTPServer):
     daemon_threads = True
-    allow_reuse_address = False
+    allow_reuse_address = True  # SO_REUSEADDR: a port in TIME_WAIT can serve again at once
 
     def __init__(self, address: tuple[str, int], state: PageState) -> None:
+        if ":" in address[0]:
+            self.address_family = socket.AF_INET6
         super().__init__(address, _Handler)
         self.state = state
 
-    def page(self) -> bytes:
+    def page(self, request_host: str = "") -> bytes:
+        """The live page; a meshcat server listening on every address (0.0.0.0, ::) is
+        reached at the host name the browser asked for."""
         import html
 
         scripts = (
             '<script src="static/common.js"></script>\n<script src="static/live.js"></script>'
         )
-        src = html.escape(str(self.state.config.get("meshcat_url", "")), quote=True)
+        url = reachable(str(self.state.config.get("meshcat_url", "")), request_host)
+        src = html.escape(url, quote=True)
         view = f'<iframe id="meshcat-frame" src="{src}" title="3D view"></iframe>'
         return render_page(self.state.title, self.state.config, scripts, view).encode()
 
@@ -156,12 +210,15 @@ class _Server(ThreadingHTTPServer):
 class TreePageServer:
     """Serve the live page on ``host:port`` (port 0 picks a free one) until :meth:`close`.
 
-    Raises OSError when the port is taken.
+    Raises :class:`PortUnavailable` (with the reason) when it cannot listen there.
     """
 
     def __init__(self, state: PageState, port: int = DEFAULT_PORT, host: str = "127.0.0.1") -> None:
         self.state = state
-        self._server = _Server((host, port), state)
+        try:
+            self._server = _Server((host, port), state)
+        except OSError as exc:
+            raise PortUnavailable(exc.errno, bind_problem(host, port, exc)) from None
         self.host = host
         self.port = int(self._server.server_address[1])
         self._thread = threading.Thread(
@@ -172,7 +229,9 @@ class TreePageServer:
 
     @property
     def url(self) -> str:
-        return f"http://{self.host}:{self.port}/"
+        """Where to open the page on this machine (loopback when serving every interface)."""
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return reachable(f"http://{host}:{self.port}/")
 
     def close(self) -> None:
         self._server.shutdown()

@@ -4,6 +4,12 @@
 ``Tree.node_records()``), keeps each node's name, node ID, depth and parent, and after every
 tick reports which nodes changed status or reason. Statuses use BehaviorTree.CPP's names:
 IDLE (py_trees' INVALID), RUNNING, SUCCESS, FAILURE.
+
+What a node shows is its status while it runs and, once it has finished, what it last
+returned: BehaviorTree.CPP (and py_trees) reset finished children to IDLE, but a failed leaf
+must stay red beside its red parent. A node that was halted while RUNNING shows IDLE. The
+last result comes from the tree's records (``last_status``) when it keeps them, otherwise from
+what the watcher saw at the end of earlier ticks.
 """
 
 from __future__ import annotations
@@ -13,6 +19,8 @@ from typing import Any
 
 STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
 """Status codes used on the pages: the index of the name."""
+IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = range(5)
+FINISHED = (SUCCESS, FAILURE)
 
 
 @dataclass(frozen=True)
@@ -50,6 +58,7 @@ class TreeWatcher:
         walk(self.tree.root, 0, -1)
         self.statuses = [0] * len(self.nodes)
         self.reasons = [""] * len(self.nodes)
+        self._seen = [IDLE] * len(self.nodes)  # status at the end of the last tick
 
     def structure(self) -> list[dict[str, Any]]:
         """The nodes as JSON-ready dicts (index, name, id, depth, parent)."""
@@ -59,15 +68,25 @@ class TreeWatcher:
         ]
 
     def _current(self) -> list[tuple[int, str]]:
+        """(shown status, reason) of every node now."""
         records = getattr(self.tree, "node_records", None)
         if callable(records):
             recs = list(records())
             if len(recs) == len(self.nodes):
-                return [(status_code(r.status), str(r.reason or "")) for r in recs]
-        return [
-            (status_code(b.status.name), str(getattr(b, "feedback_message", "") or ""))
-            for b in self._behaviours
-        ]
+                return [
+                    (shown_status(status_code(r.status),
+                                  status_code(getattr(r, "last_status", "IDLE"))),
+                     str(r.reason or ""))
+                    for r in recs
+                ]
+        out = []
+        for i, b in enumerate(self._behaviours):
+            now = status_code(b.status.name)
+            if now != IDLE or self._seen[i] == RUNNING:
+                self._seen[i] = now  # a halted node forgets its result
+            out.append((shown_status(now, self._seen[i]),
+                        str(getattr(b, "feedback_message", "") or "")))
+        return out
 
     def update(self) -> list[tuple[int, int, str]]:
         """Read the statuses now; return the changes as (node index, status code, reason)."""
@@ -78,6 +97,13 @@ class TreeWatcher:
                 self.reasons[i] = reason
                 changes.append((i, code, reason))
         return changes
+
+
+def shown_status(status: int, last: int) -> int:
+    """What a page shows for a node with ``status`` now that last returned ``last``."""
+    if status == IDLE and last in FINISHED:
+        return last
+    return status
 
 
 def status_code(name: Any) -> int:

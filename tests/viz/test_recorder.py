@@ -12,11 +12,13 @@ import pytest
 from drive_tree import ROOM, DriveTree
 
 from bt_manip.runner import Runner, RunOptions
+from bt_manip.sim.events import Attached, Detached
 from bt_manip.sim.world import World
 from bt_manip.viz.recorder import Recorder, RecordOptions
 from bt_manip.viz.replay_page import read_replay, track_samples
 from bt_manip.viz.scene import ROOT
 
+REPO = Path(__file__).resolve().parents[2]
 STATUS = {"IDLE": 0, "RUNNING": 1, "SUCCESS": 2, "FAILURE": 3}
 
 
@@ -76,13 +78,17 @@ def test_replay_holds_status_changes_with_reasons(tmp_path: Path) -> None:
 
 
 def test_replay_holds_overlays_and_highlights(tmp_path: Path) -> None:
-    held: list[str] = []
+    held: list[bool] = []
 
     def grab_at_one_second(runner: Any) -> None:
-        # stand-in for an attach joint: report the crate as held from t = 1 s to 2 s
+        # stand-in for an attach joint: announce the crate held from t = 1 s to 2 s
         world = runner.world
-        held[:] = ["crate"] if 1.0 <= world.time < 2.0 else []
-        world.attachments.all = lambda: [SimpleNamespace(object_name=n) for n in held]
+        holding = 1.0 <= world.time < 2.0
+        if holding != bool(held and held[-1]):
+            event = Attached if holding else Detached
+            args = ("crate", "husky", "tool0") if holding else ("crate", "husky")
+            world.events.announce(event(world.time, *args))
+            held.append(holding)
 
     _, header, _, world = _record(tmp_path / "run.html", hooks=[grab_at_one_second])
     world.close()
@@ -125,3 +131,76 @@ def test_replay_page_is_self_contained(tmp_path: Path) -> None:
     # nothing is fetched: no external scripts, styles, images or frames
     assert not re.search(r"<(script|link|img|iframe)[^>]+(src|href)=", text)
     assert "MeshCat" in text and 'id="bt-replay"' in text
+
+
+def test_bodies_added_and_removed_during_the_run_keep_their_times(tmp_path: Path) -> None:
+    from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D
+
+    def crate(name: str) -> BodySpec:
+        return BodySpec(
+            name=name, movable=True, parts=[Part("box", (0.3, 0.3, 0.3))], urdf=None,
+            pose=Pose3D((-1.5, 1.5, 0.6)), planar=False, mass=2.0, friction=0.8,
+            colour=(0.5, 0.3, 0.1, 1.0), randomize=Range2D(), line=0,
+        )
+
+    changes: dict[str, float] = {}
+
+    def drop_and_take_crates(runner: Any) -> None:
+        # what a block fault does (a crate falls), then DeleteModel, then the same name again
+        world = runner.world
+        for key, at, change in (("drop", 1.0, "spawn"), ("take", 2.0, "remove"),
+                                ("again", 3.0, "spawn")):
+            if key not in changes and world.time >= at:
+                changes[key] = world.time
+                if change == "spawn":
+                    world.spawn(crate("crate_drop"))
+                else:
+                    world.remove("crate_drop")
+
+    _, header, blobs, world = _record(tmp_path / "run.html", hooks=[drop_and_take_crates])
+    world.close()
+    bodies = {b["name"]: b for b in header["scene"]["bodies"]}
+    first, second = bodies["crate_drop"], bodies["crate_drop~2"]
+    assert first["appear"] == pytest.approx(changes["drop"], abs=1e-9)
+    assert first["disappear"] == pytest.approx(changes["take"], abs=1e-9)
+    assert second["appear"] == pytest.approx(changes["again"], abs=1e-9)
+    assert second["disappear"] is None and bodies["husky"]["appear"] == 0.0
+    assert f"{ROOT}/crate_drop~2/v0" in [o["path"] for o in header["scene"]["objects"]]
+    times = np.frombuffer(blobs[header["frames"]["times"]["offset"]:][
+        : header["frames"]["times"]["length"]], np.float32)
+    track = next(t for t in header["scene"]["tracks"] if t["path"] == f"{ROOT}/crate_drop")
+    # sampled from the tick it appeared at to the last sample before it was removed
+    assert times[track["first"]] == pytest.approx(changes["drop"], abs=1e-6)
+    assert times[track["first"] + track["count"] - 1] < changes["take"]
+    fall = track_samples(header, blobs, f"{ROOT}/crate_drop")[:, 2]
+    assert fall[0] == pytest.approx(0.6, abs=1e-6) and fall[-1] == pytest.approx(0.15, abs=0.01)
+
+
+def test_a_block_fault_crate_is_in_the_replay(tmp_path: Path) -> None:
+    import bt_manip.behaviours  # noqa: F401  (registers Navigate)
+    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.faults import FaultInjector, FaultSpec
+
+    with World(REPO / "worlds" / "tb3_house.yaml", seed=0) as world:
+        faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)
+        xml = ('<root BTCPP_format="4"><BehaviorTree ID="M"><Navigate goal="goal"/>'
+               "</BehaviorTree></root>")
+        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        tree = load_tree_string(xml, context=context)
+        recorder = Recorder(tmp_path / "crate.html", world, tree)
+        dropped_at = None
+        for _ in range(80):  # until the crate has been falling for a second
+            tree.tick()
+            recorder(SimpleNamespace(world=world))
+            world.step(12)
+            if dropped_at is None and "dropped_crate_0" in world.movable:
+                dropped_at = world.time
+            if dropped_at is not None and world.time > dropped_at + 1.0:
+                break
+        tree.halt()
+        recorder.close()
+    header, blobs = read_replay(tmp_path / "crate.html")
+    crate = next(b for b in header["scene"]["bodies"] if b["name"] == "dropped_crate_0")
+    assert crate["disappear"] is None and crate["path"] == f"{ROOT}/dropped_crate_0"
+    z = track_samples(header, blobs, f"{ROOT}/dropped_crate_0")[:, 2]
+    assert z[0] > z[-1] + 0.1  # it fell onto the route

@@ -55,11 +55,21 @@
 
   const n = header.frames.count;
   const times = floats(header.frames.times);
+  // each track has samples for frames first .. first + count - 1 (its body's time in the world)
   const tracks = scene.tracks.map((t) => ({
     node: viewer.scene_tree.find(split(t.path)).object,
     path: t.path,
     constant: t.const,
+    first: t.first,
+    count: t.count,
     values: floats(t),
+  }));
+  // bodies spawned or deleted while the run went on are shown only while they were there
+  const bodies = scene.bodies.map((b) => ({
+    name: b.name,
+    node: viewer.scene_tree.find(split(b.path)).object,
+    appear: b.appear,
+    disappear: b.disappear,
   }));
   const duration = header.duration;
 
@@ -67,8 +77,11 @@
   const camera = scene.camera;
   const drawing = viewer.scene_tree.find(split(header.root).slice(0, 1)).object;
   const followTrack = tracks.find((t) => t.path === camera.follow);
+  // and down by the look height, the floor grid and the axes with it
+  const lookHeight = camera.target[2] || 0;
+  for (const helper of ["Grid", "Axes"]) viewer.scene_tree.find([helper]).object.position.set(0, 0, -lookHeight);
   function centreOn(x, y) {
-    drawing.position.set(-x, -y, 0);
+    drawing.position.set(-x, -y, -lookHeight);
   }
   centreOn(camera.target[0], camera.target[1]);
   const off = camera.offset;
@@ -127,19 +140,38 @@
     }
     return lo;
   }
-  function setFrame(k) {
+  function present(b, t) {
+    return b.appear <= t + 1e-6 && (b.disappear === null || t < b.disappear - 1e-6);
+  }
+  function setFrame(k, t) {
     if (k < 0) return;
+    for (const b of bodies) b.node.visible = present(b, t);
     for (const tr of tracks) {
       const v = tr.values;
       if (tr.constant) {
         tr.node.position.set(v[0], v[1], v[2]);
         tr.node.quaternion.set(v[3], v[4], v[5], v[6]);
       } else {
-        tr.node.position.set(v[k], v[n + k], v[2 * n + k]);
-        tr.node.quaternion.set(v[3 * n + k], v[4 * n + k], v[5 * n + k], v[6 * n + k]);
+        const c = tr.count;
+        const j = Math.max(0, Math.min(c - 1, k - tr.first));
+        tr.node.position.set(v[j], v[c + j], v[2 * c + j]);
+        tr.node.quaternion.set(v[3 * c + j], v[4 * c + j], v[5 * c + j], v[6 * c + j]);
       }
     }
     if (follow.checked && followTrack) centreOn(followTrack.node.position.x, followTrack.node.position.y);
+  }
+  // where a body is in the world at time t (for tests and tools): [x, y, z] or null when absent
+  function bodyPosition(name, t) {
+    const b = bodies.find((x) => x.name === name);
+    if (!b || !present(b, t)) return null;
+    const tr = tracks.find((x) => x.path === header.root + "/" + name);
+    if (!tr) return null;
+    const k = frameAt(t);
+    const v = tr.values;
+    if (tr.constant) return [v[0], v[1], v[2]];
+    const c = tr.count;
+    const j = Math.max(0, Math.min(c - 1, k - tr.first));
+    return [v[j], v[c + j], v[2 * c + j]];
   }
   let current = -1;
   function seek(t) {
@@ -164,7 +196,7 @@
       }
       panel.setFailures(failures.slice(-12));
     }
-    setFrame(frameAt(t));
+    setFrame(frameAt(t), t);
     current = t;
     seekBar.value = t;
     label.textContent = formatTime(t) + " / " + formatTime(duration);
@@ -238,6 +270,10 @@
     play: () => setPlaying(true),
     time: () => current,
     statuses: () => statuses.slice(),
+    bodies: () => bodies.map((b) => ({ name: b.name, appear: b.appear, disappear: b.disappear })),
+    visible: (name) => { const b = bodies.find((x) => x.name === name); return !!b && b.node.visible; },
+    bodyPosition: bodyPosition,
+    frameTimes: () => Array.from(times),
     viewer: viewer,
   };
 })();
