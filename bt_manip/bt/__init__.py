@@ -16,6 +16,7 @@ from bt_manip.bt.node import (
     ControlNode,
     DecoratorNode,
     PortError,
+    SyncActionNode,
     TreeRuntimeError,
 )
 from bt_manip.bt.ports import InOutPortInformation
@@ -38,6 +39,7 @@ __all__ = [
     "NodeStatus",
     "PortError",
     "SubTree",
+    "SyncActionNode",
     "Tree",
     "TreeContext",
     "TreeRuntimeError",

@@ -5,13 +5,29 @@ blackboard sees its parent's entries only through explicit remapping (``port="{p
 or, with ``_autoremap``, through every key that does not start with ``_``. A key written as
 ``@key`` always addresses the root blackboard. There is no global state: each loaded tree owns
 its blackboards.
+
+Entries are typed as in BehaviorTree.CPP: a port bound to ``{key}`` declares the entry with the
+port's type when the tree is built (:meth:`Blackboard.declare`; the entry exists but has no
+value yet), and an entry first written without a declaration takes the type of that value.
+Text written into an entry of another type (``SetBlackboard value="5"`` over an int) is
+converted to that type, or raises :class:`EntryTypeError`. Every write bumps the entry's update
+counter (:meth:`Blackboard.sequence_id`), which WasEntryUpdated and its decorators watch.
 """
 
 from __future__ import annotations
 
 import math
+import typing
 from collections.abc import Iterator
 from typing import Any
+
+from bt_manip.bt.ports import convert_literal, type_name
+
+UNTYPED = (object, typing.Any, None)
+
+
+class EntryTypeError(ValueError):
+    """A value cannot be stored in an entry of another type."""
 
 
 class Blackboard:
@@ -27,6 +43,8 @@ class Blackboard:
         self.remap: dict[str, str] = dict(remap or {})
         self.autoremap = autoremap
         self._data: dict[str, Any] = {}
+        self._types: dict[str, Any] = {}  # declared by a port, or the type of the first value
+        self._sequence: dict[str, int] = {}  # how many times each entry was written
 
     @classmethod
     def from_dict(cls, values: dict[str, Any] | None) -> Blackboard:
@@ -47,7 +65,7 @@ class Blackboard:
         while True:
             if key.startswith("@"):
                 return bb.root(), key[1:]
-            if key in bb._data or bb.parent is None:
+            if key in bb._data or key in bb._types or bb.parent is None:
                 return bb, key
             if key in bb.remap:
                 key = bb.remap[key]
@@ -59,11 +77,16 @@ class Blackboard:
             return bb, key
 
     def exists(self, key: str) -> bool:
+        """Whether the entry exists (declared by a port, or written), with a value or not."""
+        bb, name = self._owner(key)
+        return name in bb._data or name in bb._types
+
+    def has_value(self, key: str) -> bool:
         bb, name = self._owner(key)
         return name in bb._data
 
     def get(self, key: str) -> Any:
-        """Value of ``key``; raises KeyError when the entry does not exist."""
+        """Value of ``key``; raises KeyError when the entry does not exist or has no value."""
         bb, name = self._owner(key)
         return bb._data[name]
 
@@ -71,13 +94,47 @@ class Blackboard:
         bb, name = self._owner(key)
         return bb._data.get(name, default)
 
-    def set(self, key: str, value: Any) -> None:
+    def entry_type(self, key: str) -> Any:
+        """The entry's type (declared by a port, or of its first value); None if untyped."""
         bb, name = self._owner(key)
+        return bb._types.get(name)
+
+    def declare(self, key: str, data_type: Any) -> None:
+        """Create the entry (without a value) for a port bound to it, with the port's type.
+
+        An entry that already has a type keeps it; an untyped port creates an untyped entry,
+        which takes the type of the first value written.
+        """
+        bb, name = self._owner(key)
+        if bb._types.get(name) is None:
+            bb._types[name] = None if data_type in UNTYPED else data_type
+
+    def set(self, key: str, value: Any) -> None:
+        """Write ``key``; text written into an entry of another type is converted to it."""
+        bb, name = self._owner(key)
+        types = bb._types
+        declared = types.get(name)
+        if declared is None:
+            if value is not None:
+                types[name] = type(value)
+        elif type(value) is str and declared is not str:
+            value = _from_text(name, value, declared)
         bb._data[name] = value
+        sequence = bb._sequence
+        sequence[name] = sequence.get(name, 0) + 1
+
+    def sequence_id(self, key: str) -> int | None:
+        """How many times the entry was written (None when it does not exist)."""
+        bb, name = self._owner(key)
+        if name not in bb._data and name not in bb._types:
+            return None
+        return bb._sequence.get(name, 0)
 
     def unset(self, key: str) -> None:
         bb, name = self._owner(key)
         bb._data.pop(name, None)
+        bb._types.pop(name, None)
+        bb._sequence.pop(name, None)
 
     def keys(self) -> Iterator[str]:
         """Keys stored in this blackboard itself (not those reached through the parent)."""
@@ -89,6 +146,15 @@ class Blackboard:
 
     def __repr__(self) -> str:
         return f"Blackboard({self._data!r})"
+
+
+def _from_text(name: str, text: str, data_type: Any) -> Any:
+    try:
+        return convert_literal(text, data_type)
+    except ValueError as e:
+        raise EntryTypeError(
+            f"cannot convert '{text}' to the type of entry [{name}] "
+            f"({type_name(data_type)}): {e}") from None
 
 
 def _jsonable(value: Any) -> Any:

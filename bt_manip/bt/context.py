@@ -20,6 +20,8 @@ class TreeContext:
     clock: Clock = field(default_factory=MonotonicClock)
     world: Any = None
     services: dict[str, Any] = field(default_factory=dict)
+    wake_up: bool = False
+    """A node asked for the root to be ticked again (BT.CPP's wake-up signal)."""
 
     def now(self) -> float:
         return self.clock.now()

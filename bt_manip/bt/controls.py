@@ -16,6 +16,7 @@ from bt_manip.bt.registry import registry
 from bt_manip.bt.script import FLOAT_EPS, to_text
 from bt_manip.bt.status import NodeStatus
 
+IDLE = NodeStatus.IDLE
 RUNNING = NodeStatus.RUNNING
 SUCCESS = NodeStatus.SUCCESS
 FAILURE = NodeStatus.FAILURE
@@ -32,10 +33,11 @@ class _Control(ControlNode):
 
 
 class _OrderedControl(_Control):
-    """Shared logic of Sequence, SequenceWithMemory and Fallback."""
+    """Shared logic of Sequence, SequenceWithMemory, Fallback and their Async variants."""
 
     STOP_ON = FAILURE  # child status that ends the loop early
     DONE = SUCCESS  # status when every child passed
+    YIELDS = False  # after a child that started and finished in this tick, yield (wake-up)
 
     def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
                  **attributes: Any) -> None:
@@ -50,19 +52,24 @@ class _OrderedControl(_Control):
     def tick_node(self) -> NodeStatus:
         kids = self._kids()
         n = len(kids)
-        if self.bt_status is not RUNNING:
+        if self.bt_status is IDLE:  # BT.CPP keeps the count while the node is not reset
             self._skipped = 0
         self._start()
         while self.current < n:
-            status = kids[self.current].execute_tick()
+            child = kids[self.current]
+            before = child.bt_status
+            status = child.execute_tick()
             if status is RUNNING:
                 return RUNNING
             if status is self.STOP_ON:
                 self._on_stop()
                 return status
+            self.current += 1
             if status is SKIPPED:
                 self._skipped += 1
-            self.current += 1
+            elif self.YIELDS and before is IDLE and self.current < n:
+                self.emit_wake_up()
+                return RUNNING
         all_skipped = self._skipped == n
         self.reset_children()
         self.current = 0
@@ -99,7 +106,13 @@ class SequenceWithMemory(_OrderedControl):
     - all children SUCCESS: reset everything and return SUCCESS.
 
     Being halted does not rewind it either (as in BT.CPP 4).
+
+    When a child started and finished (SUCCESS) within this tick and more children follow, it
+    returns RUNNING and asks for a wake-up: ``Tree.tick()`` then ticks the tree again from the
+    root at once, so reactive parents above re-check their conditions between two children.
     """
+
+    YIELDS = True
 
     def _on_stop(self) -> None:
         for index in range(self.current, len(self.children)):
@@ -123,6 +136,30 @@ class Fallback(_OrderedControl):
 
     STOP_ON = SUCCESS
     DONE = FAILURE
+
+
+@registry.register(builtin=True)
+class AsyncSequence(Sequence):
+    """A Sequence that yields between children.
+
+    As Sequence, but when a child started and succeeded within this tick and more children
+    follow, it returns RUNNING and asks for a wake-up (``Tree.tick()`` ticks the root again at
+    once), so reactive parents re-check their conditions between two children.
+    """
+
+    YIELDS = True
+
+
+@registry.register(builtin=True)
+class AsyncFallback(Fallback):
+    """A Fallback that yields between children.
+
+    As Fallback, but when a child started and failed within this tick and more children
+    follow, it returns RUNNING and asks for a wake-up (``Tree.tick()`` ticks the root again at
+    once).
+    """
+
+    YIELDS = True
 
 
 class _ReactiveControl(_Control):
@@ -413,7 +450,9 @@ class _Switch(_Control):
 
     At each tick the variable is compared with every case (as text, then as numbers); the
     child of the first match (or the default) is ticked. If another child was RUNNING, it is
-    halted first. When the ticked child finishes, all children are reset.
+    halted first. When the ticked child finishes, all children are reset. The Switch returns
+    the child's status and, as in BT.CPP, does not mark itself RUNNING before ticking it (a
+    Switch whose child was skipped stays IDLE).
     """
 
     CASES = 0
@@ -436,7 +475,6 @@ class _Switch(_Control):
                     break
         if self._running != -1 and self._running != match:
             self.halt_child(self._running)
-        self._start()
         status = kids[match].execute_tick()
         if status is SKIPPED:
             self._running = -1

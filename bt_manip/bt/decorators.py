@@ -16,6 +16,7 @@ from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
 from bt_manip.bt.status import NodeStatus
 
+IDLE = NodeStatus.IDLE
 RUNNING = NodeStatus.RUNNING
 SUCCESS = NodeStatus.SUCCESS
 FAILURE = NodeStatus.FAILURE
@@ -73,10 +74,12 @@ class ForceFailure(_Force):
 class Repeat(_Decorator):
     """Ticks the child up to ``num_cycles`` times in a row (-1: forever) while it succeeds.
 
-    The loop runs within one tick while the child finishes synchronously; a RUNNING child
-    returns RUNNING and the loop resumes at the next tick. A child FAILURE stops the loop and
-    returns FAILURE; after ``num_cycles`` successes the node returns SUCCESS. A SKIPPED child
-    makes the node SKIPPED (the count is kept).
+    A child that started and succeeded within this tick, with cycles left, makes it return
+    RUNNING and ask for a wake-up: ``Tree.tick()`` ticks the root again at once, so the cycles
+    still run within one tree tick but reactive parents re-check their conditions in between.
+    A RUNNING child returns RUNNING and the loop resumes at the next tick. A child FAILURE stops
+    the loop and returns FAILURE; after ``num_cycles`` successes the node returns SUCCESS. A
+    SKIPPED child makes the node SKIPPED (the count is kept).
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
@@ -94,11 +97,16 @@ class Repeat(_Decorator):
         loop = self.count < cycles or cycles == -1
         self._start()
         while loop:
-            status = self.child.execute_tick()
+            child = self.child
+            before = child.bt_status
+            status = child.execute_tick()
             if status is SUCCESS:
                 self.count += 1
                 loop = self.count < cycles or cycles == -1
                 self.reset_child()
+                if before is IDLE and loop:
+                    self.emit_wake_up()
+                    return RUNNING
             elif status is FAILURE:
                 self.count = 0
                 self.reset_child()
@@ -120,9 +128,11 @@ class Repeat(_Decorator):
 class RetryUntilSuccessful(_Decorator):
     """Ticks the child again after a FAILURE, up to ``num_attempts`` times (-1: forever).
 
-    Retries happen within the same tick while the child fails synchronously; a RUNNING child
-    returns RUNNING. Child SUCCESS returns SUCCESS; after ``num_attempts`` failures the node
-    returns FAILURE. A SKIPPED child makes the node SKIPPED.
+    A child that started and failed within this tick, with attempts left, makes it return
+    RUNNING and ask for a wake-up (``Tree.tick()`` ticks the root again at once, so the retries
+    still happen within one tree tick); a RUNNING child returns RUNNING. Child SUCCESS returns
+    SUCCESS; after ``num_attempts`` failures the node returns FAILURE. A SKIPPED child makes
+    the node SKIPPED.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
@@ -140,7 +150,9 @@ class RetryUntilSuccessful(_Decorator):
         loop = self.tries < attempts or attempts == -1
         self._start()
         while loop:
-            status = self.child.execute_tick()
+            child = self.child
+            before = child.bt_status
+            status = child.execute_tick()
             if status is SUCCESS:
                 self.tries = 0
                 self.reset_child()
@@ -150,6 +162,9 @@ class RetryUntilSuccessful(_Decorator):
                 attempts = self.get_input("num_attempts")
                 loop = self.tries < attempts or attempts == -1
                 self.reset_child()
+                if before is IDLE and loop:
+                    self.emit_wake_up()
+                    return RUNNING
             elif status is RUNNING:
                 return RUNNING
             else:

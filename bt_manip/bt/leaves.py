@@ -7,16 +7,18 @@ from typing import Any, ClassVar
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.blackboard import EntryTypeError
 from bt_manip.bt.decorators import TIME_EPS, _ScriptHolder
-from bt_manip.bt.node import ActionNode, ConditionNode, TreeRuntimeError, _truth
+from bt_manip.bt.node import ActionNode, ConditionNode, SyncActionNode, TreeRuntimeError, _truth
 from bt_manip.bt.ports import InOutPortInformation, Literal, Ref
 from bt_manip.bt.registry import registry
+from bt_manip.bt.script import to_text
 
 Ports = dict[str, PortInformation]
 
 
 @registry.register(builtin=True)
-class AlwaysSuccess(ActionNode):
+class AlwaysSuccess(SyncActionNode):
     """Returns SUCCESS."""
 
     def update(self) -> Status:
@@ -24,7 +26,7 @@ class AlwaysSuccess(ActionNode):
 
 
 @registry.register(builtin=True)
-class AlwaysFailure(ActionNode):
+class AlwaysFailure(SyncActionNode):
     """Returns FAILURE."""
 
     def update(self) -> Status:
@@ -32,7 +34,7 @@ class AlwaysFailure(ActionNode):
 
 
 @registry.register(builtin=True)
-class Script(ActionNode):
+class Script(SyncActionNode):
     """Runs the script ``code`` on the blackboard and returns SUCCESS."""
 
     INPUT_PORTS: ClassVar[Ports] = {"code": PortInformation(str, description="script to run")}
@@ -66,37 +68,59 @@ class ScriptCondition(ConditionNode):
 
 
 @registry.register(builtin=True)
-class SetBlackboard(ActionNode):
+class SetBlackboard(SyncActionNode):
     """Writes ``value`` into the entry named by ``output_key``; returns SUCCESS.
 
-    ``value`` may be text or a reference ``{other}`` (the other entry's value is copied).
-    ``output_key`` is the name of the entry (a reference ``{key}`` names the entry ``key``).
+    ``value`` is text, or a reference ``{other}`` whose value is copied (FAILURE when that
+    entry has no value). Text written into an entry of another type is converted to it (an
+    error if it cannot be). ``output_key`` is the name of the entry; as in BT.CPP, a reference
+    ``{key}`` there names the entry whose *value* is the name to write to.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "value": PortInformation(str, description="value to write (text, or {key} to copy)"),
-        "output_key": InOutPortInformation(str, description="name of the entry to write"),
+        "value": PortInformation(
+            object, description="Value to be written into the output_key"),
+        "output_key": InOutPortInformation(
+            object, description="Name of the blackboard entry where the value should be "
+                                "written"),
     }
 
     def update(self) -> Status:
+        bb = self.blackboard
         key_binding = self.bindings["output_key"]
-        key = key_binding.key if isinstance(key_binding, Ref) else str(key_binding.value)
+        if isinstance(key_binding, Ref):
+            try:
+                key = to_text(bb.get(key_binding.key))
+            except KeyError:
+                raise TreeRuntimeError(
+                    f"{self.describe()}: output_key reads the entry name from "
+                    f"'{key_binding.key}', which has no value") from None
+        else:
+            key = str(key_binding.value)
         value_binding = self.bindings["value"]
         if isinstance(value_binding, Literal):
             value = value_binding.value
         else:
-            try:
-                value = self.blackboard.get(value_binding.key)
-            except KeyError:
+            source = value_binding.key
+            if not bb.exists(source):
                 raise TreeRuntimeError(
-                    f"{self.describe()}: value refers to entry '{value_binding.key}', "
+                    f"{self.describe()}: value refers to entry '{source}', "
                     "which does not exist") from None
-        self.blackboard.set(key, value)
+            if not bb.exists(key):
+                bb.declare(key, bb.entry_type(source))
+            if not bb.has_value(source):
+                self.feedback_message = f"entry '{source}' has no value to copy"
+                return Status.FAILURE
+            value = bb.get(source)
+        try:
+            bb.set(key, value)
+        except EntryTypeError as e:
+            raise TreeRuntimeError(f"{self.describe()}: {e}") from None
         return Status.SUCCESS
 
 
 @registry.register(builtin=True)
-class UnsetBlackboard(ActionNode):
+class UnsetBlackboard(SyncActionNode):
     """Removes the entry ``key`` from the blackboard (if present); returns SUCCESS."""
 
     INPUT_PORTS: ClassVar[Ports] = {

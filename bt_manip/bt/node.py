@@ -328,6 +328,15 @@ class BtNode(PortsMixin):
         """The node's own logic for one tick (BT.CPP's ``tick()``)."""
         raise NotImplementedError
 
+    def emit_wake_up(self) -> None:
+        """Ask the tree to tick again from the root within the same ``Tree.tick()``.
+
+        BT.CPP's ``emitWakeUpSignal()``: a node that returns RUNNING only to keep the tree
+        interruptible (a SequenceWithMemory whose child finished at once, a Repeat between two
+        cycles) emits it, and ``Tree.tick()`` re-ticks the root while one is pending.
+        """
+        self.context.wake_up = True
+
     def _fault_injected(self) -> bool:
         """Whether a seeded fault (``--inject NAME:failure:P``) makes this start fail."""
         faults = self.context.services.get("faults")
@@ -390,7 +399,15 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
     ``initialise()`` runs when the node starts (it was not RUNNING), ``terminate(status)`` once
     when it finishes (SUCCESS/FAILURE) or is halted while RUNNING (INVALID).
+
+    A ``STATEFUL`` leaf follows BT.CPP's ``StatefulActionNode``: it starts only from IDLE, so
+    when its parent ticks it again after it finished without resetting it (a WhileDoElse
+    condition while a branch runs, the first children of a ReactiveSequence), it returns the
+    status it finished with and runs nothing. Other leaves (BT.CPP's ``SyncActionNode`` and
+    ``ConditionNode``) run at every tick.
     """
+
+    STATEFUL: ClassVar[bool] = False
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name or self.NODE_ID)
@@ -398,6 +415,8 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
     def tick_node(self) -> NodeStatus:
         if self.status != _RUNNING:
+            if self.STATEFUL and self.bt_status is not NodeStatus.IDLE:
+                return self.bt_status
             self.initialise()
         result = self.update()
         if result not in _BT_FROM_PY or result == Status.INVALID:
@@ -414,9 +433,23 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
 
 class ActionNode(LeafNode):
-    """Base class for actions (leaves that act; may return RUNNING)."""
+    """Base class for actions (leaves that act; may return RUNNING).
+
+    Actions are stateful (BT.CPP's ``StatefulActionNode``, see :class:`LeafNode`): ticked again
+    after they finished, without a reset in between, they return the same status.
+    """
 
     KIND = "Action"
+    STATEFUL = True
+
+
+class SyncActionNode(ActionNode):
+    """Base class for actions that finish within their tick (BT.CPP's ``SyncActionNode``).
+
+    They never return RUNNING and run again at every tick, even when not reset.
+    """
+
+    STATEFUL = False
 
 
 class ConditionNode(LeafNode):

@@ -184,7 +184,7 @@ class Unary(Expr):
             return not to_bool(v)
         num = to_number(v, self.op)
         if self.op == "-":
-            return -num
+            return -float(num)
         return float(~int(num)) if isinstance(num, float) else ~int(num)
 
 
@@ -230,6 +230,14 @@ class IfElse(Expr):
 
 @dataclass
 class Assign(Expr):
+    """``name := value``, ``name = value`` and ``name += value`` (and ``-= *= /=``).
+
+    As in BT.CPP, an entry keeps its type: text assigned to a number entry is converted to a
+    number, a number assigned to a text entry is an error, a non-integral number assigned to an
+    integer entry is an error; ``+= -= *= /=`` with a number need a number entry, and ``+=``
+    with text needs a text entry.
+    """
+
     op: str
     target: str
     value: Expr
@@ -237,28 +245,79 @@ class Assign(Expr):
 
     def eval(self, env: Variables) -> Any:
         key = self.target
-        exists = env.exists(key)
-        if not exists and self.op != ":=":
+        if not env.exists(key) and self.op != ":=":
             raise ScriptRuntimeError(
                 f"the blackboard entry [{key}] does not exist yet; use := to create it"
             )
         value = self.value.eval(env)
+        has_value = getattr(env, "has_value", env.exists)(key)
         if self.op in (":=", "="):
-            if exists:
-                old = env.get(key)
-                if isinstance(value, str) and _is_number(old):
-                    value = _string_to_number(value)
-            env.set(key, value)
+            if has_value:
+                value = _convert_for(key, env.get(key), value)
+            _store(env, key, value)
             return value
+        if not has_value:
+            raise ScriptRuntimeError(f"the entry [{key}] has no value to use with {self.op}")
         old = env.get(key)
-        if isinstance(value, str) and not _is_number(old):
+        if isinstance(value, str):
             if self.op != "+=":
                 raise ScriptRuntimeError(f"operator {self.op} cannot be used with strings")
-            new = to_text(old) + value
+            if not isinstance(old, str):
+                raise ScriptRuntimeError(
+                    f"{self.op} with a string cannot be used on entry [{key}], which holds "
+                    f"a {_type_label(old)}")
+            new: Any = old + value
         else:
+            if not _is_number(old) and not isinstance(old, bool):
+                raise ScriptRuntimeError(
+                    f"operator {self.op} cannot be used on entry [{key}], which holds a "
+                    f"{_type_label(old)} (not a number)")
             new = binary(self.op[0], to_number(old, self.op), to_number(value, self.op))
-        env.set(key, new)
+            new = _convert_for(key, old, new)
+        _store(env, key, new)
         return new
+
+
+def _store(env: Variables, key: str, value: Any) -> None:
+    try:
+        env.set(key, value)
+    except ValueError as e:  # the entry's type cannot hold the value
+        raise ScriptRuntimeError(str(e)) from None
+
+
+def _type_label(value: Any) -> str:
+    if isinstance(value, bool):
+        return "bool"
+    if isinstance(value, int):
+        return "int"
+    if isinstance(value, float):
+        return "double"
+    if isinstance(value, str):
+        return "string"
+    return type(value).__name__
+
+
+def _convert_for(key: str, old: Any, value: Any) -> Any:
+    """``value`` as it can be stored in entry ``key`` holding ``old`` (BT.CPP's rules)."""
+    if isinstance(value, str):
+        if isinstance(old, str):
+            return value
+        if _is_number(old) or isinstance(old, bool):
+            return _string_to_number(value)
+        from_string = getattr(type(old), "from_string", None)
+        if callable(from_string):
+            return from_string(value)
+        raise ScriptRuntimeError(
+            f"cannot assign a string to entry [{key}], which holds a {_type_label(old)}")
+    if isinstance(old, str) and value is not None:
+        raise ScriptRuntimeError(
+            f"cannot assign a {_type_label(value)} to entry [{key}], which holds a string")
+    if type(old) is int and isinstance(value, float):
+        if not value.is_integer():
+            raise ScriptRuntimeError(
+                f"cannot assign {value} to entry [{key}], which holds an int")
+        return int(value)
+    return value
 
 
 @dataclass
@@ -338,7 +397,10 @@ def to_text(v: Any) -> str:
     return str(v)
 
 
-def _arith(op: str, a: int | float, b: int | float) -> int | float:
+def _arith(op: str, a: int | float, b: int | float) -> float:
+    """BT.CPP computes in double: ``1 + 2`` is 3.0 (stored as 3 into an int entry)."""
+    a = float(a)
+    b = float(b)
     if op == "+":
         return a + b
     if op == "-":
