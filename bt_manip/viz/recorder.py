@@ -24,7 +24,7 @@ import numpy as np
 from bt_manip.viz.live import held_objects
 from bt_manip.viz.overlay import FrameItem, item_json
 from bt_manip.viz.scene import Scene, build_scene
-from bt_manip.viz.tree_state import TreeWatcher
+from bt_manip.viz.tree_state import TreeWatcher, run_result
 
 
 @dataclass
@@ -147,9 +147,9 @@ class Recorder:
             self._sample(t)
         self._track_overlay(t)
         self._track_highlights(t)
-        root = self.watcher.statuses[0] if self.watcher.statuses else 0
-        if root in (2, 3):
-            self.rec.result = "SUCCESS" if root == 2 else "FAILURE"
+        result = run_result(self.watcher)
+        if result:
+            self.rec.result = result
 
     # -- output -----------------------------------------------------------------------------
     def close(self) -> None:
