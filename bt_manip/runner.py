@@ -217,7 +217,11 @@ class Runner:
         except TreeRuntimeError as exc:
             status, reason = "ERROR", str(exc)
         if status in ("BUDGET", "INTERRUPTED", "ERROR"):
-            self.tree.halt()
+            try:
+                self.tree.halt()
+            except TreeRuntimeError as exc:  # an _onHalted script failed
+                if status != "ERROR":
+                    status, reason = "ERROR", str(exc)
             self._make_safe()
         wall = time.perf_counter() - wall0
         return RunReport(

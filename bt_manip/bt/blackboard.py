@@ -17,6 +17,7 @@ counter (:meth:`Blackboard.sequence_id`), which WasEntryUpdated and its decorato
 from __future__ import annotations
 
 import math
+import re
 import typing
 from collections.abc import Iterator
 from typing import Any
@@ -131,10 +132,14 @@ class Blackboard:
         return bb._sequence.get(name, 0)
 
     def unset(self, key: str) -> None:
-        bb, name = self._owner(key)
-        bb._data.pop(name, None)
-        bb._types.pop(name, None)
-        bb._sequence.pop(name, None)
+        """Remove an entry of this blackboard itself.
+
+        As in BT.CPP, the key is not followed through remapping: in a SubTree, unsetting an
+        entry shared with the parent does nothing.
+        """
+        self._data.pop(key, None)
+        self._types.pop(key, None)
+        self._sequence.pop(key, None)
 
     def keys(self) -> Iterator[str]:
         """Keys stored in this blackboard itself (not those reached through the parent)."""
@@ -148,8 +153,35 @@ class Blackboard:
         return f"Blackboard({self._data!r})"
 
 
+_INT_PREFIX = re.compile(r"-?\d+")
+_REAL_PREFIX = re.compile(
+    r"\s*[+-]?(?:(0[xX][0-9a-fA-F]*\.?[0-9a-fA-F]*(?:[pP][+-]?\d+)?)"
+    r"|((?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(inf(?:inity)?|nan))", re.IGNORECASE)
+
+
+def number_from_text(text: str, data_type: type) -> int | float:
+    """BT.CPP's text to int (``std::from_chars``) or double (``std::stod``): the number at the
+    start of the text, the rest ignored (``"2.5"`` is 2 for an int); ValueError if none."""
+    if data_type is int:
+        match = _INT_PREFIX.match(text)
+        if match is None:
+            raise ValueError(f"expected an integer, got '{text}'")
+        return int(match.group(0))
+    match = _REAL_PREFIX.match(text)
+    if match is None:
+        raise ValueError(f"expected a number, got '{text}'")
+    number = match.group(0).strip()
+    if match.group(1):
+        sign = -1.0 if number.startswith("-") else 1.0
+        digits = number.lstrip("+-")
+        return sign * float.fromhex(digits if len(digits) > 2 else "0x0")
+    return float(number)
+
+
 def _from_text(name: str, text: str, data_type: Any) -> Any:
     try:
+        if data_type is int or data_type is float:
+            return number_from_text(text, data_type)
         return convert_literal(text, data_type)
     except ValueError as e:
         raise EntryTypeError(

@@ -239,13 +239,14 @@ class Timeout(_Decorator):
 class Delay(_Decorator):
     """Waits ``delay_msec`` milliseconds (returning RUNNING), then ticks the child.
 
-    The wait starts at the first tick; once it is over, the child's status is returned and the
-    next start waits again.
+    The wait starts at the first tick, which always returns RUNNING (even with 0 ms: BT.CPP
+    starts a timer there and looks at it again at the next tick). Once the time has passed,
+    the child is ticked and its status returned; the next start waits again.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "delay_msec": PortInformation(
-            int, description="milliseconds to wait before ticking the child"),
+            int, description="Tick the child after a few milliseconds"),
     }
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -260,6 +261,7 @@ class Delay(_Decorator):
             self._started = True
             self._start()
             self._start_time = self.now()
+            return RUNNING
         if self.now() - self._start_time >= delay / 1000.0 - TIME_EPS:
             status = self.child.execute_tick()
             if status.completed:

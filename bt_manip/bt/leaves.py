@@ -121,15 +121,17 @@ class SetBlackboard(SyncActionNode):
 
 @registry.register(builtin=True)
 class UnsetBlackboard(SyncActionNode):
-    """Removes the entry ``key`` from the blackboard (if present); returns SUCCESS."""
+    """Removes the entry ``key`` of this tree's blackboard (if present); returns SUCCESS.
+
+    As in BT.CPP, ``key="{other}"`` removes the entry named by the value of ``other``, and an
+    entry a SubTree shares with its parent is not removed from the parent.
+    """
 
     INPUT_PORTS: ClassVar[Ports] = {
         "key": PortInformation(str, description="name of the entry to remove")}
 
     def update(self) -> Status:
-        binding = self.bindings["key"]
-        key = binding.key if isinstance(binding, Ref) else str(self.get_input("key"))
-        self.blackboard.unset(key)
+        self.blackboard.unset(str(self.get_input("key")))
         return Status.SUCCESS
 
 

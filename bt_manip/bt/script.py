@@ -181,7 +181,9 @@ class Unary(Expr):
     def eval(self, env: Variables) -> Any:
         v = self.operand.eval(env)
         if self.op == "!":
-            return not to_bool(v)
+            if isinstance(v, str):
+                raise ScriptRuntimeError("operator [!] cannot be used with a string")
+            return not to_number(v, "!")
         num = to_number(v, self.op)
         if self.op == "-":
             return -float(num)
@@ -224,7 +226,7 @@ class IfElse(Expr):
 
     def eval(self, env: Variables) -> Any:
         c = self.cond.eval(env)
-        ok = len(c) > 0 if isinstance(c, str) else bool(to_number(c, "?"))
+        ok = bool(to_number(c, "?"))
         return self.then.eval(env) if ok else self.other.eval(env)
 
 
@@ -372,18 +374,25 @@ def to_number(v: Any, op: str) -> int | float:
 
 
 def to_bool(v: Any) -> bool:
-    """BT.CPP's cast to bool: numbers are true when non-zero; 'true'/'false'/'1'/'0' strings."""
+    """BT.CPP's cast to bool (a condition's value): a bool, the integers 0 and 1, or a
+    non-negative real (true when non-zero). Other integers, negative numbers and strings (even
+    'true') are errors, as in BT.CPP."""
     if isinstance(v, bool):
         return v
-    if _is_number(v):
+    if isinstance(v, int):
+        if v < 0:
+            raise ScriptRuntimeError(f"{v} is negative and cannot be converted to a boolean")
+        if v > 1:
+            raise ScriptRuntimeError(
+                f"{v} cannot be converted to a boolean (only 0 and 1 can; compare it instead)")
+        return v == 1
+    if isinstance(v, float):
+        if v < 0:
+            raise ScriptRuntimeError(f"{v} is negative and cannot be converted to a boolean")
         return v != 0
     if isinstance(v, str):
-        low = v.strip().lower()
-        if low in ("true", "1"):
-            return True
-        if low in ("false", "0"):
-            return False
-        raise ScriptRuntimeError(f"cannot convert '{v}' to a boolean")
+        raise ScriptRuntimeError(
+            f"the string '{v}' cannot be converted to a boolean (compare it instead)")
     if v is None:
         raise ScriptRuntimeError("the script has no value to use as a condition")
     raise ScriptRuntimeError(f"cannot convert {type(v).__name__} to a boolean")
@@ -416,7 +425,13 @@ def _arith(op: str, a: int | float, b: int | float) -> float:
 
 def binary(op: str, lhs: Any, rhs: Any) -> Any:
     if op in ("&&", "||"):
-        a, b = to_bool(lhs), to_bool(rhs)
+        if isinstance(lhs, str) or isinstance(rhs, str):
+            raise ScriptRuntimeError(f"operation [{op}] is not permitted with strings")
+        try:
+            a, b = to_bool(lhs), to_bool(rhs)
+        except ScriptRuntimeError as e:
+            raise ScriptRuntimeError(f"operator [{op}] needs operands that are booleans: {e}"
+                                     ) from None
         return (a and b) if op == "&&" else (a or b)
     if op == "..":
         return to_text(lhs) + to_text(rhs)

@@ -109,10 +109,18 @@ class Tree:
         return status
 
     def halt(self) -> None:
-        """Halt every RUNNING node and make the whole tree IDLE."""
-        if self.root.bt_status is NodeStatus.RUNNING:
-            self.root.halt_node()
-        self.root.reset_status()
+        """Halt the whole tree and make it IDLE (BT.CPP's ``Tree::haltTree()``).
+
+        The root is halted (each RUNNING node's ``terminate(INVALID)`` runs once, then its
+        ``_onHalted``), then, as BT.CPP does to be sure, every node is halted again, parents
+        before children: a node's ``_onHalted`` script runs even if it was IDLE (twice for the
+        root and for the nodes that were RUNNING), while ``terminate`` never runs twice.
+        """
+        root = self.root
+        root.halt_node()
+        for node in self.nodes():
+            node.halt_node()
+        root.reset_status()
         self.bt_status = NodeStatus.IDLE
 
     def walk(self) -> Iterator[tuple[str, int, BtNode]]:
