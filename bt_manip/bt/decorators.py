@@ -10,6 +10,7 @@ from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.context import TIME_EPS
 from bt_manip.bt.node import BtNode, DecoratorNode
 from bt_manip.bt.ports import Ref
 from bt_manip.bt.registry import registry
@@ -21,7 +22,6 @@ RUNNING = NodeStatus.RUNNING
 SUCCESS = NodeStatus.SUCCESS
 FAILURE = NodeStatus.FAILURE
 SKIPPED = NodeStatus.SKIPPED
-TIME_EPS = 1e-9  # seconds: tolerance when comparing clock readings
 
 
 class _Decorator(DecoratorNode):
@@ -198,40 +198,53 @@ class Timeout(_Decorator):
     """Halts the child and returns FAILURE when it has been RUNNING for ``msec`` milliseconds.
 
     The time starts at the first tick; a child that finishes earlier returns its status. With
-    ``msec`` 0 there is no time limit.
+    ``msec`` 0 there is no time limit. As BT.CPP's timer thread does, the timer halts the child
+    (and emits the wake-up signal) when it fires, at the start of the tick after the time ran
+    out; that tick the node returns FAILURE.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "msec": PortInformation(
-            int, description="after this many milliseconds, halt the child if still running"),
+            int, description="After a certain amount of time, halt() the child if it is still "
+                             "running."),
     }
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
         super().__init__(name, child, **attributes)
-        self._deadline: float | None = None
         self._started = False
+        self._child_halted = False
+        self._timer: int | None = None
+        self._msec = 0
+
+    def _on_timeout(self) -> None:
+        if self.child.bt_status is RUNNING:
+            self._child_halted = True
+            self.reset_child()
+            self.feedback_message = f"timed out after {self._msec} ms"
 
     def tick_node(self) -> NodeStatus:
         msec = self.get_input("msec")
         if not self._started:
             self._started = True
             self._start()
-            self._deadline = self.now() + msec / 1000.0 if msec > 0 else None
-        if (self._deadline is not None and self.now() >= self._deadline - TIME_EPS
-                and self.child.bt_status is RUNNING):
-            self.reset_child()
+            self._child_halted = False
+            self._msec = msec
+            if msec > 0:
+                self._timer = self.context.start_timer(msec / 1000.0, self._on_timeout)
+        if self._child_halted:
             self._started = False
-            self.feedback_message = f"timed out after {msec} ms"
             return FAILURE
         status = self.child.execute_tick()
         if status.completed:
             self._started = False
+            self.context.cancel_timer(self._timer)
             self.reset_child()
         return status
 
     def halt(self) -> None:
         self._started = False
+        self.context.cancel_timer(self._timer)
         super().halt()
 
 
@@ -254,6 +267,7 @@ class Delay(_Decorator):
         super().__init__(name, child, **attributes)
         self._started = False
         self._start_time = 0.0
+        self._timer: int | None = None
 
     def tick_node(self) -> NodeStatus:
         delay = self.get_input("delay_msec")
@@ -261,6 +275,7 @@ class Delay(_Decorator):
             self._started = True
             self._start()
             self._start_time = self.now()
+            self._timer = self.context.start_timer(delay / 1000.0)
             return RUNNING
         if self.now() - self._start_time >= delay / 1000.0 - TIME_EPS:
             status = self.child.execute_tick()
@@ -272,6 +287,7 @@ class Delay(_Decorator):
 
     def halt(self) -> None:
         self._started = False
+        self.context.cancel_timer(self._timer)
         super().halt()
 
 

@@ -139,23 +139,31 @@ class UnsetBlackboard(SyncActionNode):
 class Sleep(ActionNode):
     """Returns RUNNING until ``msec`` milliseconds of the tree's clock have passed, then SUCCESS.
 
-    The first tick always returns RUNNING (SUCCESS at once when ``msec`` <= 0). Halting it
-    stops the wait; the next start waits the full time again.
+    The first tick always returns RUNNING (SUCCESS at once when ``msec`` <= 0). Its timer
+    emits the wake-up signal when the time is up (at the start of the next tick, see
+    ``TreeContext.start_timer``). Halting it cancels the wait; the next start waits the full
+    time again.
     """
 
-    INPUT_PORTS: ClassVar[Ports] = {
-        "msec": PortInformation(int, description="milliseconds to wait")}
+    INPUT_PORTS: ClassVar[Ports] = {"msec": PortInformation(int, description="")}
 
     def initialise(self) -> None:
         self._start_time = self.now()
         self._first = True
+        self._timer: int | None = None
 
     def update(self) -> Status:
         msec = self.get_input("msec")
         if self._first:
             self._first = False
-            return Status.SUCCESS if msec <= 0 else Status.RUNNING
+            if msec <= 0:
+                return Status.SUCCESS
+            self._timer = self.context.start_timer(msec / 1000.0)
+            return Status.RUNNING
         elapsed = self.now() - self._start_time
         if elapsed >= msec / 1000.0 - TIME_EPS:
             return Status.SUCCESS
         return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        self.context.cancel_timer(getattr(self, "_timer", None))

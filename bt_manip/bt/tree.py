@@ -81,6 +81,8 @@ class Tree:
         self.tick_count += 1
         root = self.root
         context = self.context
+        if context.timers:
+            context.fire_timers()
         status = root.execute_tick()
         while status is NodeStatus.RUNNING and context.wake_up:
             context.wake_up = False
@@ -90,6 +92,8 @@ class Tree:
     def tick_exactly_once(self) -> NodeStatus:
         """Tick the root once, even if a wake-up is pending (``tickExactlyOnce``)."""
         self.tick_count += 1
+        if self.context.timers:
+            self.context.fire_timers()
         return self._finish(self.root.execute_tick())
 
     def _finish(self, status: NodeStatus) -> NodeStatus:
