@@ -9,8 +9,9 @@ tick:
 - child FAILURE: FAILURE (the items left stay in the queue);
 - queue empty, when no child is running: the status ``if_empty`` (SUCCESS by default).
 
-A queue given as text is copied each time the node starts; a queue on the blackboard is
-consumed in place, as BT.CPP pops its shared deque.
+A queue given as text is copied each time the node starts; a queue on the blackboard (a list)
+is consumed in place, as BT.CPP pops its shared deque. An entry holding text is an error, as in
+BT.CPP 4.8.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from typing import Any, ClassVar
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.node import BtNode, DecoratorNode, PortError
-from bt_manip.bt.ports import InOutPortInformation, Literal, convert_literal
+from bt_manip.bt.ports import InOutPortInformation, Literal
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 
@@ -46,14 +47,11 @@ class _Loop(DecoratorNode):
         value = self.blackboard.get_or(binding.key)
         if value is None:
             return None
-        if isinstance(value, str):
-            if self._queue is None:
-                self._queue = convert_literal(value, list[self.ITEM])  # type: ignore[name-defined]
-            return self._queue
-        if not isinstance(value, list):
+        if not isinstance(value, list):  # BT.CPP 4.8 does not convert text entries either
             raise PortError(
                 f"{self.describe()}: queue entry '{binding.key}' holds a "
-                f"{type(value).__name__}, not a list")
+                f"{type(value).__name__}, not a list; write the items in the queue port "
+                "(queue=\"1;2;3\") or store a list")
         return value
 
     def tick_node(self) -> NodeStatus:

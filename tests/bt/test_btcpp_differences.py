@@ -61,3 +61,12 @@ def test_skip_unless_updated_halts_its_running_child() -> None:
     assert ours.blackboard.get("h") == 1  # BT.CPP leaves the Sleep RUNNING and never halts it
     sleep = ours.nodes()[-1]
     assert sleep.bt_status is NodeStatus.IDLE
+
+
+def test_set_blackboard_into_a_text_entry_stores_the_text() -> None:
+    body = ('<Sequence><SetBlackboard value="b" output_key="s"/>'
+            '<Script code="r := s .. &quot;x&quot;"/></Sequence>')
+    assert run_btcpp(body, 1, {"s": "a"})[0] == ["ERROR"]  # "not initialized"
+    ours = run_ours(body, 1, {"s": "a"})
+    assert ours.statuses == ["SUCCESS"]
+    assert ours.tree.blackboard.get("r") == "bx"
