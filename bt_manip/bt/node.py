@@ -261,7 +261,10 @@ class BtNode(PortsMixin):
         binding = self.bindings.get(port_name)
         if not isinstance(binding, Ref):
             return False
-        self.blackboard.set(binding.key, value)
+        try:
+            self.blackboard.set(binding.key, value)
+        except ValueError as e:  # text that the entry's type cannot hold
+            raise PortError(f"{self.describe()}: output port '{port_name}': {e}") from None
         return True
 
     def _set_output(self, port_name: str, value: Any) -> None:

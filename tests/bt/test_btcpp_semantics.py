@@ -171,3 +171,30 @@ def test_root_that_is_skipped_ends_the_run_with_status_skipped() -> None:
     report = Runner(tree, options=RunOptions(max_ticks=50)).run()
     assert (report.status, report.ticks, report.exit_code) == ("SKIPPED", 1, 1)
     assert tree.bt_status is NodeStatus.SKIPPED
+
+
+def test_a_timer_that_fired_between_ticks_wakes_the_tree_up() -> None:
+    # BT.CPP's Sleep timer emits the wake-up signal when it fires; on the sim clock it fires
+    # at the start of the tick at which its time is up, so that tick re-ticks the root once
+    # the second Sleep has started.
+    body = ('<ReactiveSequence><Script code="c += 1"/><Sequence><Sleep msec="100"/>'
+            '<Sleep msec="100"/></Sequence></ReactiveSequence>')
+    tree = run_ours(body, 0, {"c": 0}).tree
+    clock = tree.context.clock
+    assert tree.tick() is NodeStatus.RUNNING and tree.blackboard.get("c") == 1
+    clock.advance(0.05)
+    assert tree.tick() is NodeStatus.RUNNING and tree.blackboard.get("c") == 2
+    clock.advance(0.05)
+    assert tree.tick() is NodeStatus.RUNNING and tree.blackboard.get("c") == 4
+    clock.advance(0.1)
+    assert tree.tick() is NodeStatus.SUCCESS and tree.blackboard.get("c") == 5
+
+
+def test_timeout_halts_its_child_when_its_timer_fires() -> None:
+    body = '<Timeout msec="100"><Sleep msec="1000" _onHalted="h := 1"/></Timeout>'
+    tree = run_ours(body, 0).tree
+    assert tree.tick() is NodeStatus.RUNNING
+    tree.context.clock.advance(0.1)
+    assert tree.tick() is NodeStatus.FAILURE
+    assert tree.blackboard.get("h") == 1
+    assert not tree.context.timers
