@@ -20,7 +20,7 @@ from differential.campaign import Differential, run_campaign
 from differential.compare import first_divergence
 from differential.generator import BUILTINS, POST_ATTRIBUTES, PRE_ATTRIBUTES, generate
 from differential.oracle import Oracle, oracle_available
-from differential.rules import DOC, RULES, doc_headings, enabled_builtins
+from differential.rules import DOC, NOT_GENERATED, RULES, doc_sections, enabled_builtins
 from differential.spec import HALT, TICK, Case, Node
 
 from bt_manip.bt.decorators import ForceSuccess
@@ -30,7 +30,7 @@ pytestmark = pytest.mark.skipif(not oracle_available(),
 
 TREES = int(os.environ.get("BTM_DIFF_TREES", "1000"))
 FIRST_SEED = int(os.environ.get("BTM_DIFF_SEED", "0"))
-SHOWN = 5  # shrunk mismatches shown in a failure message
+SHRUNK = 12  # mismatches shrunk for a failure message (one example per cause is shown)
 
 
 @pytest.fixture(scope="module")
@@ -40,15 +40,17 @@ def oracle():
 
 
 def test_random_trees_agree_with_btcpp(oracle: Oracle) -> None:
-    report = run_campaign(FIRST_SEED, TREES, shrink_limit=SHOWN, oracle=oracle)
+    report = run_campaign(FIRST_SEED, TREES, shrink_limit=SHRUNK, oracle=oracle)
     figures = report.figures()
     print("differential figures:", figures)
     assert report.total == TREES
     if report.mismatches:
-        blocks = [f"--- cause: {m.cause}\n{m.report()}" for m in report.mismatches]
+        blocks = [f"--- cause: {cause} ({len(group)} of the {len(report.mismatches)} shrunk)\n"
+                  + min(group, key=lambda m: m.shrunk.size()).report()
+                  for cause, group in report.by_cause().items()]
         pytest.fail(f"{figures['mismatch']} of {TREES} trees disagree with BehaviorTree.CPP "
-                    f"(first {len(blocks)} shrunk; figures {figures}):\n\n" + "\n\n".join(blocks),
-                    pytrace=False)
+                    f"(figures {figures}); one shrunk example per cause:\n\n"
+                    + "\n\n".join(blocks), pytrace=False)
 
 
 class _BrokenInverter(ForceSuccess):
@@ -84,17 +86,23 @@ def test_shrinker_reduces_a_seeded_artificial_mismatch_to_the_minimal_tree(
 
 
 def test_oracle_worker_survives_an_abort_and_goes_on(oracle: Oracle) -> None:
-    # _onHalted throws (arithmetic on a string) while the leaf runs: BT.CPP's destructor
-    # halts the tree again, the exception escapes it and the process aborts.
-    aborting = Case(Node("Sequence", {}, [Node("TestLeaf", {"name": "T1_R",
+    # _onHalted throws (arithmetic on a string) while the leaf runs: halting fails, and the
+    # worker must keep that tree alive rather than let its destructor abort the process.
+    throwing = Case(Node("Sequence", {}, [Node("TestLeaf", {"name": "T1_R",
                                                             "_onHalted": "s0 += 1"})]),
-                    init=[("s0", "str", "a")], schedule=[TICK, TICK])
-    result = oracle.run(aborting)
-    assert [s["status"] for s in result["steps"]] == ["RUNNING", "RUNNING"]
-    assert result["steps"][1]["events"] == ["T1_R:run"]
+                    init=[("s0", "str", "a")], schedule=[TICK, TICK, HALT])
+    result = oracle.run(throwing)
+    assert [s["status"] for s in result["steps"]] == ["RUNNING", "RUNNING", None]
+    assert result["steps"][2]["error"] is not None
+    assert result["steps"][2]["events"] == ["T1_R:halt"]
     after = Case(Node("Sequence", {}, [Node("Script", {"code": "c0 += 1"})]),
                  init=[("c0", "int", 4)], schedule=[TICK])
+    restarts = oracle.restarts
     assert oracle.run(after)["steps"][0]["bb"] == {"c0": ["n", 5.0]}
+    assert oracle.restarts == restarts
+    oracle.abort_worker()
+    assert oracle.run(after)["steps"][0]["bb"] == {"c0": ["n", 5.0]}
+    assert oracle.restarts == restarts + 1
 
 
 def test_blackboard_normalisation_keeps_strings_apart_from_numbers(oracle: Oracle) -> None:
@@ -148,11 +156,13 @@ def test_generator_is_seeded_and_covers_every_builtin_and_attribute() -> None:
     assert autoremap > 20 and remapped > 20 and halted > 300
 
 
-def test_every_exclusion_rule_cites_a_heading_of_the_differences_doc() -> None:
-    headings = doc_headings()
-    for rule in RULES:
-        assert rule.heading in headings, (
+def test_every_exclusion_rule_cites_an_entry_of_the_differences_doc() -> None:
+    sections = doc_sections()
+    for rule in [*RULES, *NOT_GENERATED]:
+        assert rule.heading in sections, (
             f"rule {rule.name} cites '{rule.heading}', which {DOC.name} does not have")
+        assert rule.row in sections[rule.heading], (
+            f"rule {rule.name}: '{rule.row}' is not under '{rule.heading}' in {DOC.name}")
 
 
 def test_test_leaf_follows_its_pattern_on_bt_manip() -> None:

@@ -11,7 +11,6 @@ from typing import Any
 
 from py_trees.common import Status
 
-import bt_manip.bt as btm
 from bt_manip.bt import ActionNode, NodeStatus, TreeContext, load_tree_string
 from bt_manip.bt.registry import NodeRegistry, registry
 from bt_manip.clock import ManualClock
@@ -34,45 +33,29 @@ def _state(node: Any) -> LeafState:
     return state
 
 
-_Stateful = getattr(btm, "StatefulActionNode", None)
+class TestLeaf(ActionNode):
+    """The test leaf (see :mod:`differential.leaf`) on bt-manip's action protocol.
 
-if _Stateful is not None:
+    bt-manip actions are BT.CPP stateful actions: ``initialise`` runs when the leaf starts from
+    IDLE (it calls onStart in ``update``), later ``update`` calls are onRunning, and
+    ``terminate(INVALID)`` is a halt while RUNNING (onHalted).
+    """
 
-    class TestLeaf(_Stateful):  # type: ignore[misc, valid-type]
-        """The test leaf on bt-manip's stateful-action protocol (see :mod:`differential.leaf`)."""
+    NODE_ID = LEAF_ID
 
-        NODE_ID = LEAF_ID
+    def initialise(self) -> None:
+        self._fresh = True
 
-        def on_start(self) -> Any:
-            return NodeStatus[_state(self).on_start(_trace(self))]
+    def update(self) -> Status:
+        state = _state(self)
+        if self._fresh:
+            self._fresh = False
+            return _STATUS[state.on_start(_trace(self))]
+        return _STATUS[state.on_running(_trace(self))]
 
-        def on_running(self) -> Any:
-            return NodeStatus[_state(self).on_running(_trace(self))]
-
-        def on_halted(self) -> None:
+    def terminate(self, new_status: Status) -> None:
+        if new_status == Status.INVALID:
             _state(self).on_halted(_trace(self))
-
-else:
-
-    class TestLeaf(ActionNode):  # type: ignore[no-redef]
-        """The test leaf on py_trees' protocol: ``initialise`` marks a start, ``update`` calls
-        onStart or onRunning, ``terminate(INVALID)`` is a halt."""
-
-        NODE_ID = LEAF_ID
-
-        def initialise(self) -> None:
-            self._fresh = True
-
-        def update(self) -> Status:
-            state = _state(self)
-            if self._fresh:
-                self._fresh = False
-                return _STATUS[state.on_start(_trace(self))]
-            return _STATUS[state.on_running(_trace(self))]
-
-        def terminate(self, new_status: Status) -> None:
-            if new_status == Status.INVALID:
-                _state(self).on_halted(_trace(self))
 
 
 def make_registry(overrides: dict[str, type] | None = None) -> NodeRegistry:

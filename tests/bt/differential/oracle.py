@@ -45,7 +45,7 @@ class Oracle:
 
     def _start(self) -> subprocess.Popen[bytes]:
         if self.proc is None or self.proc.poll() is not None:
-            if self.proc is not None:
+            if self.proc is not None:  # it died since the last case
                 self.restarts += 1
             self.proc = subprocess.Popen(
                 [sys.executable, str(WORKER)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -70,6 +70,15 @@ class Oracle:
             self.proc.kill()
             self.proc.wait()
             self.proc = None
+            self.restarts += 1
+
+    def abort_worker(self) -> None:
+        """Make the worker abort (as a tree's destructor can); for testing the restart."""
+        proc = self._start()
+        assert proc.stdin is not None
+        proc.stdin.write(b'{"abort": true}\n')
+        proc.stdin.flush()
+        proc.wait()
 
     def _read_line(self) -> bytes | None:
         """One line from the worker, or None when it died or did not answer in time."""
@@ -87,18 +96,25 @@ class Oracle:
         line, _, self._buffer = self._buffer.partition(b"\n")
         return line
 
-    def run(self, case: Case) -> dict[str, Any]:
-        """The oracle's result for ``case`` (see ``oracle_worker.run_case``)."""
+    def run(self, case: Case, settle_ms: int = 0) -> dict[str, Any]:
+        """The oracle's result for ``case`` (see ``oracle_worker.run_case``).
+
+        With ``settle_ms``, each ``tickOnce`` gives timers that long to signal a wake-up
+        (``oracle_worker.tick_once_settled``).
+        """
+        request = case.to_json()
+        request["settle_ms"] = settle_ms
+        line = (json.dumps(request) + "\n").encode()
         proc = self._start()
         assert proc.stdin is not None
         try:
-            proc.stdin.write((json.dumps(case.to_json()) + "\n").encode())
+            proc.stdin.write(line)
             proc.stdin.flush()
         except BrokenPipeError:
             self._kill()
             proc = self._start()
             assert proc.stdin is not None
-            proc.stdin.write((json.dumps(case.to_json()) + "\n").encode())
+            proc.stdin.write(line)
             proc.stdin.flush()
         line = self._read_line()
         if line is None:

@@ -10,7 +10,6 @@ lines; the parent then knows the result is complete and starts a new worker.
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
 import sys
@@ -83,6 +82,20 @@ def set_entry(bb: Any, key: str, kind: str, value: Any) -> None:
      "float": bb.set_double}[kind](key, value)
 
 
+def tick_once_settled(tree: Any, settle_ms: int) -> Any:
+    """``tickOnce()`` in which a timer started during the tick gets ``settle_ms`` to fire.
+
+    BT.CPP's ``tickOnce()`` re-ticks the root while it is RUNNING and a wake-up is pending,
+    checking the signal without waiting. A 0 ms Delay's timer thread usually, but not always,
+    signals before that check. Here the check waits up to ``settle_ms`` for the signal, which
+    gives the outcome of the timer winning the race; the rest is ``Tree::tickRoot`` as is.
+    """
+    status = tree.tick_exactly_once()
+    while status == bt.NodeStatus.RUNNING and tree.sleep(settle_ms):
+        status = tree.tick_exactly_once()
+    return status
+
+
 def run_case(case: dict[str, Any]) -> tuple[dict[str, Any], Any]:
     """Load and run one case; returns the result and the objects to destroy afterwards."""
     leaves = Leaves()
@@ -98,12 +111,14 @@ def run_case(case: dict[str, Any]) -> tuple[dict[str, Any], Any]:
     except Exception as e:
         return {"load_error": _error_text(e), "steps": []}, (factory,)
     root_bb = tree.root_blackboard()
+    settle = int(case.get("settle_ms", 0))
     steps: list[dict[str, Any]] = []
     for action in case["schedule"]:
         step: dict[str, Any] = {"action": action, "status": None, "error": None}
         try:
             if action == "tick":
-                step["status"] = _status_name(tree.tick_once())
+                status = tree.tick_once() if settle <= 0 else tick_once_settled(tree, settle)
+                step["status"] = _status_name(status)
             else:
                 tree.halt_tree()
         except Exception as e:
@@ -122,19 +137,26 @@ def main() -> None:
     devnull = os.open(os.devnull, os.O_WRONLY)
     os.dup2(devnull, 1)
     sys.stdout = sys.stderr
+    kept: list[Any] = []  # trees whose halt throws: their destructor would abort the process
     for line in sys.stdin:
         if not line.strip():
             continue
-        result, keep = run_case(json.loads(line))
+        request = json.loads(line)
+        if request.get("abort"):  # lets the tests check that the parent survives an abort
+            os.abort()
+        result, keep = run_case(request)
         results.write(json.dumps(result) + "\n")
         results.flush()
         if len(keep) == 2:
-            with contextlib.suppress(Exception):  # halt outside the destructor, where a
-                keep[0].halt_tree()  # throwing _onHalted is caught
-        keep = keep[1:]  # the tree goes first, then its factory
-        del keep
+            try:
+                keep[0].halt_tree()
+            except Exception:
+                kept.append(keep)
+        del keep  # the tree goes first, then its factory
         results.write('{"done": true}\n')
         results.flush()
+    results.close()
+    os._exit(0)  # no destructors for the kept trees
 
 
 if __name__ == "__main__":
