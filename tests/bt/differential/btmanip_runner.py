@@ -7,6 +7,10 @@ bt-manip node plus the test leaf. The result has the oracle worker's shape.
 
 from __future__ import annotations
 
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from py_trees.common import Status
@@ -65,6 +69,8 @@ def make_registry(overrides: dict[str, type] | None = None) -> NodeRegistry:
         reg.register(cls, builtin=registry.is_builtin(cls.NODE_ID))
     reg.register(TestLeaf)
     for node_id, cls in (overrides or {}).items():
+        if node_id != cls.NODE_ID:
+            raise ValueError(f"override for {node_id} has NODE_ID {cls.NODE_ID}")
         reg.unregister(node_id)
         reg.register(cls, builtin=True)
     return reg
@@ -94,8 +100,36 @@ def _error_text(e: BaseException) -> str:
     return (f"{type(e).__name__}: " + (str(e).strip().splitlines() or [""])[0])[:300]
 
 
-def run_case(case: Case, reg: NodeRegistry | None = None) -> dict[str, Any]:
-    """Load and run ``case`` on bt-manip; returns the oracle worker's result shape."""
+@contextmanager
+def _deadline(seconds: float) -> Iterator[None]:
+    """Raise TimeoutError in the code inside after ``seconds`` (main thread only)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expire(signum: int, frame: Any) -> None:
+        raise TimeoutError(f"no answer within {seconds} s (a loop that never ends?)")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def run_case(case: Case, reg: NodeRegistry | None = None,
+             timeout: float = 10.0) -> dict[str, Any]:
+    """Load and run ``case`` on bt-manip; returns the oracle worker's result shape.
+
+    A step that takes longer than ``timeout`` seconds is an error (TimeoutError).
+    """
+    with _deadline(timeout):
+        return _run(case, reg)
+
+
+def _run(case: Case, reg: NodeRegistry | None) -> dict[str, Any]:
     trace: list[str] = []
     context = TreeContext(clock=ManualClock(), services={TRACE_SERVICE: trace})
     init = {key: value for key, _, value in case.init}

@@ -16,8 +16,9 @@ Limits that keep a run comparable (not exclusions of behaviour, see also
 :mod:`differential.rules`):
 
 - durations are 0 ms only: BT.CPP's Sleep, Delay and Timeout run on wall-clock timer threads;
-- ``Repeat``/``RetryUntilSuccessful`` get 1 to 3 cycles, never -1, since a child that always
-  finishes at once would loop forever inside one ``tickOnce`` (in both engines);
+- ``Repeat``/``RetryUntilSuccessful`` get 1 to 3 cycles (a literal, or the entry ``k0`` that no
+  node writes), never -1, since a child that always finishes at once would loop forever inside
+  one ``tickOnce`` (in both engines);
 - scripts never chain ``-`` or ``/`` (BT.CPP 4.8.2 groups them from the right) and use no
   operator that BT.CPP's grammar lacks.
 
@@ -117,8 +118,9 @@ class Generator:
                                     f"{n} := {c} > 1 ? 5 : 6"))
         if r < 0.83:
             return self.rng.choice(("t0 := 'q'", "t0 := s0 .. 'y'"))
-        if r < 0.86:  # a script error in BT.CPP: arithmetic on a string entry
-            return self.rng.choice(("s0 += 1", "n0 += 1"))
+        if r < 0.86:  # errors in BT.CPP: arithmetic on text, a type change of an entry
+            return self.rng.choice(("s0 += 1", "n0 += 1", "s0 := 5", "c0 := 'x'",
+                                    "c1 := '4'", "b0 := 2"))
         if depth == 0:
             return f"{self.action(1)}; {self.action(1)}"
         return f"{c} += 1"
@@ -169,7 +171,7 @@ class Generator:
         if tag in ("IfThenElse", "WhileDoElse"):
             return Node(tag, {}, self.children(rng.randint(2, 3), depth, max_depth))
         cases = int(tag[-1])
-        attrs = {"variable": "{s0}"}
+        attrs = {"variable": "{s0}" if rng.random() < 0.95 else rng.choice(("{c0}", "{t0}"))}
         values = ["a", "b", "ax", "1", "c"]
         rng.shuffle(values)
         for i in range(cases):
@@ -182,16 +184,16 @@ class Generator:
         rng = self.rng
         attrs: dict[str, str] = {}
         if tag == "Repeat":
-            attrs["num_cycles"] = str(rng.randint(1, 3))
+            attrs["num_cycles"] = self.count_port()
         elif tag == "RetryUntilSuccessful":
-            attrs["num_attempts"] = str(rng.randint(1, 3))
+            attrs["num_attempts"] = self.count_port()
         elif tag == "Timeout":
             attrs["msec"] = "0"
         elif tag == "Delay":
             attrs["delay_msec"] = "0"
         elif tag == "RunOnce":
             if rng.random() < 0.6:
-                attrs["then_skip"] = rng.choice(("true", "false"))
+                attrs["then_skip"] = rng.choice(("true", "false", "{b0}"))
         elif tag == "Precondition":
             attrs["if"] = self.condition()
             if rng.random() < 0.7:
@@ -210,6 +212,10 @@ class Generator:
         elif tag in ("SkipUnlessUpdated", "WaitValueUpdate"):
             attrs["entry"] = self.entry_ref()
         return Node(tag, attrs, self.children(1, depth, max_depth))
+
+    def count_port(self) -> str:
+        """A cycle count: a literal 1-3, or a reference to ``k0`` (1-3, never written)."""
+        return "{k0}" if self.rng.random() < 0.2 else str(self.rng.randint(1, 3))
 
     def entry_ref(self) -> str:
         key = self.rng.choice(POOL)
@@ -230,6 +236,8 @@ class Generator:
             return Node(tag, {"code": self.condition()})
         if tag == "SetBlackboard":
             key = rng.choice((*POOL, *NEW_NUMBERS, *NEW_TEXTS))
+            if rng.random() < 0.05:  # the entry named by the value of s0
+                key = "{s0}"
             value = rng.choice(("1", "7", "abc", "true", "2.5", "{c0}", "{s0}", "{b1}"))
             return Node(tag, {"value": value, "output_key": key})
         if tag == "UnsetBlackboard":
@@ -293,6 +301,7 @@ class Generator:
         for key in BOOL_VARS:
             init.append((key, "bool", rng.random() < 0.5))
         init.append(("s0", "str", rng.choice(("a", "b", "ax"))))
+        init.append(("k0", "int", rng.randint(1, 3)))
         return init
 
     def schedule(self) -> list[str]:

@@ -90,11 +90,13 @@ def _has(case: Case, *tags: str) -> bool:
 
 
 def _agrees_with(overrides: dict[str, type], case: Case, oracle: dict[str, Any]) -> bool:
-    """Whether bt-manip, with BT.CPP's behaviour for the ``overrides`` node IDs, agrees."""
+    """Whether bt-manip, with BT.CPP's behaviour for the ``overrides`` node IDs, loads the
+    tree and agrees with BT.CPP at every step."""
     from differential.btmanip_runner import make_registry, run_case
     from differential.compare import first_divergence
 
-    return first_divergence(oracle, run_case(case, make_registry(overrides))) is None
+    again = run_case(case, make_registry(overrides))
+    return again["load_error"] is None and first_divergence(oracle, again) is None
 
 
 def _btcpp_precondition() -> type:
@@ -103,6 +105,8 @@ def _btcpp_precondition() -> type:
     class BtcppPrecondition(Precondition):
         """BT.CPP 4.8.2's Precondition: no ``halt()`` of its own, so the flag saying that the
         child runs survives a halt and the next start ticks the child without checking ``if``."""
+
+        NODE_ID = "Precondition"
 
         def halt(self) -> None:
             running = self._child_running
