@@ -57,7 +57,7 @@ class Mismatch:
             f"schedule: {', '.join(self.shrunk.schedule)}",
             f"initial blackboard: {self.shrunk.init_text()}",
             self.shrunk_divergence.describe(),
-            step_table(self.shrunk.schedule, self.oracle, self.btmanip),
+            step_table(self.oracle, self.btmanip),
         ])
 
 

@@ -99,7 +99,7 @@ def first_divergence(oracle: dict[str, Any], btmanip: dict[str, Any]) -> Diverge
     return None
 
 
-def step_table(case_schedule: list[str], oracle: dict[str, Any], btmanip: dict[str, Any]) -> str:
+def step_table(oracle: dict[str, Any], btmanip: dict[str, Any]) -> str:
     """Both runs side by side, one line per step, for failure messages and reports."""
     lines = []
     for name, result in (("BT.CPP", oracle), ("bt-manip", btmanip)):

@@ -52,6 +52,14 @@ DECORATORS = ("Inverter", "ForceSuccess", "ForceFailure", "KeepRunningUntilFailu
 LEAVES = ("AlwaysSuccess", "AlwaysFailure", "Script", "ScriptCondition", "SetBlackboard",
           "UnsetBlackboard", "Sleep", "WasEntryUpdated")
 BUILTINS = (*CONTROLS, *DECORATORS, *LEAVES)
+# Nodes that emit the wake-up signal (tickOnce re-ticks the root at once), and parents that
+# halt a RUNNING child when it is re-ticked. Two emitters under one such parent can halt each
+# other forever within a single tickOnce (in both engines), so the generator never puts two
+# there (one is fine: it makes progress at each re-tick).
+EMITTERS = ("Repeat", "RetryUntilSuccessful", "SequenceWithMemory", "AsyncSequence",
+            "AsyncFallback", "Delay")
+HALTERS = ("ReactiveSequence", "ReactiveFallback", "WhileDoElse", "Switch2", "Switch3",
+           "Switch4", "Switch5", "Switch6")
 STATUS_TEXTS = ("SUCCESS", "FAILURE", "RUNNING", "SKIPPED")
 PRE_ATTRIBUTES = ("_skipIf", "_failureIf", "_successIf", "_while")
 POST_ATTRIBUTES = ("_onSuccess", "_onFailure", "_onHalted", "_post")
@@ -67,6 +75,8 @@ class Generator:
         self.subtrees: dict[str, Node] = {}
         self.leaf_count = 0
         self.in_subtree = False
+        self.halting_depth = 0  # how many HALTERS are above the node being generated
+        self.emitters = 0  # EMITTERS generated under the outermost of them
 
     # ------------------------------------------------------------------ scripts
 
@@ -128,9 +138,14 @@ class Generator:
     # ------------------------------------------------------------------ nodes
 
     def pick(self, choices: tuple[str, ...], weights: tuple[float, ...]) -> str:
-        names = [c for c in choices if c in self.enabled]
-        ws = [w for c, w in zip(choices, weights, strict=True) if c in self.enabled]
-        return self.rng.choices(names, ws)[0]
+        blocked = EMITTERS if self.halting_depth and self.emitters else ()
+        names = [c for c in choices if c in self.enabled and c not in blocked]
+        ws = [w for c, w in zip(choices, weights, strict=True)
+              if c in self.enabled and c not in blocked]
+        tag = self.rng.choices(names, ws)[0]
+        if self.halting_depth and tag in EMITTERS:
+            self.emitters += 1
+        return tag
 
     def node(self, depth: int, max_depth: int) -> Node:
         """A node at ``depth`` (1 is the root) in a tree of at most ``max_depth`` levels."""
@@ -150,6 +165,16 @@ class Generator:
     def control(self, depth: int, max_depth: int) -> Node:
         weights = (6, 5, 6, 6, 5, 3, 3, 4, 3, 5, 5, 2, 1, 1, 1, 1)
         tag = self.pick(CONTROLS, weights)
+        halter = tag in HALTERS
+        self.halting_depth += halter
+        try:
+            return self._control(tag, depth, max_depth)
+        finally:
+            self.halting_depth -= halter
+            if not self.halting_depth:
+                self.emitters = 0
+
+    def _control(self, tag: str, depth: int, max_depth: int) -> Node:
         rng = self.rng
         if tag in SEQUENCES:
             return Node(tag, {}, self.children(rng.randint(1, 4), depth, max_depth))
@@ -264,6 +289,11 @@ class Generator:
             self.in_subtree = False
         else:
             tree_id = rng.choice(sorted(self.subtrees))
+            inside = sum(n.tag in EMITTERS for n in self.subtrees[tree_id].walk())
+            if self.halting_depth and inside + self.emitters > 1:
+                return self.test_leaf()
+            if self.halting_depth:
+                self.emitters += inside
         attrs = {"ID": tree_id}
         if rng.random() < 0.5:
             attrs["_autoremap"] = "true"
