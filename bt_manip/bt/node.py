@@ -405,7 +405,7 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
     A ``STATEFUL`` leaf follows BT.CPP's ``StatefulActionNode``: it starts only from IDLE, so
     when its parent ticks it again after it finished without resetting it (a WhileDoElse
-    condition while a branch runs, the first children of a ReactiveSequence), it returns the
+    condition while a branch runs, an IfThenElse condition after it failed), it returns the
     status it finished with and runs nothing. Other leaves (BT.CPP's ``SyncActionNode`` and
     ``ConditionNode``) run at every tick.
     """

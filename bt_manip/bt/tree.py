@@ -40,7 +40,8 @@ class Tree:
     ``tick_exactly_once()`` ticks the root once whatever is pending. Both return the root's
     :class:`NodeStatus` (also kept in :attr:`bt_status`); a root that finished (SUCCESS or
     FAILURE) is reset to IDLE afterwards, as in BT.CPP, so the next tick starts it again.
-    ``halt()`` stops every RUNNING node; each one's ``terminate(INVALID)`` runs once.
+    ``halt()`` is ``haltTree()``: every RUNNING node's ``terminate(INVALID)`` runs once, and
+    every node's ``_onHalted`` script runs.
     """
 
     def __init__(
@@ -69,7 +70,7 @@ class Tree:
             self._wire(node.child, node.make_blackboard(bb))
             return
         for port, binding in node.bindings.items():
-            if isinstance(binding, Ref) and not binding.key.startswith("@"):
+            if isinstance(binding, Ref):
                 info = node.port_info(port)
                 if info is not None:
                     bb.declare(binding.key, info.data_type)
