@@ -24,7 +24,7 @@ from differential.causes import cause_of
 from differential.compare import Divergence, first_divergence, step_table
 from differential.generator import generate
 from differential.oracle import Oracle
-from differential.rules import RULES, Rule, enabled_builtins
+from differential.rules import Rule, active_rules, enabled_builtins
 from differential.shrink import shrink
 from differential.spec import Case
 
@@ -98,7 +98,7 @@ class Differential:
                  rules: list[Rule] | None = None) -> None:
         self.oracle = oracle
         self.reg = reg or make_registry()
-        self.rules = RULES if rules is None else rules
+        self.rules = active_rules() if rules is None else rules
 
     def compare(self, case: Case) -> tuple[Divergence | None, dict[str, Any], dict[str, Any]]:
         """The first divergence (None: they agree), BT.CPP's result and bt-manip's."""
