@@ -208,6 +208,7 @@ class Timeout(_Decorator):
             int, description="After a certain amount of time, halt() the child if it is still "
                              "running."),
     }
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"msec": "unsigned int"}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
@@ -261,6 +262,7 @@ class Delay(_Decorator):
         "delay_msec": PortInformation(
             int, description="Tick the child after a few milliseconds"),
     }
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"delay_msec": "unsigned int"}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:

@@ -29,6 +29,9 @@ ENTRY_PORT: dict[str, PortInformation] = {
     "entry": PortInformation(object, description="Entry to check")}
 
 
+ENTRY_TYPE = {"entry": "BT::Any"}
+
+
 class _EntryWatch:
     """The last update counter a node saw of its entry."""
 
@@ -51,6 +54,7 @@ class WasEntryUpdated(SyncActionNode):
     """SUCCESS if the entry ``entry`` was written since this node's last tick, else FAILURE."""
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = ENTRY_PORT
+    PORT_TYPE_NAMES = ENTRY_TYPE
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name, **attributes)
@@ -63,6 +67,7 @@ class WasEntryUpdated(SyncActionNode):
 class _EntryUpdatedDecorator(DecoratorNode):
     IF_NOT_UPDATED = NodeStatus.SKIPPED
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = ENTRY_PORT
+    PORT_TYPE_NAMES = ENTRY_TYPE
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:

@@ -55,7 +55,8 @@ class ScriptCondition(ConditionNode):
     """Evaluates the script ``code``: SUCCESS if its value is true, FAILURE otherwise."""
 
     INPUT_PORTS: ClassVar[Ports] = {
-        "code": PortInformation(str, description="script whose value is the result")}
+        "code": PortInformation(
+            object, description="Piece of code that can be parsed. Must return false or true")}
     SCRIPT_PORTS = ("code",)
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
@@ -146,6 +147,7 @@ class Sleep(ActionNode):
     """
 
     INPUT_PORTS: ClassVar[Ports] = {"msec": PortInformation(int, description="")}
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"msec": "unsigned int"}
 
     def initialise(self) -> None:
         self._start_time = self.now()

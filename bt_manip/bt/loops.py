@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.node import BtNode, DecoratorNode, PortError
-from bt_manip.bt.ports import InOutPortInformation, Literal
+from bt_manip.bt.ports import InOutPortInformation, Literal, type_name
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 
@@ -81,6 +81,7 @@ class _Loop(DecoratorNode):
 
 
 def _make_loop(node_id: str, item: type) -> type[_Loop]:
+    cpp = type_name(item)
     ports = {
         "if_empty": PortInformation(
             NodeStatus, required=False, default_value=NodeStatus.SUCCESS,
@@ -93,6 +94,8 @@ def _make_loop(node_id: str, item: type) -> type[_Loop]:
         "ITEM": item,
         "INPUT_PORTS": ports,
         "OUTPUT_PORTS": {"value": PortInformation(item, description="the current item")},
+        "PORT_TYPE_NAMES": {
+            "queue": f"std::shared_ptr<std::deque<{cpp}, std::allocator<{cpp}> > >"},
         "__doc__": __doc__.split("\n\n")[1] if __doc__ else "",
         "__module__": __name__,
     })

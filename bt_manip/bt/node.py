@@ -118,6 +118,7 @@ class BtNode(PortsMixin):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes

@@ -78,8 +78,9 @@ def run_ours(body: str, ticks: int, init: dict[str, Any] | None = None,
     return Ours(tree, statuses)
 
 
-def builtin_models() -> dict[str, dict[str, tuple[str, str | None]]]:
-    """{node ID: {port: (direction, default)}} of BT.CPP's factory, from Groot2's FULLTREE."""
+def builtin_models() -> dict[str, dict[str, tuple[str, str | None, str | None]]]:
+    """{node ID: {port: (direction, default, type)}} of BT.CPP's factory, from Groot2's
+    FULLTREE."""
     b = btcpp()
     zmq = pytest.importorskip("zmq")
     factory = b.BehaviorTreeFactory()
@@ -102,7 +103,7 @@ def builtin_models() -> dict[str, dict[str, tuple[str, str | None]]]:
         context.term()
         del publisher
     root = parse_xml_text(xml, "fulltree.xml")
-    models: dict[str, dict[str, tuple[str, str | None]]] = {}
+    models: dict[str, dict[str, tuple[str, str | None, str | None]]] = {}
     for section in root.children:
         if section.tag != "TreeNodesModel":
             continue
@@ -110,6 +111,7 @@ def builtin_models() -> dict[str, dict[str, tuple[str, str | None]]]:
             ports = {}
             for port in node.children:
                 direction = port.tag.removesuffix("_port")
-                ports[port.get("name") or ""] = (direction, port.get("default"))
+                ports[port.get("name") or ""] = (direction, port.get("default"),
+                                                 port.get("type"))
             models[node.get("ID") or ""] = ports
     return models

@@ -1,5 +1,6 @@
 """bt-manip registers every node BehaviorTree.CPP 4.8.2's factory registers by default, with the
-same port names, directions and defaults."""
+same port names, directions, defaults and type names (so a TreeNodesModel exported by bt-manip
+declares the built-ins as BT.CPP does)."""
 
 from __future__ import annotations
 
@@ -9,16 +10,18 @@ from bt_manip.bt import registry
 from bt_manip.bt.models import spec_of
 
 
-def ours() -> dict[str, dict[str, tuple[str, str | None]]]:
+def ours() -> dict[str, dict[str, tuple[str, str | None, str | None]]]:
     models = {}
     for cls in registry.classes(builtin=True):
         spec = spec_of(cls)
-        models[cls.NODE_ID] = {name: (p.direction, p.default) for name, p in spec.ports.items()}
-    models["SubTree"] = {"_autoremap": ("input", "false")}  # handled by the SubTree element
+        models[cls.NODE_ID] = {name: (p.direction, p.default, p.type_name)
+                               for name, p in spec.ports.items()}
+    # handled by the SubTree element itself
+    models["SubTree"] = {"_autoremap": ("input", "false", "bool")}
     return models
 
 
-def test_builtin_ids_ports_directions_and_defaults_match_btcpp() -> None:
+def test_builtin_ids_ports_directions_defaults_and_types_match_btcpp() -> None:
     theirs = builtin_models()
     mine = ours()
     assert len(theirs) == 41
