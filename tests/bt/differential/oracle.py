@@ -7,6 +7,7 @@ hangs is replaced; the case it was running gets a ``crashed`` or ``hung`` result
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import select
@@ -36,6 +37,7 @@ class Oracle:
         self.proc: subprocess.Popen[bytes] | None = None
         self.restarts = 0
         self._buffer = b""
+        self._timed_out = False
 
     def __enter__(self) -> Oracle:
         return self
@@ -85,9 +87,11 @@ class Oracle:
         proc = self.proc
         assert proc is not None and proc.stdout is not None
         fd = proc.stdout.fileno()
+        self._timed_out = False
         while b"\n" not in self._buffer:
             ready, _, _ = select.select([fd], [], [], self.timeout)
             if not ready:
+                self._timed_out = True
                 return None
             chunk = os.read(fd, 1 << 16)
             if not chunk:
@@ -118,6 +122,8 @@ class Oracle:
             proc.stdin.flush()
         line = self._read_line()
         if line is None:
+            with contextlib.suppress(subprocess.TimeoutExpired):  # no output: dying, or hung
+                proc.wait(timeout=0 if self._timed_out else 5)
             hung = proc.poll() is None
             self._kill()
             return {"load_error": None, "steps": [], "crashed": not hung, "hung": hung}

@@ -219,6 +219,8 @@ PENDING: list[Rule] = [
     Rule("port-type-against-initial-entry", NOT_YET,
          "A port bound to an entry of another type given before the tree is built",
          _refused_by_btcpp("was initially created with type")),
+    Rule("btcpp-aborts", INTERNAL, "BT.CPP aborts the process",
+         lambda c, o, b, d: d.kind == "crash"),
 ]
 
 
