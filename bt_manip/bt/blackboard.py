@@ -25,6 +25,7 @@ from typing import Any
 from bt_manip.bt.ports import convert_literal, type_name
 
 UNTYPED = (object, typing.Any, None)
+SCALARS = frozenset({"int", "unsigned int", "double", "bool", "std::string"})
 
 
 class EntryTypeError(ValueError):
@@ -45,6 +46,7 @@ class Blackboard:
         self.autoremap = autoremap
         self._data: dict[str, Any] = {}
         self._types: dict[str, Any] = {}  # declared by a port, or the type of the first value
+        self._strong: dict[str, str] = {}  # BT.CPP type name of the strongly typed entries
         self._sequence: dict[str, int] = {}  # how many times each entry was written
 
     @classmethod
@@ -100,23 +102,58 @@ class Blackboard:
         bb, name = self._owner(key)
         return bb._types.get(name)
 
-    def declare(self, key: str, data_type: Any) -> None:
+    def declare(self, key: str, data_type: Any, cpp_type: str | None = None) -> None:
         """Create the entry (without a value) for a port bound to it, with the port's type.
 
         An entry that already has a type keeps it; an untyped port creates an untyped entry,
-        which takes the type of the first value written.
+        which takes the type of the first value written. As BT.CPP refuses to build a tree in
+        which two ports give one entry different types, a port whose scalar type (int,
+        unsigned int, double, bool, string) differs from the scalar type of an existing
+        strongly typed entry (other than a string) raises :class:`EntryTypeError`.
         """
         bb, name = self._owner(key)
-        if bb._types.get(name) is None:
-            bb._types[name] = None if data_type in UNTYPED else data_type
+        untyped = data_type in UNTYPED
+        port_type = None if untyped else (cpp_type or type_name(data_type))
+        previous = bb._strong.get(name)
+        if (previous is not None and port_type is not None and previous != port_type
+                and previous in SCALARS and port_type in SCALARS
+                and previous != "std::string"):
+            raise EntryTypeError(
+                f"entry [{name}] was created with type [{previous}] and this port uses type "
+                f"[{port_type}]; BT.CPP refuses such a tree: use one type for the entry")
+        if name in bb._data or name in bb._types:
+            if bb._types.get(name) is None and not untyped:
+                bb._types[name] = data_type
+            return
+        bb._types[name] = None if untyped else data_type
+        if port_type is not None:
+            bb._strong[name] = port_type
+
+    def strong_type(self, key: str) -> str | None:
+        """BT.CPP type name of a strongly typed entry (created by a typed port or a typed
+        write, not by a script); None otherwise."""
+        bb, name = self._owner(key)
+        return bb._strong.get(name)
 
     def set(self, key: str, value: Any) -> None:
-        """Write ``key``; text written into an entry of another type is converted to it."""
+        """Write ``key``; text written into an entry of another type is converted to it.
+
+        A new entry is strongly typed by the value (as BT.CPP's typed ``Blackboard::set``)."""
+        self._write(key, value, True)
+
+    def assign(self, key: str, value: Any) -> None:
+        """Write ``key`` from a script: a new entry is not strongly typed (BT.CPP's scripts
+        create their entries untyped; the value they hold still has a type)."""
+        self._write(key, value, False)
+
+    def _write(self, key: str, value: Any, strong: bool) -> None:
         bb, name = self._owner(key)
         types = bb._types
         declared = types.get(name)
         if declared is None:
             if value is not None:
+                if strong and name not in types and name not in bb._data:
+                    bb._strong[name] = type_name(type(value))
                 types[name] = type(value)
         elif type(value) is str and declared is not str:
             value = _from_text(name, value, declared)
@@ -139,6 +176,7 @@ class Blackboard:
         """
         self._data.pop(key, None)
         self._types.pop(key, None)
+        self._strong.pop(key, None)
         self._sequence.pop(key, None)
 
     def keys(self) -> Iterator[str]:

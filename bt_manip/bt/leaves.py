@@ -10,7 +10,7 @@ from py_trees.ports import PortInformation
 from bt_manip.bt.blackboard import EntryTypeError
 from bt_manip.bt.decorators import TIME_EPS, _ScriptHolder
 from bt_manip.bt.node import ActionNode, ConditionNode, SyncActionNode, TreeRuntimeError, _truth
-from bt_manip.bt.ports import InOutPortInformation, Literal, Ref
+from bt_manip.bt.ports import InOutPortInformation, Literal, Ref, type_name
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import to_text
 
@@ -107,14 +107,22 @@ class SetBlackboard(SyncActionNode):
                 raise TreeRuntimeError(
                     f"{self.describe()}: value refers to entry '{source}', "
                     "which does not exist") from None
-            if not bb.exists(key):
-                bb.declare(key, bb.entry_type(source))
+            if not bb.exists(key):  # created with the source entry's type
+                source_type = bb.strong_type(source)
+                bb.declare(key, bb.entry_type(source) if source_type else object, source_type)
             if not bb.has_value(source):
                 self.feedback_message = f"entry '{source}' has no value to copy"
                 return Status.FAILURE
             value = bb.get(source)
+            held = bb.strong_type(key)
+            given = type_name(type(value))
+            if held is not None and type(value) is not str and given != held:
+                raise TreeRuntimeError(
+                    f"{self.describe()}: entry [{key}] holds a {held}; copying a {given} from "
+                    f"'{source}' would change its type (BT.CPP: once declared, the type of "
+                    "an entry shall not change)")
         try:
-            bb.set(key, value)
+            bb.assign(key, value)
         except EntryTypeError as e:
             raise TreeRuntimeError(f"{self.describe()}: {e}") from None
         return Status.SUCCESS

@@ -282,7 +282,7 @@ class Assign(Expr):
 
 def _store(env: Variables, key: str, value: Any) -> None:
     try:
-        env.set(key, value)
+        getattr(env, "assign", env.set)(key, value)
     except ValueError as e:  # the entry's type cannot hold the value
         raise ScriptRuntimeError(str(e)) from None
 

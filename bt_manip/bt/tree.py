@@ -6,12 +6,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.blackboard import Blackboard, EntryTypeError
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.ports import Ref
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
+from bt_manip.errors import InputError
 
 
 @dataclass
@@ -73,7 +74,12 @@ class Tree:
             if isinstance(binding, Ref):
                 info = node.port_info(port)
                 if info is not None:
-                    bb.declare(binding.key, info.data_type)
+                    try:
+                        bb.declare(binding.key, info.data_type, node.PORT_TYPE_NAMES.get(port))
+                    except EntryTypeError as e:
+                        raise InputError.single(
+                            node.xml_file or self.source or "<tree>", node.xml_line,
+                            f"{node.NODE_ID} port '{port}': {e}") from None
         for child in node.bt_children():
             self._wire(child, bb)
 

@@ -140,6 +140,13 @@ class _Checker:
         if n < lo or (hi is not None and n > hi):
             rule = children_rule(_Rule(lo, hi))  # type: ignore[arg-type]
             self.add(file, element, f"{spec.node_id} {rule}, found {n}")
+        if spec.node_id == "ReactiveSequence":  # BT.CPP's VerifyXML refuses these trees
+            async_children = [c for c in element.children if c.tag == "AsyncSequence"]
+            if len(async_children) > 1:
+                self.add(file, element,
+                         "a ReactiveSequence cannot have more than one AsyncSequence child "
+                         f"(found {len(async_children)}, as BehaviorTree.CPP requires); wrap "
+                         "them in one Sequence")
 
     def check_subtree(self, element: Element, tree: TreeDef, attributes: dict[str, str]) -> None:
         file = tree.file

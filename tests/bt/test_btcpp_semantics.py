@@ -6,9 +6,10 @@ from __future__ import annotations
 from typing import Any
 
 import pytest
-from btcpp_reference import run_btcpp, run_ours
+from btcpp_reference import btcpp, document, run_btcpp, run_ours
 
 from bt_manip.bt import NodeStatus
+from bt_manip.errors import InputError
 from bt_manip.runner import Runner, RunOptions
 
 
@@ -198,3 +199,43 @@ def test_timeout_halts_its_child_when_its_timer_fires() -> None:
     assert tree.tick() is NodeStatus.FAILURE
     assert tree.blackboard.get("h") == 1
     assert not tree.context.timers
+
+
+def test_a_port_of_another_scalar_type_on_a_typed_entry_is_refused_at_load() -> None:
+    body = ('<Switch2 variable="{c}" case_1="1" case_2="2"><AlwaysSuccess/><AlwaysSuccess/>'
+            "<AlwaysSuccess/></Switch2>")
+    b = btcpp()
+    factory = b.BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(document(body))
+    bb = b.Blackboard.create()
+    bb.set_int("c", 1)
+    with pytest.raises(Exception, match="was initially created with type"):
+        factory.create_tree("MainTree", bb)
+    with pytest.raises(InputError) as error:
+        run_ours(body, 1, {"c": 1})
+    assert str(error.value) == (
+        "<string>:1: Switch2 port 'variable': entry [c] was created with type [int] and this "
+        "port uses type [std::string]; BT.CPP refuses such a tree: use one type for the entry")
+    assert run_ours(body, 1, {"c": "1"}).statuses == ["SUCCESS"]  # a text entry is fine
+
+
+def test_set_blackboard_cannot_change_the_type_of_a_typed_entry() -> None:
+    statuses, _, _ = same('<SetBlackboard value="{b}" output_key="c"/>', 1, {"b": True, "c": 1})
+    assert statuses == ["ERROR"]
+    statuses, theirs, ours = same('<SetBlackboard value="{b}" output_key="c"/>', 1,
+                                  {"b": 7, "c": 1})
+    assert statuses == ["SUCCESS"] and theirs["c"] == "7" and ours["c"] == 7
+
+
+def test_reactive_sequence_with_two_async_sequences_is_refused_at_load() -> None:
+    two = "<AsyncSequence><AlwaysSuccess/></AsyncSequence>" * 2
+    body = f"<ReactiveSequence>{two}</ReactiveSequence>"
+    b = btcpp()
+    with pytest.raises(Exception, match="cannot have more than one async child"):
+        b.BehaviorTreeFactory().register_behavior_tree_from_text(document(body))
+    with pytest.raises(InputError) as error:
+        run_ours(body, 1)
+    assert str(error.value) == (
+        "<string>:1: a ReactiveSequence cannot have more than one AsyncSequence child (found 2, "
+        "as BehaviorTree.CPP requires); wrap them in one Sequence")
+    assert run_ours(f"<ReactiveFallback>{two}</ReactiveFallback>", 1).statuses == ["SUCCESS"]
