@@ -20,7 +20,7 @@ from bt_manip.bt.registry import NodeRegistry, registry
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError
 from differential.leaf import LEAF_ID, LeafState
-from differential.spec import HALT, Case
+from differential.spec import HALT, TICK_EXACTLY_ONCE, Case
 
 TRACE_SERVICE = "differential_trace"
 _STATUS = {"SUCCESS": Status.SUCCESS, "FAILURE": Status.FAILURE, "RUNNING": Status.RUNNING}
@@ -143,8 +143,9 @@ def _run(case: Case, reg: NodeRegistry | None) -> dict[str, Any]:
         step: dict[str, Any] = {"action": action, "status": None, "error": None}
         try:
             if action == HALT:
-                halt = getattr(tree, "halt_tree", None) or tree.halt
-                halt()
+                tree.halt()
+            elif action == TICK_EXACTLY_ONCE:
+                step["status"] = tree.tick_exactly_once().value
             else:
                 result = tree.tick()
                 status = result if isinstance(result, NodeStatus) else tree.bt_status

@@ -3,8 +3,8 @@
 ``generate(seed)`` always gives the same case for the same seed. A case is a main tree of
 depth 2 to 5 (its root is a control or a decorator), up to two subtree definitions reached
 through ``<SubTree>`` with explicit port remapping or ``_autoremap``, a starting blackboard and
-a schedule of 3 to 8 ``tickOnce`` calls with, in some cases, a ``haltTree`` between them or at
-the end.
+a schedule of 3 to 8 ``tickOnce`` calls (some of them ``tickExactlyOnce`` in a fifth of the
+cases) with, in some cases, a ``haltTree`` between them or at the end.
 
 Nodes: every built-in that BehaviorTree.CPP 4.8.2's factory registers (controls, decorators,
 Script/ScriptCondition, SetBlackboard/UnsetBlackboard, Sleep, WasEntryUpdated, the Loop*
@@ -32,7 +32,7 @@ import random
 from collections.abc import Callable, Collection
 
 from differential.leaf import LEAF_ID, leaf_name
-from differential.spec import HALT, TICK, Case, Node
+from differential.spec import HALT, TICK, TICK_EXACTLY_ONCE, Case, Node
 
 INT_VARS = ("c0", "c1", "c2")
 BOOL_VARS = ("b0", "b1")
@@ -337,6 +337,8 @@ class Generator:
     def schedule(self) -> list[str]:
         rng = self.rng
         steps = [TICK] * rng.randint(3, 8)
+        if rng.random() < 0.2:  # some ticks without the wake-up re-ticks
+            steps = [TICK_EXACTLY_ONCE if rng.random() < 0.4 else step for step in steps]
         if rng.random() < 0.3:
             steps.insert(rng.randint(1, len(steps) - 1), HALT)
         if rng.random() < 0.5:

@@ -1,11 +1,12 @@
 """Oracle worker: runs cases on the real BehaviorTree.CPP 4.8.2 (``behaviortreepy``).
 
 Started by :mod:`differential.oracle` as ``python oracle_worker.py``. It reads one case per
-line on stdin (JSON: ``xml``, ``init``, ``schedule``) and writes, on the stream that was its
-stdout, one result line per case (JSON, see :func:`run_case`) followed by a ``{"done": true}``
-line once the tree has been destroyed. BT.CPP's own diagnostics, which it prints on stdout,
-are sent to /dev/null. A tree whose destructor throws aborts this process between the two
-lines; the parent then knows the result is complete and starts a new worker.
+line on stdin (JSON: ``xml``, ``init``, ``schedule`` of ``tick``/``tick1``/``halt``) and
+writes, on the stream that was its stdout, one result line per case (JSON, see
+:func:`run_case`) followed by a ``{"done": true}`` line once the tree has been destroyed.
+BT.CPP's own diagnostics, which it prints on stdout, are sent to /dev/null. A tree whose
+halt throws is kept alive (its destructor would abort the process); if the process dies
+anyway, the parent starts a new worker.
 """
 
 from __future__ import annotations
@@ -119,6 +120,8 @@ def run_case(case: dict[str, Any]) -> tuple[dict[str, Any], Any]:
             if action == "tick":
                 status = tree.tick_once() if settle <= 0 else tick_once_settled(tree, settle)
                 step["status"] = _status_name(status)
+            elif action == "tick1":
+                step["status"] = _status_name(tree.tick_exactly_once())
             else:
                 tree.halt_tree()
         except Exception as e:

@@ -11,8 +11,9 @@ from dataclasses import dataclass, field
 from typing import Any
 from xml.sax.saxutils import quoteattr
 
-TICK = "tick"
-HALT = "halt"
+TICK = "tick"  # Tree::tickOnce()
+TICK_EXACTLY_ONCE = "tick1"  # Tree::tickExactlyOnce()
+HALT = "halt"  # Tree::haltTree()
 
 
 @dataclass
@@ -55,7 +56,8 @@ class Case:
 
     ``init`` lists ``(key, type, value)`` with type ``int``, ``bool``, ``str`` or ``float``: BT.CPP
     types an entry when it is created, so both engines start from the same typed entries.
-    ``schedule`` is a list of ``tick`` (one ``tickOnce``) and ``halt`` (``haltTree``).
+    ``schedule`` is a list of ``tick`` (``tickOnce``), ``tick1`` (``tickExactlyOnce``) and
+    ``halt`` (``haltTree``).
     """
 
     main: Node
