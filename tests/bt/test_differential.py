@@ -1,12 +1,14 @@
 """bt-manip against the real BehaviorTree.CPP 4.8.2, tick by tick, on random trees.
 
-The default run compares 1,000 seeded random trees (``BTM_DIFF_TREES=20000`` for more;
-``BTM_DIFF_SEED`` moves the first seed). Each tree is ticked on both engines with the same
-schedule; root status per tick, the test leaf's start/run/halt trace and the root blackboard
-after each step must agree, apart from the named rules of ``differential/rules.py``. A
-mismatch is shrunk and the failure message shows the minimal XML and what each engine did.
-The harness itself is tested here too: the shrinker on a seeded artificial bug, the oracle
-worker surviving an abort, the blackboard normalisation and the generator's coverage.
+The default run compares 1,000 seeded random trees. Environment: ``BTM_DIFF_TREES=20000`` for
+more, ``BTM_DIFF_SEED`` moves the first seed, ``BTM_DIFF_DELAY=1`` also generates Delay (its
+0 ms timer races in BT.CPP), ``BTM_DIFF_ALL_NODES=1`` every built-in (differential/rules.py).
+Each tree is ticked on both engines with the same schedule; root status per tick, the test
+leaf's start/run/halt trace and the root blackboard after each step must agree, apart from the
+named rules of ``differential/rules.py``. A mismatch is shrunk and the failure message shows
+the minimal XML and what each engine did. The harness itself is tested here too: the shrinker
+on a seeded artificial bug, the oracle worker surviving an abort, the blackboard
+normalisation, the rules' citations of the differences doc and the generator's coverage.
 """
 
 from __future__ import annotations

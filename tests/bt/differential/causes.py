@@ -37,6 +37,8 @@ def _at_halt(case: Case, div: Divergence) -> bool:
 
 
 KNOWN: list[tuple[str, Detector]] = [
+    ("BT.CPP aborted its process (an exception left a destructor)",
+     lambda c, o, b, d: d.kind == "crash"),
     ("BT.CPP internal error: a skipped condition child of IfThenElse/WhileDoElse",
      lambda c, o, b, d: any(t in _step_error(o, d) for t in (
          "Something unexpected happened", "not allowed to set manually the status to IDLE"))),
