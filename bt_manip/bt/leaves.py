@@ -116,7 +116,8 @@ class SetBlackboard(SyncActionNode):
             value = bb.get(source)
             held = bb.strong_type(key)
             given = type_name(type(value))
-            if held is not None and type(value) is not str and given != held:
+            if (held is not None and held != "std::string" and type(value) is not str
+                    and given != held):
                 raise TreeRuntimeError(
                     f"{self.describe()}: entry [{key}] holds a {held}; copying a {given} from "
                     f"'{source}' would change its type (BT.CPP: once declared, the type of "

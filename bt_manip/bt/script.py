@@ -406,6 +406,18 @@ def to_text(v: Any) -> str:
     return str(v)
 
 
+def concat_text(v: Any) -> str:
+    """Text of a value for ``..``, as BT.CPP converts it: ``true`` is "1", a real is written
+    with six decimals (``1 + 2`` gives "3.000000", ``2.5`` "2.500000"), an integer as is."""
+    if isinstance(v, bool):
+        return "1" if v else "0"
+    if isinstance(v, float):
+        if math.isfinite(v):
+            return f"{v:f}"
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    return to_text(v)
+
+
 def _arith(op: str, a: int | float, b: int | float) -> float:
     """BT.CPP computes in double: ``1 + 2`` is 3.0 (stored as 3 into an int entry)."""
     a = float(a)
@@ -434,7 +446,7 @@ def binary(op: str, lhs: Any, rhs: Any) -> Any:
                                      ) from None
         return (a and b) if op == "&&" else (a or b)
     if op == "..":
-        return to_text(lhs) + to_text(rhs)
+        return concat_text(lhs) + concat_text(rhs)
     if op == "+" and isinstance(lhs, str) and isinstance(rhs, str):
         return lhs + rhs
     if isinstance(lhs, str) or isinstance(rhs, str):

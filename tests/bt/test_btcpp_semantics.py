@@ -239,3 +239,18 @@ def test_reactive_sequence_with_two_async_sequences_is_refused_at_load() -> None
         "<string>:1: a ReactiveSequence cannot have more than one AsyncSequence child (found 2, "
         "as BehaviorTree.CPP requires); wrap them in one Sequence")
     assert run_ours(f"<ReactiveFallback>{two}</ReactiveFallback>", 1).statuses == ["SUCCESS"]
+
+
+@pytest.mark.parametrize(("code", "text"), [
+    ('x := 1 + 2; s := x .. ""', "3.000000"), ('s := 2.5 .. ""', "2.500000"),
+    ('b := true; s := b .. ""', "1"), ('s := 3 .. ""', "3")])
+def test_concatenation_writes_numbers_as_btcpp(code: str, text: str) -> None:
+    _, theirs, ours = same(f'<Script code="{code.replace(chr(34), "&quot;")}"/>', 1)
+    assert theirs["s"] == text and ours["s"] == text
+
+
+def test_set_blackboard_copies_any_value_into_a_text_entry() -> None:
+    body = ('<Sequence><SetBlackboard value="{b}" output_key="s"/>'
+            '<Script code="r := s .. &quot;x&quot;"/></Sequence>')
+    _, theirs, ours = same(body, 1, {"b": 5, "s": "t"})
+    assert theirs["r"] == "5x" and ours["r"] == "5x"
