@@ -7,6 +7,7 @@ runs once), then every child goes back to IDLE.
 
 from __future__ import annotations
 
+import re
 from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
@@ -431,18 +432,30 @@ class WhileDoElse(_Control):
         return status
 
 
+_INT_PREFIX = re.compile(r"\s*([+-]?)(?:0[xX]([0-9a-fA-F]+)|(\d+))")
+_REAL_PREFIX = re.compile(r"\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)",
+                          re.IGNORECASE)
+
+
+def _leading_int(text: str) -> int | None:
+    match = _INT_PREFIX.match(text)
+    if match is None:
+        return None
+    sign, hexa, decimal = match.groups()
+    value = int(hexa, 16) if hexa else int(decimal)
+    return -value if sign == "-" else value
+
+
 def _switch_equal(a: str, b: str) -> bool:
+    """BT.CPP's ``CheckStringEquality``: equal texts, or equal integers (decimal or 0x hex), or
+    reals within float epsilon, each number read from the start of the text."""
     if a == b:
         return True
-    try:
-        if int(a.strip()) == int(b.strip()):
-            return True
-    except ValueError:
-        pass
-    try:
-        return abs(float(a) - float(b)) <= FLOAT_EPS
-    except ValueError:
-        return False
+    ia, ib = _leading_int(a), _leading_int(b)
+    if ia is not None and ia == ib:
+        return True
+    ra, rb = _REAL_PREFIX.match(a), _REAL_PREFIX.match(b)
+    return bool(ra and rb and abs(float(ra.group(0)) - float(rb.group(0))) <= FLOAT_EPS)
 
 
 class _Switch(_Control):

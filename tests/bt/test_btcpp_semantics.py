@@ -254,3 +254,12 @@ def test_set_blackboard_copies_any_value_into_a_text_entry() -> None:
             '<Script code="r := s .. &quot;x&quot;"/></Sequence>')
     _, theirs, ours = same(body, 1, {"b": 5, "s": "t"})
     assert theirs["r"] == "5x" and ours["r"] == "5x"
+
+
+@pytest.mark.parametrize(("variable", "expected"), [
+    ("2abc", 1), (" +2.0e0", 1), ("0x2", 1), ("-0x2", 2), ("a2", 3), ("1.99999999", 1)])
+def test_switch_compares_cases_as_btcpp(variable: str, expected: int) -> None:
+    body = (f'<Switch2 variable="{variable}" case_1="2" case_2="-2"><Script code="r := 1"/>'
+            '<Script code="r := 2"/><Script code="r := 3"/></Switch2>')
+    _, theirs, ours = same(body, 1)
+    assert theirs["r"] == str(expected) and ours["r"] == expected
