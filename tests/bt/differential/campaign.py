@@ -2,12 +2,13 @@
 
 Used by ``tests/bt/test_differential.py`` and ``benchmarks/btcpp_differential.py``.
 
-BT.CPP's Delay starts a timer thread even for 0 ms, and whether it fires before ``tickOnce``
-looks at the wake-up signal is a race (on an idle machine BT.CPP returns RUNNING instead of
-going on in about 0.5 % of runs, far more often under load). A case with a Delay is therefore
-run on the oracle with each ``tickOnce`` giving the timer time to fire (2 ms, then 20 ms, then
-200 ms if bt-manip disagrees with the shorter waits): the outcome of the timer winning the
-race, which is what BT.CPP does when it is not starved of CPU.
+Delay is generated only with ``BTM_DIFF_DELAY=1`` (see ``rules.NOT_GENERATED``): BT.CPP's
+Delay starts a timer thread even for 0 ms, and whether it fires before ``tickOnce`` looks at
+the wake-up signal is a race (BT.CPP then returns RUNNING instead of going on: about 0.5 % of
+runs on an idle machine, far more under load), as is whether it fires before the Delay itself
+looks. A case with a Delay is run on the oracle with each ``tickOnce`` giving the timer time to
+fire (2 ms, then 20 ms, then 200 ms while bt-manip disagrees); bt-manip agrees if it matches
+one of these runs.
 """
 
 from __future__ import annotations
