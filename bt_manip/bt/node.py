@@ -57,6 +57,9 @@ _MISSING = object()
 _RUNNING = Status.RUNNING
 _PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
 _BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
+# Enum members hash in Python code: the hot path maps statuses through identity lookups.
+_PY_BY_ID = {id(s): p for s, p in _PY_FROM_BT.items()}
+_LEAF_RESULT = {id(s): b for s, b in _BT_FROM_PY.items() if s is not Status.INVALID}
 
 
 class TreeRuntimeError(RuntimeError):
@@ -325,7 +328,7 @@ class BtNode(PortsMixin):
         self.last_status = new
         if new is not NodeStatus.SKIPPED:
             self.bt_status = new
-            self.status = _PY_FROM_BT[new]
+            self.status = _PY_BY_ID[id(new)]
         return new
 
     def tick_node(self) -> NodeStatus:
@@ -423,12 +426,13 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
                 return self.bt_status
             self.initialise()
         result = self.update()
-        if result not in _BT_FROM_PY or result == Status.INVALID:
+        status = _LEAF_RESULT.get(id(result))
+        if status is None:
             raise TreeRuntimeError(f"{self.describe()}: update() returned {result!r}")
-        if result != _RUNNING:
+        if result is not _RUNNING:
             self.terminate(result)
         self.status = result
-        return _BT_FROM_PY[result]
+        return status
 
     def halt(self) -> None:
         if self.status == _RUNNING:
