@@ -315,7 +315,7 @@ class RunOnce(_Decorator):
         self._returned = NodeStatus.IDLE
 
     def tick_node(self) -> NodeStatus:
-        skip = self.get_input("then_skip")
+        skip = self.get_input("then_skip", True)  # BT.CPP: true unless the port gives a value
         if self._done:
             return SKIPPED if skip else self._returned
         self._start()

@@ -244,9 +244,10 @@ class BtNode(PortsMixin):
         except KeyError:
             if default is not _MISSING:
                 return default
+            state = "has no value" if self.blackboard.exists(binding.key) else "does not exist"
             raise PortError(
                 f"{self.describe()}: input port '{port_name}' reads blackboard entry "
-                f"'{binding.key}', which does not exist") from None
+                f"'{binding.key}', which {state}") from None
         if isinstance(value, str) and info.data_type is not str:
             try:
                 return convert_literal(value, info.data_type)

@@ -314,6 +314,8 @@ def _convert_for(key: str, old: Any, value: Any) -> Any:
     if isinstance(old, str) and value is not None:
         raise ScriptRuntimeError(
             f"cannot assign a {_type_label(value)} to entry [{key}], which holds a string")
+    if type(old) is float and type(value) is int:  # a double entry stays double
+        return float(value)
     if type(old) is int and isinstance(value, float):
         if not value.is_integer():
             raise ScriptRuntimeError(

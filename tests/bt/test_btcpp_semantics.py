@@ -263,3 +263,17 @@ def test_switch_compares_cases_as_btcpp(variable: str, expected: int) -> None:
             '<Script code="r := 2"/><Script code="r := 3"/></Switch2>')
     _, theirs, ours = same(body, 1)
     assert theirs["r"] == str(expected) and ours["r"] == expected
+
+
+def test_an_integer_assigned_to_a_double_entry_keeps_it_double() -> None:
+    body = ('<Sequence><Script code="n := 0.5"/><Script code="n := 6"/>'
+            '<Script code="n := 0.5"/></Sequence>')
+    statuses, _, ours = same(body, 1)
+    assert statuses == ["SUCCESS"] and ours["n"] == 0.5
+
+
+def test_run_once_reads_then_skip_as_true_when_its_entry_has_no_value() -> None:
+    statuses, _, _ = same('<RunOnce then_skip="{b}"><AlwaysSuccess/></RunOnce>', 2)
+    assert statuses == ["SUCCESS", "SKIPPED"]
+    statuses, _, _ = same('<Parallel success_count="{k}"><AlwaysSuccess/></Parallel>', 1)
+    assert statuses == ["ERROR"]  # other ports without a value are errors
