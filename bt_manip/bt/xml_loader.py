@@ -241,7 +241,13 @@ def validate(path: str, models: Iterable[str] | None = None, tree_id: str | None
              text: str | None = None, reg: NodeRegistry | None = None
              ) -> tuple[list[Problem], list[Problem]]:
     """(problems, warnings) of a tree file: everything loading checks, without running."""
-    doc, _, problems = _prepare(path, text, models, tree_id, reg or registry, False)
+    reg = reg or registry
+    doc, main, problems = _prepare(path, text, models, tree_id, reg, False)
+    if not problems and main is not None:
+        try:  # building the tree checks the types of the entries that ports share
+            Tree(_Builder(doc, reg, True).tree_root(main), tree_id=main, source=path)
+        except InputError as e:
+            problems = list(e.problems)
     return problems, doc.warnings
 
 

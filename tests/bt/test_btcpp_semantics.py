@@ -3,12 +3,13 @@ real engine (``behaviortreepy``) and pinned on bt-manip."""
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import pytest
 from btcpp_reference import btcpp, document, run_btcpp, run_ours
 
-from bt_manip.bt import NodeStatus
+from bt_manip.bt import NodeStatus, validate_file
 from bt_manip.errors import InputError
 from bt_manip.runner import Runner, RunOptions
 
@@ -277,3 +278,14 @@ def test_run_once_reads_then_skip_as_true_when_its_entry_has_no_value() -> None:
     assert statuses == ["SUCCESS", "SKIPPED"]
     statuses, _, _ = same('<Parallel success_count="{k}"><AlwaysSuccess/></Parallel>', 1)
     assert statuses == ["ERROR"]  # other ports without a value are errors
+
+
+def test_validate_reports_ports_of_two_types_on_one_entry(tmp_path: Path) -> None:
+    tree = tmp_path / "conflict.xml"
+    tree.write_text(document('<Sequence><Sleep msec="{c}"/>\n<Switch2 variable="{c}" '
+                             'case_1="1" case_2="2"><AlwaysSuccess/><AlwaysSuccess/>'
+                             "<AlwaysSuccess/></Switch2></Sequence>"))
+    assert [str(p) for p in validate_file(str(tree))] == [
+        f"{tree}:2: Switch2 port 'variable': entry [c] was created with type [unsigned int] "
+        "and this port uses type [std::string]; BT.CPP refuses such a tree: use one type for "
+        "the entry"]
