@@ -171,6 +171,8 @@ RULES: list[Rule] = [
          "SkipUnlessUpdated / WaitValueUpdate halted while their child runs", _entry_updated_halt),
     Rule("set-blackboard-text-into-text-entry", INTERNAL,
          "SetBlackboard writing text into an entry that holds text", _set_blackboard_text),
+    Rule("btcpp-aborts", INTERNAL, "BT.CPP aborts the process",
+         lambda c, o, b, d: d.kind == "crash" and b.get("load_error") is not None),
 ]
 
 
@@ -182,15 +184,19 @@ def _copy_across_types(case: Case, oracle: dict[str, Any], btmanip: dict[str, An
                                     "not change") and _oracle_error(oracle, div, "[BT::Any]")
 
 
-def _text_into_script_number(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                             div: Divergence) -> bool:
+def _into_script_entry(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
+                       div: Divergence) -> bool:
+    """BT.CPP holds no value in an entry that bt-manip holds (as a number for text written;
+    as anything for a copied value) and that a SetBlackboard writes."""
     if div.step < 0:
         return False
-    written = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"
-               and not n.attrs.get("value", "").startswith("{")}
+    texts = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"
+             and not n.attrs.get("value", "").startswith("{")}
+    copies = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"
+              and n.attrs.get("value", "").startswith("{")}
     o_bb, b_bb = oracle["steps"][div.step]["bb"], btmanip["steps"][div.step]["bb"]
-    return any(key not in o_bb and value[0] == "n" for key, value in b_bb.items()
-               if key in written)
+    return any(key not in o_bb and ((key in texts and value[0] == "n") or key in copies)
+               for key, value in b_bb.items())
 
 
 def _refused_by_btcpp(text: str) -> Predicate:
@@ -210,17 +216,15 @@ NOT_YET = "Not yet matched"
 PENDING: list[Rule] = [
     Rule("set-blackboard-copy-across-types", NOT_YET,
          "SetBlackboard copying an entry into an entry of another type", _copy_across_types),
-    Rule("set-blackboard-text-into-script-number", NOT_YET,
+    Rule("set-blackboard-into-script-entry", NOT_YET,
          "SetBlackboard writing text into a number entry created by a script",
-         _text_into_script_number),
+         _into_script_entry),
     Rule("reactive-sequence-two-async-sequences", NOT_YET,
          "ReactiveSequence with two AsyncSequence children",
          _refused_by_btcpp("cannot have more than one async child")),
     Rule("port-type-against-initial-entry", NOT_YET,
          "A port bound to an entry of another type given before the tree is built",
          _refused_by_btcpp("was initially created with type")),
-    Rule("btcpp-aborts", INTERNAL, "BT.CPP aborts the process",
-         lambda c, o, b, d: d.kind == "crash"),
 ]
 
 
