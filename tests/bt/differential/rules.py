@@ -145,14 +145,34 @@ def _entry_updated_halt(case: Case, oracle: dict[str, Any], btmanip: dict[str, A
     return bool(ids) and _agrees_with({i: _btcpp_entry_updated(i) for i in ids}, case, oracle)
 
 
+def _written_keys(case: Case, bb: dict[str, list[Any]], copies: bool | None = None) -> set[str]:
+    """Keys the SetBlackboard nodes write (``copies``: only those with ``value="{src}"``,
+    False: only those with a text value, None: all). ``output_key="{k}"`` writes the entry
+    named by the value of k, read in bt-manip's blackboard ``bb``."""
+    keys = set()
+    for node in case.nodes():
+        if node.tag != "SetBlackboard":
+            continue
+        if copies is not None and node.attrs.get("value", "").startswith("{") != copies:
+            continue
+        key = node.attrs.get("output_key", "")
+        if key.startswith("{") and key.endswith("}"):
+            named = bb.get(key[1:-1])
+            if named is None or named[0] != "s":
+                continue
+            key = named[1]
+        keys.add(key)
+    return keys
+
+
 def _set_blackboard_text(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
                          div: Divergence) -> bool:
     """BT.CPP lacks (holds no value in) an entry that bt-manip holds as text and that a
     SetBlackboard writes: BT.CPP 4.8.2 nests a ``BT::Any`` in a text entry."""
     if div.step < 0:
         return False
-    written = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"}
     o_bb, b_bb = oracle["steps"][div.step]["bb"], btmanip["steps"][div.step]["bb"]
+    written = _written_keys(case, b_bb)
     return any(key not in o_bb and value[0] == "s" for key, value in b_bb.items()
                if key in written)
 
@@ -190,11 +210,8 @@ def _into_script_entry(case: Case, oracle: dict[str, Any], btmanip: dict[str, An
     as anything for a copied value) and that a SetBlackboard writes."""
     if div.step < 0:
         return False
-    texts = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"
-             and not n.attrs.get("value", "").startswith("{")}
-    copies = {n.attrs.get("output_key") for n in case.nodes() if n.tag == "SetBlackboard"
-              and n.attrs.get("value", "").startswith("{")}
     o_bb, b_bb = oracle["steps"][div.step]["bb"], btmanip["steps"][div.step]["bb"]
+    texts, copies = _written_keys(case, b_bb, False), _written_keys(case, b_bb, True)
     return any(key not in o_bb and ((key in texts and value[0] == "n") or key in copies)
                for key, value in b_bb.items())
 
