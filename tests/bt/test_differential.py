@@ -36,8 +36,8 @@ from differential.spec import HALT, TICK, Case, Node
 
 from bt_manip.bt.decorators import ForceSuccess
 
-pytestmark = pytest.mark.skipif(not oracle_available(),
-                                reason="behaviortreepy (BehaviorTree.CPP) is not installed")
+needs_oracle = pytest.mark.skipif(not oracle_available(),
+                                  reason="behaviortreepy (BehaviorTree.CPP) is not installed")
 
 TREES = int(os.environ.get("BTM_DIFF_TREES", "1000"))
 FIRST_SEED = int(os.environ.get("BTM_DIFF_SEED", "0"))
@@ -50,6 +50,7 @@ def oracle():
         yield o
 
 
+@needs_oracle
 def test_random_trees_agree_with_btcpp(oracle: Oracle) -> None:
     report = run_campaign(FIRST_SEED, TREES, shrink_limit=SHRUNK, oracle=oracle)
     figures = report.figures()
@@ -70,6 +71,7 @@ class _BrokenInverter(ForceSuccess):
     NODE_ID = "Inverter"
 
 
+@needs_oracle
 def test_shrinker_reduces_a_seeded_artificial_mismatch_to_the_minimal_tree(
         oracle: Oracle) -> None:
     broken = Differential(oracle, make_registry({"Inverter": _BrokenInverter}))
@@ -96,6 +98,7 @@ def test_shrinker_reduces_a_seeded_artificial_mismatch_to_the_minimal_tree(
     assert "<Inverter>" in mismatch.report()
 
 
+@needs_oracle
 def test_oracle_worker_survives_an_abort_and_goes_on(oracle: Oracle) -> None:
     # _onHalted throws (arithmetic on a string) while the leaf runs: halting fails, and the
     # worker must keep that tree alive rather than let its destructor abort the process.
@@ -116,6 +119,7 @@ def test_oracle_worker_survives_an_abort_and_goes_on(oracle: Oracle) -> None:
     assert oracle.restarts == restarts + 1
 
 
+@needs_oracle
 def test_blackboard_normalisation_keeps_strings_apart_from_numbers(oracle: Oracle) -> None:
     case = Case(Node("Sequence", {}, [
         Node("Script", {"code": "i := 1; d := 2.5; s := 'x'; t := true; u := '1'"}),
