@@ -99,6 +99,26 @@ def test_shrinker_reduces_a_seeded_artificial_mismatch_to_the_minimal_tree(
 
 
 @needs_oracle
+def test_a_counterfactual_rule_applies_only_when_btcpp_behaviour_explains_the_whole_run(
+        oracle: Oracle) -> None:
+    # BT.CPP's Precondition keeps "child running" over a halt: after the halt it ticks the
+    # leaf again without counting c2 up in its `if` (bt-manip checks `if` again).
+    body = Node("Precondition", {"if": "c2 += 1; c2 > 1"}, [Node("TestLeaf", {"name": "T1_RS"})])
+    case = Case(body, init=[("c2", "int", 1)], schedule=[TICK, HALT, TICK, TICK])
+    diff = Differential(oracle)
+    div, o, b = diff.compare(case)
+    assert div is not None and div.kind == "bb"
+    assert diff.excluded_by(case, o, b, div).name == "precondition-flag-survives-halt"
+    # The same tree under an Inverter, with an unrelated bug (the broken Inverter passes the
+    # SUCCESS of tick 4 through): BT.CPP's Precondition alone does not explain the run.
+    broken = Differential(oracle, make_registry({"Inverter": _BrokenInverter}))
+    inverted = Case(Node("Inverter", {}, [body]), init=case.init, schedule=case.schedule)
+    div, o, b = broken.compare(inverted)
+    assert div is not None
+    assert broken.excluded_by(inverted, o, b, div) is None
+
+
+@needs_oracle
 def test_oracle_worker_survives_an_abort_and_goes_on(oracle: Oracle) -> None:
     # _onHalted throws (arithmetic on a string) while the leaf runs: halting fails, and the
     # worker must keep that tree alive rather than let its destructor abort the process.

@@ -62,12 +62,16 @@ class TestLeaf(ActionNode):
             _state(self).on_halted(_trace(self))
 
 
-def make_registry(overrides: dict[str, type] | None = None) -> NodeRegistry:
-    """Every registered bt-manip node, the test leaf, and ``overrides`` (ID -> class)."""
+def make_registry(overrides: dict[str, type] | None = None,
+                  base: NodeRegistry | None = None) -> NodeRegistry:
+    """Every node of ``base`` (default: every registered bt-manip node, and the test leaf),
+    with ``overrides`` (ID -> class) in place of some."""
     reg = NodeRegistry()
-    for cls in registry.classes():
-        reg.register(cls, builtin=registry.is_builtin(cls.NODE_ID))
-    reg.register(TestLeaf)
+    source = base or registry
+    for cls in source.classes():
+        reg.register(cls, builtin=source.is_builtin(cls.NODE_ID))
+    if base is None:
+        reg.register(TestLeaf)
     for node_id, cls in (overrides or {}).items():
         if node_id != cls.NODE_ID:
             raise ValueError(f"override for {node_id} has NODE_ID {cls.NODE_ID}")

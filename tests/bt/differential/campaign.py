@@ -115,7 +115,7 @@ class Differential:
     def excluded_by(self, case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
                     div: Divergence) -> Rule | None:
         for rule in self.rules:
-            if rule.applies(case, oracle, btmanip, div):
+            if rule.applies(case, oracle, btmanip, div, self.reg):
                 return rule
         return None
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from bt_manip.bt.registry import NodeRegistry
 from differential.compare import Divergence
 from differential.generator import BUILTINS
 from differential.spec import Case
@@ -65,7 +66,8 @@ def enabled_builtins() -> tuple[set[str], set[str]]:
     return set(BUILTINS) - set(left_out), {f"{k} ({v})" for k, v in left_out.items()}
 
 
-Predicate = Callable[[Case, dict[str, Any], dict[str, Any], Divergence], bool]
+# (case, BT.CPP's result, bt-manip's result, the divergence, the registry bt-manip ran with)
+Predicate = Callable[[Case, dict[str, Any], dict[str, Any], Divergence, NodeRegistry], bool]
 
 
 @dataclass(frozen=True)
@@ -89,13 +91,14 @@ def _has(case: Case, *tags: str) -> bool:
     return any(node.tag in tags for node in case.nodes())
 
 
-def _agrees_with(overrides: dict[str, type], case: Case, oracle: dict[str, Any]) -> bool:
-    """Whether bt-manip, with BT.CPP's behaviour for the ``overrides`` node IDs, loads the
-    tree and agrees with BT.CPP at every step."""
+def _agrees_with(overrides: dict[str, type], case: Case, oracle: dict[str, Any],
+                 reg: NodeRegistry) -> bool:
+    """Whether bt-manip (``reg``), with BT.CPP's behaviour for the ``overrides`` node IDs,
+    loads the tree and agrees with BT.CPP at every step."""
     from differential.btmanip_runner import make_registry, run_case
     from differential.compare import first_divergence
 
-    again = run_case(case, make_registry(overrides))
+    again = run_case(case, make_registry(overrides, base=reg))
     return again["load_error"] is None and first_divergence(oracle, again) is None
 
 
@@ -134,15 +137,16 @@ def _btcpp_entry_updated(node_id: str) -> type:
 
 
 def _precondition_halt(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                       div: Divergence) -> bool:
+                       div: Divergence, reg: NodeRegistry) -> bool:
     return _has(case, "Precondition") and _agrees_with(
-        {"Precondition": _btcpp_precondition()}, case, oracle)
+        {"Precondition": _btcpp_precondition()}, case, oracle, reg)
 
 
 def _entry_updated_halt(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                        div: Divergence) -> bool:
+                        div: Divergence, reg: NodeRegistry) -> bool:
     ids = [i for i in ("SkipUnlessUpdated", "WaitValueUpdate") if _has(case, i)]
-    return bool(ids) and _agrees_with({i: _btcpp_entry_updated(i) for i in ids}, case, oracle)
+    return bool(ids) and _agrees_with({i: _btcpp_entry_updated(i) for i in ids}, case, oracle,
+                                      reg)
 
 
 def _written_keys(case: Case, bb: dict[str, list[Any]], copies: bool | None = None) -> set[str]:
@@ -166,7 +170,7 @@ def _written_keys(case: Case, bb: dict[str, list[Any]], copies: bool | None = No
 
 
 def _set_blackboard_text(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                         div: Divergence) -> bool:
+                         div: Divergence, reg: NodeRegistry) -> bool:
     """BT.CPP lacks (holds no value in) an entry that bt-manip holds as text and that a
     SetBlackboard writes: BT.CPP 4.8.2 nests a ``BT::Any`` in a text entry."""
     if div.step < 0:
@@ -181,9 +185,9 @@ INTERNAL = "Where BT.CPP throws an internal error or breaks its own contract"
 
 RULES: list[Rule] = [
     Rule("if-then-else-skipped-condition", INTERNAL, "IfThenElse whose condition is SKIPPED",
-         lambda c, o, b, d: _oracle_error(o, d, "Something unexpected happened in IfThenElse")),
+         lambda c, o, b, d, r: _oracle_error(o, d, "Something unexpected happened in IfThenElse")),
     Rule("while-do-else-skipped-condition", INTERNAL, "WhileDoElse whose condition is SKIPPED",
-         lambda c, o, b, d: _has(c, "WhileDoElse") and _oracle_error(
+         lambda c, o, b, d, r: _has(c, "WhileDoElse") and _oracle_error(
              o, d, "you are not allowed to set manually the status to IDLE")),
     Rule("precondition-flag-survives-halt", INTERNAL, "Precondition halted while its child runs",
          _precondition_halt),
@@ -192,12 +196,12 @@ RULES: list[Rule] = [
     Rule("set-blackboard-text-into-text-entry", INTERNAL,
          "SetBlackboard writing text into an entry that holds text", _set_blackboard_text),
     Rule("btcpp-aborts", INTERNAL, "BT.CPP aborts the process",
-         lambda c, o, b, d: d.kind == "crash" and b.get("load_error") is not None),
+         lambda c, o, b, d, r: d.kind == "crash" and b.get("load_error") is not None),
 ]
 
 
 def _copy_across_types(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                       div: Divergence) -> bool:
+                       div: Divergence, reg: NodeRegistry) -> bool:
     copies = any(n.tag == "SetBlackboard" and n.attrs.get("value", "").startswith("{")
                  for n in case.nodes())
     return copies and _oracle_error(oracle, div, "once declared, the type of a port shall "
@@ -205,7 +209,7 @@ def _copy_across_types(case: Case, oracle: dict[str, Any], btmanip: dict[str, An
 
 
 def _into_script_entry(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                       div: Divergence) -> bool:
+                       div: Divergence, reg: NodeRegistry) -> bool:
     """BT.CPP holds no value in an entry that bt-manip holds (as a number for text written;
     as anything for a copied value) and that a SetBlackboard writes."""
     if div.step < 0:
@@ -218,7 +222,7 @@ def _into_script_entry(case: Case, oracle: dict[str, Any], btmanip: dict[str, An
 
 def _refused_by_btcpp(text: str) -> Predicate:
     def applies(case: Case, oracle: dict[str, Any], btmanip: dict[str, Any],
-                div: Divergence) -> bool:
+                div: Divergence, reg: NodeRegistry) -> bool:
         return (div.kind == "load" and btmanip.get("load_error") is None
                 and text in (oracle.get("load_error") or ""))
 
