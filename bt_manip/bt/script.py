@@ -316,10 +316,10 @@ def _convert_for(key: str, old: Any, value: Any) -> Any:
             f"cannot assign a {_type_label(value)} to entry [{key}], which holds a string")
     if type(old) is float and type(value) is int:  # a double entry stays double
         return float(value)
-    if type(old) is int and isinstance(value, float):
+    if type(old) in (int, bool) and type(value) is float:
         if not value.is_integer():
             raise ScriptRuntimeError(
-                f"cannot assign {value} to entry [{key}], which holds an int")
+                f"cannot assign {value} to entry [{key}], which holds a {_type_label(old)}")
         return int(value)
     return value
 

@@ -289,3 +289,12 @@ def test_validate_reports_ports_of_two_types_on_one_entry(tmp_path: Path) -> Non
         f"{tree}:2: Switch2 port 'variable': entry [c] was created with type [unsigned int] "
         "and this port uses type [std::string]; BT.CPP refuses such a tree: use one type for "
         "the entry"]
+
+
+@pytest.mark.parametrize(("code", "status"), [("b = 0.5", "ERROR"), ("b = 1.0", "SUCCESS"),
+                                              ("b += 1", "SUCCESS")])
+def test_a_real_assigned_to_a_bool_entry_must_be_integral(code: str, status: str) -> None:
+    statuses, _, ours = same(f'<Script code="{code}"/>', 1, {"b": False})
+    assert statuses == [status]
+    if status == "SUCCESS":
+        assert ours["b"] == 1 and type(ours["b"]) is int
