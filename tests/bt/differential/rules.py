@@ -240,6 +240,10 @@ PENDING: list[Rule] = [
     Rule("set-blackboard-into-script-entry", NOT_YET,
          "SetBlackboard writing text into a number entry created by a script",
          _into_script_entry),
+    Rule("set-blackboard-retypes-to-any", NOT_YET,
+         "retypes any entry that is not strongly typed",
+         lambda c, o, b, d, r: _has(c, "SetBlackboard") and d.kind == "error"
+         and _oracle_error(o, d, "to type [BT::Any]")),
     Rule("reactive-sequence-two-async-sequences", NOT_YET,
          "ReactiveSequence with two AsyncSequence children",
          _refused_by_btcpp("cannot have more than one async child")),
