@@ -186,8 +186,15 @@ def _set_blackboard_text(case: Case, oracle: dict[str, Any], btmanip: dict[str, 
         return False
     o_bb, b_bb = oracle["steps"][div.step]["bb"], btmanip["steps"][div.step]["bb"]
     written = _written_keys(case, b_bb)
-    return any(key not in o_bb and value[0] == "s" for key, value in b_bb.items()
-               if key in written)
+    if any(key not in o_bb and value[0] == "s" for key, value in b_bb.items()
+           if key in written):
+        return True
+    # BT.CPP's entry, reading as "not initialized", takes what a script assigns next; bt-manip
+    # refuses a number into the entry, which holds text.
+    error = btmanip["steps"][div.step]["error"] or ""
+    return (div.kind == "error" and oracle["steps"][div.step]["error"] is None
+            and "holds a string" in error
+            and any(f"entry [{key}]" in error for key in written))
 
 
 INTERNAL = "Where BT.CPP throws an internal error or breaks its own contract"
@@ -204,6 +211,10 @@ RULES: list[Rule] = [
          "SkipUnlessUpdated / WaitValueUpdate halted while their child runs", _entry_updated_halt),
     Rule("set-blackboard-text-into-text-entry", INTERNAL,
          "SetBlackboard writing text into an entry that holds text", _set_blackboard_text),
+    Rule("text-into-entry-port-entry", INTERNAL,
+         "Text written (by SetBlackboard or a script) into an entry created by the `entry` port",
+         lambda c, o, b, d, r: _has(c, "WasEntryUpdated", "SkipUnlessUpdated", "WaitValueUpdate")
+         and _oracle_error(o, d, "convertFromString for this type: BT::Any")),
     Rule("btcpp-aborts", INTERNAL, "BT.CPP aborts the process",
          lambda c, o, b, d, r: d.kind == "crash" and b.get("load_error") is not None),
 ]
