@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from bt_manip.bt.blackboard import Blackboard
 from bt_manip.faults import FaultInjector, FaultSpec, check_targets
 from bt_manip.runner import Runner, RunOptions, RunReport
 
@@ -59,7 +60,8 @@ class Episode:
                 tree_id=spec.tree_id,
                 models=spec.models,
                 context=self.context,
-                blackboard=dict(spec.blackboard),
+                # entries given by the user (--bb) are typed as a script would type them
+                blackboard=Blackboard.from_dict(dict(spec.blackboard), typed=False),
             )
             nodes = self.tree.nodes()
             check_targets(list(spec.inject), {n.name for n in nodes}, {n.NODE_ID for n in nodes})

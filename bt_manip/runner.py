@@ -6,7 +6,12 @@ clock unless pacing is asked for (``realtime``), so a headless run goes as fast 
 allows. Without a world the tree runs on the monotonic clock and the loop paces itself at the
 tick rate, as BehaviorTree.CPP's ``tickWhileRunning`` does.
 
-Exit codes (:data:`EXIT_CODES`): 0 root SUCCESS, 1 root FAILURE or budget spent, 2 bad input
+The tree is ticked with ``tick()`` (BT.CPP's ``tickOnce()``: a wake-up signal re-ticks the root
+within the same tick). A root that returns SKIPPED (every node it would run was skipped by a
+pre-condition) ends the run with status SKIPPED.
+
+Exit codes (:data:`EXIT_CODES`): 0 root SUCCESS, 1 root FAILURE, root SKIPPED or budget spent,
+2 bad input
 (including a tree that breaks while running: a script error, a port without a value), 130
 interrupted. In every case but SUCCESS and FAILURE the tree is halted first and the robots are
 left stopped.
@@ -35,6 +40,7 @@ EXIT_INTERRUPTED = 130
 EXIT_CODES = {
     "SUCCESS": EXIT_SUCCESS,
     "FAILURE": EXIT_FAILURE,
+    "SKIPPED": EXIT_FAILURE,
     "BUDGET": EXIT_FAILURE,
     "ERROR": EXIT_BAD_INPUT,
     "INTERRUPTED": EXIT_INTERRUPTED,
@@ -46,7 +52,8 @@ class TickableTree(Protocol):
 
     root: py_trees.behaviour.Behaviour
 
-    def tick(self) -> py_trees.common.Status: ...
+    def tick(self) -> Any: ...
+    """The root's status after the tick: a ``NodeStatus`` (or a py_trees ``Status``)."""
 
     def halt(self) -> None: ...
 
@@ -198,16 +205,20 @@ class Runner:
         status, reason = "BUDGET", ""
         try:
             while True:
-                result = self.tree.tick()
+                result = self.tree.tick().name
                 self.ticks += 1
                 for hook in self.on_tick:
                     hook(self)
-                if result == py_trees.common.Status.SUCCESS:
+                if result == "SUCCESS":
                     status = "SUCCESS"
                     break
-                if result == py_trees.common.Status.FAILURE:
+                if result == "FAILURE":
                     status = "FAILURE"
                     reason = self._failure_reason()
+                    break
+                if result == "SKIPPED":
+                    status = "SKIPPED"
+                    reason = "every node the root would run was skipped by a pre-condition"
                     break
                 if opts.max_ticks is not None and self.ticks >= opts.max_ticks:
                     reason = f"tick budget of {opts.max_ticks} spent"
@@ -221,7 +232,11 @@ class Runner:
         except TreeRuntimeError as exc:
             status, reason = "ERROR", str(exc)
         if status in ("BUDGET", "INTERRUPTED", "ERROR"):
-            self.tree.halt()
+            try:
+                self.tree.halt()
+            except TreeRuntimeError as exc:  # an _onHalted script failed
+                if status != "ERROR":
+                    status, reason = "ERROR", str(exc)
             self._make_safe()
         wall = time.perf_counter() - wall0
         return RunReport(

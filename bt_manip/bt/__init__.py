@@ -6,7 +6,13 @@ Public API::
     from bt_manip.bt import ActionNode, ConditionNode   # base classes for robot behaviours
 """
 
-from bt_manip.bt import controls, decorators, leaves  # noqa: F401  (register the built-ins)
+from bt_manip.bt import (  # noqa: F401  (register the built-ins)
+    controls,
+    decorators,
+    entry_updates,
+    leaves,
+    loops,
+)
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import (
@@ -16,6 +22,7 @@ from bt_manip.bt.node import (
     ControlNode,
     DecoratorNode,
     PortError,
+    SyncActionNode,
     TreeRuntimeError,
 )
 from bt_manip.bt.ports import InOutPortInformation
@@ -38,6 +45,7 @@ __all__ = [
     "NodeStatus",
     "PortError",
     "SubTree",
+    "SyncActionNode",
     "Tree",
     "TreeContext",
     "TreeRuntimeError",

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 from bt_manip.clock import Clock, MonotonicClock
+
+TIME_EPS = 1e-9  # seconds: tolerance when comparing clock readings
 
 
 @dataclass
@@ -20,6 +23,43 @@ class TreeContext:
     clock: Clock = field(default_factory=MonotonicClock)
     world: Any = None
     services: dict[str, Any] = field(default_factory=dict)
+    wake_up: bool = False
+    """A node asked for the root to be ticked again (BT.CPP's wake-up signal)."""
+    timers: dict[int, tuple[float, Callable[[], None] | None]] = field(default_factory=dict)
+    """Pending timers of Sleep, Delay and Timeout: id -> (deadline, callback)."""
+    _timer_ids: int = 0
 
     def now(self) -> float:
         return self.clock.now()
+
+    def start_timer(self, seconds: float, callback: Callable[[], None] | None = None) -> int:
+        """A timer on the tree's clock, as BT.CPP's timer queue (which runs on its own thread).
+
+        When ``seconds`` have passed, ``callback`` runs and the wake-up signal is emitted. The
+        clock only moves between ticks, so timers fire at the start of the next ``Tree.tick()``
+        (or at once when ``seconds`` <= 0). Returns an id for :meth:`cancel_timer`.
+        """
+        self._timer_ids += 1
+        if seconds <= 0:
+            if callback is not None:
+                callback()
+            self.wake_up = True
+        else:
+            self.timers[self._timer_ids] = (self.clock.now() + seconds, callback)
+        return self._timer_ids
+
+    def cancel_timer(self, timer: int | None) -> None:
+        """Forget a timer (it neither calls back nor wakes the tree up)."""
+        if timer is not None:
+            self.timers.pop(timer, None)
+
+    def fire_timers(self) -> None:
+        """Run the timers whose time has come, in deadline order."""
+        now = self.clock.now() + TIME_EPS
+        due = sorted((deadline, timer) for timer, (deadline, _) in self.timers.items()
+                     if deadline <= now)
+        for _, timer in due:
+            _, callback = self.timers.pop(timer)
+            if callback is not None:
+                callback()
+            self.wake_up = True

@@ -7,6 +7,7 @@ runs once), then every child goes back to IDLE.
 
 from __future__ import annotations
 
+import re
 from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
@@ -16,6 +17,7 @@ from bt_manip.bt.registry import registry
 from bt_manip.bt.script import FLOAT_EPS, to_text
 from bt_manip.bt.status import NodeStatus
 
+IDLE = NodeStatus.IDLE
 RUNNING = NodeStatus.RUNNING
 SUCCESS = NodeStatus.SUCCESS
 FAILURE = NodeStatus.FAILURE
@@ -32,10 +34,11 @@ class _Control(ControlNode):
 
 
 class _OrderedControl(_Control):
-    """Shared logic of Sequence, SequenceWithMemory and Fallback."""
+    """Shared logic of Sequence, SequenceWithMemory, Fallback and their Async variants."""
 
     STOP_ON = FAILURE  # child status that ends the loop early
     DONE = SUCCESS  # status when every child passed
+    YIELDS = False  # after a child that started and finished in this tick, yield (wake-up)
 
     def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
                  **attributes: Any) -> None:
@@ -50,19 +53,24 @@ class _OrderedControl(_Control):
     def tick_node(self) -> NodeStatus:
         kids = self._kids()
         n = len(kids)
-        if self.bt_status is not RUNNING:
+        if self.bt_status is IDLE:  # BT.CPP keeps the count while the node is not reset
             self._skipped = 0
         self._start()
         while self.current < n:
-            status = kids[self.current].execute_tick()
+            child = kids[self.current]
+            before = child.bt_status
+            status = child.execute_tick()
             if status is RUNNING:
                 return RUNNING
             if status is self.STOP_ON:
                 self._on_stop()
                 return status
+            self.current += 1
             if status is SKIPPED:
                 self._skipped += 1
-            self.current += 1
+            elif self.YIELDS and before is IDLE and self.current < n:
+                self.emit_wake_up()
+                return RUNNING
         all_skipped = self._skipped == n
         self.reset_children()
         self.current = 0
@@ -99,7 +107,13 @@ class SequenceWithMemory(_OrderedControl):
     - all children SUCCESS: reset everything and return SUCCESS.
 
     Being halted does not rewind it either (as in BT.CPP 4).
+
+    When a child started and finished (SUCCESS) within this tick and more children follow, it
+    returns RUNNING and asks for a wake-up: ``Tree.tick()`` then ticks the tree again from the
+    root at once, so reactive parents above re-check their conditions between two children.
     """
+
+    YIELDS = True
 
     def _on_stop(self) -> None:
         for index in range(self.current, len(self.children)):
@@ -123,6 +137,30 @@ class Fallback(_OrderedControl):
 
     STOP_ON = SUCCESS
     DONE = FAILURE
+
+
+@registry.register(builtin=True)
+class AsyncSequence(Sequence):
+    """A Sequence that yields between children.
+
+    As Sequence, but when a child started and succeeded within this tick and more children
+    follow, it returns RUNNING and asks for a wake-up (``Tree.tick()`` ticks the root again at
+    once), so reactive parents re-check their conditions between two children.
+    """
+
+    YIELDS = True
+
+
+@registry.register(builtin=True)
+class AsyncFallback(Fallback):
+    """A Fallback that yields between children.
+
+    As Fallback, but when a child started and failed within this tick and more children
+    follow, it returns RUNNING and asks for a wake-up (``Tree.tick()`` ticks the root again at
+    once).
+    """
+
+    YIELDS = True
 
 
 class _ReactiveControl(_Control):
@@ -394,18 +432,30 @@ class WhileDoElse(_Control):
         return status
 
 
+_INT_PREFIX = re.compile(r"\s*([+-]?)(?:0[xX]([0-9a-fA-F]+)|(\d+))")
+_REAL_PREFIX = re.compile(r"\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|inf(?:inity)?|nan)",
+                          re.IGNORECASE)
+
+
+def _leading_int(text: str) -> int | None:
+    match = _INT_PREFIX.match(text)
+    if match is None:
+        return None
+    sign, hexa, decimal = match.groups()
+    value = int(hexa, 16) if hexa else int(decimal)
+    return -value if sign == "-" else value
+
+
 def _switch_equal(a: str, b: str) -> bool:
+    """BT.CPP's ``CheckStringEquality``: equal texts, or equal integers (decimal or 0x hex), or
+    reals within float epsilon, each number read from the start of the text."""
     if a == b:
         return True
-    try:
-        if int(a.strip()) == int(b.strip()):
-            return True
-    except ValueError:
-        pass
-    try:
-        return abs(float(a) - float(b)) <= FLOAT_EPS
-    except ValueError:
-        return False
+    ia, ib = _leading_int(a), _leading_int(b)
+    if ia is not None and ia == ib:
+        return True
+    ra, rb = _REAL_PREFIX.match(a), _REAL_PREFIX.match(b)
+    return bool(ra and rb and abs(float(ra.group(0)) - float(rb.group(0))) <= FLOAT_EPS)
 
 
 class _Switch(_Control):
@@ -413,7 +463,9 @@ class _Switch(_Control):
 
     At each tick the variable is compared with every case (as text, then as numbers); the
     child of the first match (or the default) is ticked. If another child was RUNNING, it is
-    halted first. When the ticked child finishes, all children are reset.
+    halted first. When the ticked child finishes, all children are reset. The Switch returns
+    the child's status and, as in BT.CPP, does not mark itself RUNNING before ticking it (a
+    Switch whose child was skipped stays IDLE).
     """
 
     CASES = 0
@@ -436,7 +488,6 @@ class _Switch(_Control):
                     break
         if self._running != -1 and self._running != match:
             self.halt_child(self._running)
-        self._start()
         status = kids[match].execute_tick()
         if status is SKIPPED:
             self._running = -1

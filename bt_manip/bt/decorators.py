@@ -10,17 +10,18 @@ from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.context import TIME_EPS
 from bt_manip.bt.node import BtNode, DecoratorNode, PortError
 from bt_manip.bt.ports import NON_NEGATIVE, Port, Ref
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
 from bt_manip.bt.status import NodeStatus
 
+IDLE = NodeStatus.IDLE
 RUNNING = NodeStatus.RUNNING
 SUCCESS = NodeStatus.SUCCESS
 FAILURE = NodeStatus.FAILURE
 SKIPPED = NodeStatus.SKIPPED
-TIME_EPS = 1e-9  # seconds: tolerance when comparing clock readings
 
 
 class _Decorator(DecoratorNode):
@@ -73,10 +74,12 @@ class ForceFailure(_Force):
 class Repeat(_Decorator):
     """Ticks the child up to ``num_cycles`` times in a row (-1: forever) while it succeeds.
 
-    The loop runs within one tick while the child finishes synchronously; a RUNNING child
-    returns RUNNING and the loop resumes at the next tick. A child FAILURE stops the loop and
-    returns FAILURE; after ``num_cycles`` successes the node returns SUCCESS. A SKIPPED child
-    makes the node SKIPPED (the count is kept).
+    A child that started and succeeded within this tick, with cycles left, makes it return
+    RUNNING and ask for a wake-up: ``Tree.tick()`` ticks the root again at once, so the cycles
+    still run within one tree tick but reactive parents re-check their conditions in between.
+    A RUNNING child returns RUNNING and the loop resumes at the next tick. A child FAILURE stops
+    the loop and returns FAILURE; after ``num_cycles`` successes the node returns SUCCESS. A
+    SKIPPED child makes the node SKIPPED (the count is kept).
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
@@ -94,11 +97,16 @@ class Repeat(_Decorator):
         loop = self.count < cycles or cycles == -1
         self._start()
         while loop:
-            status = self.child.execute_tick()
+            child = self.child
+            before = child.bt_status
+            status = child.execute_tick()
             if status is SUCCESS:
                 self.count += 1
                 loop = self.count < cycles or cycles == -1
                 self.reset_child()
+                if before is IDLE and loop:
+                    self.emit_wake_up()
+                    return RUNNING
             elif status is FAILURE:
                 self.count = 0
                 self.reset_child()
@@ -120,9 +128,11 @@ class Repeat(_Decorator):
 class RetryUntilSuccessful(_Decorator):
     """Ticks the child again after a FAILURE, up to ``num_attempts`` times (-1: forever).
 
-    Retries happen within the same tick while the child fails synchronously; a RUNNING child
-    returns RUNNING. Child SUCCESS returns SUCCESS; after ``num_attempts`` failures the node
-    returns FAILURE. A SKIPPED child makes the node SKIPPED.
+    A child that started and failed within this tick, with attempts left, makes it return
+    RUNNING and ask for a wake-up (``Tree.tick()`` ticks the root again at once, so the retries
+    still happen within one tree tick); a RUNNING child returns RUNNING. Child SUCCESS returns
+    SUCCESS; after ``num_attempts`` failures the node returns FAILURE. A SKIPPED child makes
+    the node SKIPPED.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
@@ -140,7 +150,9 @@ class RetryUntilSuccessful(_Decorator):
         loop = self.tries < attempts or attempts == -1
         self._start()
         while loop:
-            status = self.child.execute_tick()
+            child = self.child
+            before = child.bt_status
+            status = child.execute_tick()
             if status is SUCCESS:
                 self.tries = 0
                 self.reset_child()
@@ -150,6 +162,9 @@ class RetryUntilSuccessful(_Decorator):
                 attempts = self.get_input("num_attempts")
                 loop = self.tries < attempts or attempts == -1
                 self.reset_child()
+                if before is IDLE and loop:
+                    self.emit_wake_up()
+                    return RUNNING
             elif status is RUNNING:
                 return RUNNING
             else:
@@ -183,21 +198,32 @@ class Timeout(_Decorator):
     """Halts the child and returns FAILURE when it has been RUNNING for ``msec`` milliseconds.
 
     The time starts at the first tick; a child that finishes earlier returns its status. With
-    ``msec`` 0 there is no time limit. A negative ``msec`` is refused at load; read from the
-    blackboard, it makes the node fail (halting the child) with the reason.
+    ``msec`` 0 there is no time limit. As BT.CPP's timer thread does, the timer halts the child
+    (and emits the wake-up signal) when it fires, at the start of the tick after the time ran
+    out; that tick the node returns FAILURE. A negative ``msec`` is refused at load; read from
+    the blackboard, it makes the node fail (halting the child) with the reason.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "msec": Port(
-            int, description="after this many milliseconds, halt the child if still running",
-            accepts=NON_NEGATIVE),
+            int, description="After a certain amount of time, halt() the child if it is still "
+                             "running.", accepts=NON_NEGATIVE),
     }
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"msec": "unsigned int"}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
         super().__init__(name, child, **attributes)
-        self._deadline: float | None = None
         self._started = False
+        self._child_halted = False
+        self._timer: int | None = None
+        self._msec = 0
+
+    def _on_timeout(self) -> None:
+        if self.child.bt_status is RUNNING:
+            self._child_halted = True
+            self.reset_child()
+            self.feedback_message = f"timed out after {self._msec} ms"
 
     def tick_node(self) -> NodeStatus:
         try:
@@ -210,21 +236,23 @@ class Timeout(_Decorator):
         if not self._started:
             self._started = True
             self._start()
-            self._deadline = self.now() + msec / 1000.0 if msec > 0 else None
-        if (self._deadline is not None and self.now() >= self._deadline - TIME_EPS
-                and self.child.bt_status is RUNNING):
-            self.reset_child()
+            self._child_halted = False
+            self._msec = msec
+            if msec > 0:
+                self._timer = self.context.start_timer(msec / 1000.0, self._on_timeout)
+        if self._child_halted:
             self._started = False
-            self.feedback_message = f"timed out after {msec} ms"
             return FAILURE
         status = self.child.execute_tick()
         if status.completed:
             self._started = False
+            self.context.cancel_timer(self._timer)
             self.reset_child()
         return status
 
     def halt(self) -> None:
         self._started = False
+        self.context.cancel_timer(self._timer)
         super().halt()
 
 
@@ -232,20 +260,23 @@ class Timeout(_Decorator):
 class Delay(_Decorator):
     """Waits ``delay_msec`` milliseconds (returning RUNNING), then ticks the child.
 
-    The wait starts at the first tick; once it is over, the child's status is returned and the
-    next start waits again.
+    The wait starts at the first tick, which always returns RUNNING (even with 0 ms: BT.CPP
+    starts a timer there and looks at it again at the next tick). Once the time has passed,
+    the child is ticked and its status returned; the next start waits again.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "delay_msec": PortInformation(
-            int, description="milliseconds to wait before ticking the child"),
+            int, description="Tick the child after a few milliseconds"),
     }
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"delay_msec": "unsigned int"}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
         super().__init__(name, child, **attributes)
         self._started = False
         self._start_time = 0.0
+        self._timer: int | None = None
 
     def tick_node(self) -> NodeStatus:
         delay = self.get_input("delay_msec")
@@ -253,6 +284,8 @@ class Delay(_Decorator):
             self._started = True
             self._start()
             self._start_time = self.now()
+            self._timer = self.context.start_timer(delay / 1000.0)
+            return RUNNING
         if self.now() - self._start_time >= delay / 1000.0 - TIME_EPS:
             status = self.child.execute_tick()
             if status.completed:
@@ -263,6 +296,7 @@ class Delay(_Decorator):
 
     def halt(self) -> None:
         self._started = False
+        self.context.cancel_timer(self._timer)
         super().halt()
 
 
@@ -288,7 +322,7 @@ class RunOnce(_Decorator):
         self._returned = NodeStatus.IDLE
 
     def tick_node(self) -> NodeStatus:
-        skip = self.get_input("then_skip")
+        skip = self.get_input("then_skip", True)  # BT.CPP: true unless the port gives a value
         if self._done:
             return SKIPPED if skip else self._returned
         self._start()

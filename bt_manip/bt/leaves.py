@@ -7,16 +7,25 @@ from typing import Any, ClassVar
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.blackboard import EntryTypeError
 from bt_manip.bt.decorators import TIME_EPS, _ScriptHolder
-from bt_manip.bt.node import ActionNode, ConditionNode, PortError, TreeRuntimeError, _truth
-from bt_manip.bt.ports import NON_NEGATIVE, InOutPortInformation, Literal, Port, Ref
+from bt_manip.bt.node import (
+    ActionNode,
+    ConditionNode,
+    PortError,
+    SyncActionNode,
+    TreeRuntimeError,
+    _truth,
+)
+from bt_manip.bt.ports import NON_NEGATIVE, InOutPortInformation, Literal, Port, Ref, type_name
 from bt_manip.bt.registry import registry
+from bt_manip.bt.script import to_text
 
 Ports = dict[str, PortInformation]
 
 
 @registry.register(builtin=True)
-class AlwaysSuccess(ActionNode):
+class AlwaysSuccess(SyncActionNode):
     """Returns SUCCESS."""
 
     def update(self) -> Status:
@@ -24,7 +33,7 @@ class AlwaysSuccess(ActionNode):
 
 
 @registry.register(builtin=True)
-class AlwaysFailure(ActionNode):
+class AlwaysFailure(SyncActionNode):
     """Returns FAILURE."""
 
     def update(self) -> Status:
@@ -32,7 +41,7 @@ class AlwaysFailure(ActionNode):
 
 
 @registry.register(builtin=True)
-class Script(ActionNode):
+class Script(SyncActionNode):
     """Runs the script ``code`` on the blackboard and returns SUCCESS."""
 
     INPUT_PORTS: ClassVar[Ports] = {"code": PortInformation(str, description="script to run")}
@@ -53,7 +62,8 @@ class ScriptCondition(ConditionNode):
     """Evaluates the script ``code``: SUCCESS if its value is true, FAILURE otherwise."""
 
     INPUT_PORTS: ClassVar[Ports] = {
-        "code": PortInformation(str, description="script whose value is the result")}
+        "code": PortInformation(
+            object, description="Piece of code that can be parsed. Must return false or true")}
     SCRIPT_PORTS = ("code",)
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
@@ -66,46 +76,79 @@ class ScriptCondition(ConditionNode):
 
 
 @registry.register(builtin=True)
-class SetBlackboard(ActionNode):
+class SetBlackboard(SyncActionNode):
     """Writes ``value`` into the entry named by ``output_key``; returns SUCCESS.
 
-    ``value`` may be text or a reference ``{other}`` (the other entry's value is copied).
-    ``output_key`` is the name of the entry (a reference ``{key}`` names the entry ``key``).
+    ``value`` is text, or a reference ``{other}`` whose value is copied (FAILURE when that
+    entry has no value). Text written into an entry of another type is converted to it (an
+    error if it cannot be). ``output_key`` is the name of the entry; as in BT.CPP, a reference
+    ``{key}`` there names the entry whose *value* is the name to write to.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "value": PortInformation(str, description="value to write (text, or {key} to copy)"),
-        "output_key": InOutPortInformation(str, description="name of the entry to write"),
+        "value": PortInformation(
+            object, description="Value to be written into the output_key"),
+        "output_key": InOutPortInformation(
+            object, description="Name of the blackboard entry where the value should be "
+                                "written"),
     }
 
     def update(self) -> Status:
+        bb = self.blackboard
         key_binding = self.bindings["output_key"]
-        key = key_binding.key if isinstance(key_binding, Ref) else str(key_binding.value)
+        if isinstance(key_binding, Ref):
+            try:
+                key = to_text(bb.get(key_binding.key))
+            except KeyError:
+                raise TreeRuntimeError(
+                    f"{self.describe()}: output_key reads the entry name from "
+                    f"'{key_binding.key}', which has no value") from None
+        else:
+            key = str(key_binding.value)
         value_binding = self.bindings["value"]
         if isinstance(value_binding, Literal):
             value = value_binding.value
         else:
-            try:
-                value = self.blackboard.get(value_binding.key)
-            except KeyError:
+            source = value_binding.key
+            if not bb.exists(source):
                 raise TreeRuntimeError(
-                    f"{self.describe()}: value refers to entry '{value_binding.key}', "
+                    f"{self.describe()}: value refers to entry '{source}', "
                     "which does not exist") from None
-        self.blackboard.set(key, value)
+            if not bb.exists(key):  # created with the source entry's type
+                source_type = bb.strong_type(source)
+                bb.declare(key, bb.entry_type(source) if source_type else object, source_type)
+            if not bb.has_value(source):
+                self.feedback_message = f"entry '{source}' has no value to copy"
+                return Status.FAILURE
+            value = bb.get(source)
+            held = bb.strong_type(key)
+            given = type_name(type(value))
+            if (held is not None and held != "std::string" and type(value) is not str
+                    and given != held):
+                raise TreeRuntimeError(
+                    f"{self.describe()}: entry [{key}] holds a {held}; copying a {given} from "
+                    f"'{source}' would change its type (BT.CPP: once declared, the type of "
+                    "an entry shall not change)")
+        try:
+            bb.assign(key, value)
+        except EntryTypeError as e:
+            raise TreeRuntimeError(f"{self.describe()}: {e}") from None
         return Status.SUCCESS
 
 
 @registry.register(builtin=True)
-class UnsetBlackboard(ActionNode):
-    """Removes the entry ``key`` from the blackboard (if present); returns SUCCESS."""
+class UnsetBlackboard(SyncActionNode):
+    """Removes the entry ``key`` of this tree's blackboard (if present); returns SUCCESS.
+
+    As in BT.CPP, ``key="{other}"`` removes the entry named by the value of ``other``, and an
+    entry a SubTree shares with its parent is not removed from the parent.
+    """
 
     INPUT_PORTS: ClassVar[Ports] = {
         "key": PortInformation(str, description="name of the entry to remove")}
 
     def update(self) -> Status:
-        binding = self.bindings["key"]
-        key = binding.key if isinstance(binding, Ref) else str(self.get_input("key"))
-        self.blackboard.unset(key)
+        self.blackboard.unset(str(self.get_input("key")))
         return Status.SUCCESS
 
 
@@ -113,17 +156,20 @@ class UnsetBlackboard(ActionNode):
 class Sleep(ActionNode):
     """Returns RUNNING until ``msec`` milliseconds of the tree's clock have passed, then SUCCESS.
 
-    The first tick always returns RUNNING (SUCCESS at once when ``msec`` is 0). Halting it
-    stops the wait; the next start waits the full time again. A negative ``msec`` is refused
-    at load; read from the blackboard, it makes the node fail with the reason.
+    The first tick always returns RUNNING (SUCCESS at once when ``msec`` is 0). Its timer
+    emits the wake-up signal when the time is up (at the start of the next tick, see
+    ``TreeContext.start_timer``). Halting it cancels the wait; the next start waits the full
+    time again. A negative ``msec`` is refused at load; read from the blackboard, it makes the
+    node fail with the reason.
     """
 
-    INPUT_PORTS: ClassVar[Ports] = {
-        "msec": Port(int, description="milliseconds to wait", accepts=NON_NEGATIVE)}
+    INPUT_PORTS: ClassVar[Ports] = {"msec": Port(int, description="", accepts=NON_NEGATIVE)}
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"msec": "unsigned int"}
 
     def initialise(self) -> None:
         self._start_time = self.now()
         self._first = True
+        self._timer: int | None = None
 
     def update(self) -> Status:
         try:
@@ -133,8 +179,14 @@ class Sleep(ActionNode):
             return Status.FAILURE
         if self._first:
             self._first = False
-            return Status.SUCCESS if msec <= 0 else Status.RUNNING
+            if msec <= 0:
+                return Status.SUCCESS
+            self._timer = self.context.start_timer(msec / 1000.0)
+            return Status.RUNNING
         elapsed = self.now() - self._start_time
         if elapsed >= msec / 1000.0 - TIME_EPS:
             return Status.SUCCESS
         return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        self.context.cancel_timer(getattr(self, "_timer", None))

@@ -60,6 +60,9 @@ _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 _PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
 _BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
+# Enum members hash in Python code: the hot path maps statuses through identity lookups.
+_PY_BY_ID = {id(s): p for s, p in _PY_FROM_BT.items()}
+_LEAF_RESULT = {id(s): b for s, b in _BT_FROM_PY.items() if s is not Status.INVALID}
 
 
 class TreeRuntimeError(RuntimeError):
@@ -126,6 +129,7 @@ class BtNode(PortsMixin):
     """When the node last started (was ticked while IDLE) and last returned FAILURE, as ranks
     on one counter (0: never); they tell the failures of a node's last run from older ones
     (see :mod:`bt_manip.failure_cause`)."""
+    PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
@@ -257,9 +261,10 @@ class BtNode(PortsMixin):
         except KeyError:
             if default is not _MISSING:
                 return default
+            state = "has no value" if self.blackboard.exists(binding.key) else "does not exist"
             raise PortError(
                 f"{self.describe()}: input port '{port_name}' reads blackboard entry "
-                f"'{binding.key}', which does not exist") from None
+                f"'{binding.key}', which {state}") from None
         if isinstance(value, str) and info.data_type is not str:
             try:
                 value = convert_literal(value, info.data_type)
@@ -282,7 +287,10 @@ class BtNode(PortsMixin):
         binding = self.bindings.get(port_name)
         if not isinstance(binding, Ref):
             return False
-        self.blackboard.set(binding.key, value)
+        try:
+            self.blackboard.set(binding.key, value)
+        except ValueError as e:  # text that the entry's type cannot hold
+            raise PortError(f"{self.describe()}: output port '{port_name}': {e}") from None
         return True
 
     def _set_output(self, port_name: str, value: Any) -> None:
@@ -346,12 +354,21 @@ class BtNode(PortsMixin):
             self.failure_order = next(_ORDER)
         if new is not NodeStatus.SKIPPED:
             self.bt_status = new
-            self.status = _PY_FROM_BT[new]
+            self.status = _PY_BY_ID[id(new)]
         return new
 
     def tick_node(self) -> NodeStatus:
         """The node's own logic for one tick (BT.CPP's ``tick()``)."""
         raise NotImplementedError
+
+    def emit_wake_up(self) -> None:
+        """Ask the tree to tick again from the root within the same ``Tree.tick()``.
+
+        BT.CPP's ``emitWakeUpSignal()``: a node that returns RUNNING only to keep the tree
+        interruptible (a SequenceWithMemory whose child finished at once, a Repeat between two
+        cycles) emits it, and ``Tree.tick()`` re-ticks the root while one is pending.
+        """
+        self.context.wake_up = True
 
     def _fault_injected(self) -> bool:
         """Whether a seeded fault (``--inject NAME:failure:P``) makes this start fail."""
@@ -415,7 +432,15 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
     ``initialise()`` runs when the node starts (it was not RUNNING), ``terminate(status)`` once
     when it finishes (SUCCESS/FAILURE) or is halted while RUNNING (INVALID).
+
+    A ``STATEFUL`` leaf follows BT.CPP's ``StatefulActionNode``: it starts only from IDLE, so
+    when its parent ticks it again after it finished without resetting it (a WhileDoElse
+    condition while a branch runs, an IfThenElse condition after it failed), it returns the
+    status it finished with and runs nothing. Other leaves (BT.CPP's ``SyncActionNode`` and
+    ``ConditionNode``) run at every tick.
     """
+
+    STATEFUL: ClassVar[bool] = False
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name or self.NODE_ID)
@@ -423,14 +448,17 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
     def tick_node(self) -> NodeStatus:
         if self.status != _RUNNING:
+            if self.STATEFUL and self.bt_status is not NodeStatus.IDLE:
+                return self.bt_status
             self.initialise()
         result = self.update()
-        if result not in _BT_FROM_PY or result == Status.INVALID:
+        status = _LEAF_RESULT.get(id(result))
+        if status is None:
             raise TreeRuntimeError(f"{self.describe()}: update() returned {result!r}")
-        if result != _RUNNING:
+        if result is not _RUNNING:
             self.terminate(result)
         self.status = result
-        return _BT_FROM_PY[result]
+        return status
 
     def halt(self) -> None:
         if self.status == _RUNNING:
@@ -439,9 +467,23 @@ class LeafNode(BtNode, py_trees.behaviour.Behaviour):
 
 
 class ActionNode(LeafNode):
-    """Base class for actions (leaves that act; may return RUNNING)."""
+    """Base class for actions (leaves that act; may return RUNNING).
+
+    Actions are stateful (BT.CPP's ``StatefulActionNode``, see :class:`LeafNode`): ticked again
+    after they finished, without a reset in between, they return the same status.
+    """
 
     KIND = "Action"
+    STATEFUL = True
+
+
+class SyncActionNode(ActionNode):
+    """Base class for actions that finish within their tick (BT.CPP's ``SyncActionNode``).
+
+    They never return RUNNING and run again at every tick, even when not reset.
+    """
+
+    STATEFUL = False
 
 
 class ConditionNode(LeafNode):

@@ -182,10 +182,12 @@ class Unary(Expr):
     def eval(self, env: Variables) -> Any:
         v = self.operand.eval(env)
         if self.op == "!":
-            return not to_bool(v)
+            if isinstance(v, str):
+                raise ScriptRuntimeError("operator [!] cannot be used with a string")
+            return not to_number(v, "!")
         num = to_number(v, self.op)
         if self.op == "-":
-            return -num
+            return -float(num)
         return float(~int(num)) if isinstance(num, float) else ~int(num)
 
 
@@ -225,12 +227,20 @@ class IfElse(Expr):
 
     def eval(self, env: Variables) -> Any:
         c = self.cond.eval(env)
-        ok = len(c) > 0 if isinstance(c, str) else bool(to_number(c, "?"))
+        ok = bool(to_number(c, "?"))
         return self.then.eval(env) if ok else self.other.eval(env)
 
 
 @dataclass
 class Assign(Expr):
+    """``name := value``, ``name = value`` and ``name += value`` (and ``-= *= /=``).
+
+    As in BT.CPP, an entry keeps its type: text assigned to a number entry is converted to a
+    number, a number assigned to a text entry is an error, a non-integral number assigned to an
+    integer entry is an error; ``+= -= *= /=`` with a number need a number entry, and ``+=``
+    with text needs a text entry.
+    """
+
     op: str
     target: str
     value: Expr
@@ -238,28 +248,81 @@ class Assign(Expr):
 
     def eval(self, env: Variables) -> Any:
         key = self.target
-        exists = env.exists(key)
-        if not exists and self.op != ":=":
+        if not env.exists(key) and self.op != ":=":
             raise ScriptRuntimeError(
                 f"the blackboard entry [{key}] does not exist yet; use := to create it"
             )
         value = self.value.eval(env)
+        has_value = getattr(env, "has_value", env.exists)(key)
         if self.op in (":=", "="):
-            if exists:
-                old = env.get(key)
-                if isinstance(value, str) and _is_number(old):
-                    value = _string_to_number(value)
-            env.set(key, value)
+            if has_value:
+                value = _convert_for(key, env.get(key), value)
+            _store(env, key, value)
             return value
+        if not has_value:
+            raise ScriptRuntimeError(f"the entry [{key}] has no value to use with {self.op}")
         old = env.get(key)
-        if isinstance(value, str) and not _is_number(old):
+        if isinstance(value, str):
             if self.op != "+=":
                 raise ScriptRuntimeError(f"operator {self.op} cannot be used with strings")
-            new = to_text(old) + value
+            if not isinstance(old, str):
+                raise ScriptRuntimeError(
+                    f"{self.op} with a string cannot be used on entry [{key}], which holds "
+                    f"a {_type_label(old)}")
+            new: Any = old + value
         else:
+            if not _is_number(old) and not isinstance(old, bool):
+                raise ScriptRuntimeError(
+                    f"operator {self.op} cannot be used on entry [{key}], which holds a "
+                    f"{_type_label(old)} (not a number)")
             new = binary(self.op[0], to_number(old, self.op), to_number(value, self.op))
-        env.set(key, new)
+            new = _convert_for(key, old, new)
+        _store(env, key, new)
         return new
+
+
+def _store(env: Variables, key: str, value: Any) -> None:
+    try:
+        getattr(env, "assign", env.set)(key, value)
+    except ValueError as e:  # the entry's type cannot hold the value
+        raise ScriptRuntimeError(str(e)) from None
+
+
+def _type_label(value: Any) -> str:
+    if isinstance(value, bool):
+        return "bool"
+    if isinstance(value, int):
+        return "int"
+    if isinstance(value, float):
+        return "double"
+    if isinstance(value, str):
+        return "string"
+    return type(value).__name__
+
+
+def _convert_for(key: str, old: Any, value: Any) -> Any:
+    """``value`` as it can be stored in entry ``key`` holding ``old`` (BT.CPP's rules)."""
+    if isinstance(value, str):
+        if isinstance(old, str):
+            return value
+        if _is_number(old) or isinstance(old, bool):
+            return _string_to_number(value)
+        from_string = getattr(type(old), "from_string", None)
+        if callable(from_string):
+            return from_string(value)
+        raise ScriptRuntimeError(
+            f"cannot assign a string to entry [{key}], which holds a {_type_label(old)}")
+    if isinstance(old, str) and value is not None:
+        raise ScriptRuntimeError(
+            f"cannot assign a {_type_label(value)} to entry [{key}], which holds a string")
+    if type(old) is float and type(value) is int:  # a double entry stays double
+        return float(value)
+    if type(old) in (int, bool) and type(value) is float:
+        if not value.is_integer():
+            raise ScriptRuntimeError(
+                f"cannot assign {value} to entry [{key}], which holds a {_type_label(old)}")
+        return int(value)
+    return value
 
 
 @dataclass
@@ -314,18 +377,25 @@ def to_number(v: Any, op: str) -> int | float:
 
 
 def to_bool(v: Any) -> bool:
-    """BT.CPP's cast to bool: numbers are true when non-zero; 'true'/'false'/'1'/'0' strings."""
+    """BT.CPP's cast to bool (a condition's value): a bool, the integers 0 and 1, or a
+    non-negative real (true when non-zero). Other integers, negative numbers and strings (even
+    'true') are errors, as in BT.CPP."""
     if isinstance(v, bool):
         return v
-    if _is_number(v):
+    if isinstance(v, int):
+        if v < 0:
+            raise ScriptRuntimeError(f"{v} is negative and cannot be converted to a boolean")
+        if v > 1:
+            raise ScriptRuntimeError(
+                f"{v} cannot be converted to a boolean (only 0 and 1 can; compare it instead)")
+        return v == 1
+    if isinstance(v, float):
+        if v < 0:
+            raise ScriptRuntimeError(f"{v} is negative and cannot be converted to a boolean")
         return v != 0
     if isinstance(v, str):
-        low = v.strip().lower()
-        if low in ("true", "1"):
-            return True
-        if low in ("false", "0"):
-            return False
-        raise ScriptRuntimeError(f"cannot convert '{v}' to a boolean")
+        raise ScriptRuntimeError(
+            f"the string '{v}' cannot be converted to a boolean (compare it instead)")
     if v is None:
         raise ScriptRuntimeError("the script has no value to use as a condition")
     raise ScriptRuntimeError(f"cannot convert {type(v).__name__} to a boolean")
@@ -339,7 +409,22 @@ def to_text(v: Any) -> str:
     return str(v)
 
 
-def _arith(op: str, a: int | float, b: int | float) -> int | float:
+def concat_text(v: Any) -> str:
+    """Text of a value for ``..``, as BT.CPP converts it: ``true`` is "1", a real is written
+    with six decimals (``1 + 2`` gives "3.000000", ``2.5`` "2.500000"), an integer as is."""
+    if isinstance(v, bool):
+        return "1" if v else "0"
+    if isinstance(v, float):
+        if math.isfinite(v):
+            return f"{v:f}"
+        return "nan" if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    return to_text(v)
+
+
+def _arith(op: str, a: int | float, b: int | float) -> float:
+    """BT.CPP computes in double: ``1 + 2`` is 3.0 (stored as 3 into an int entry)."""
+    a = float(a)
+    b = float(b)
     if op == "+":
         return a + b
     if op == "-":
@@ -355,10 +440,16 @@ def _arith(op: str, a: int | float, b: int | float) -> int | float:
 
 def binary(op: str, lhs: Any, rhs: Any) -> Any:
     if op in ("&&", "||"):
-        a, b = to_bool(lhs), to_bool(rhs)
+        if isinstance(lhs, str) or isinstance(rhs, str):
+            raise ScriptRuntimeError(f"operation [{op}] is not permitted with strings")
+        try:
+            a, b = to_bool(lhs), to_bool(rhs)
+        except ScriptRuntimeError as e:
+            raise ScriptRuntimeError(f"operator [{op}] needs operands that are booleans: {e}"
+                                     ) from None
         return (a and b) if op == "&&" else (a or b)
     if op == "..":
-        return to_text(lhs) + to_text(rhs)
+        return concat_text(lhs) + concat_text(rhs)
     if op == "+" and isinstance(lhs, str) and isinstance(rhs, str):
         return lhs + rhs
     if isinstance(lhs, str) or isinstance(rhs, str):

@@ -6,13 +6,13 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
-from py_trees.common import Status
-
-from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.blackboard import Blackboard, EntryTypeError
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
+from bt_manip.bt.ports import Ref
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
+from bt_manip.errors import InputError
 
 
 @dataclass
@@ -36,9 +36,13 @@ class NodeRecord:
 class Tree:
     """A tree ready to tick.
 
-    ``tick()`` ticks the root once and returns a py_trees status; a root that was SKIPPED
-    (every node skipped) returns ``Status.INVALID`` (see :attr:`bt_status` for the BT.CPP
-    status). ``halt()`` stops every RUNNING node; each one's ``terminate(INVALID)`` runs once.
+    ``tick()`` is BT.CPP's ``Tree::tickOnce()``: it ticks the root, then ticks it again as long
+    as the root is RUNNING and a node asked for a wake-up (see :meth:`BtNode.emit_wake_up`);
+    ``tick_exactly_once()`` ticks the root once whatever is pending. Both return the root's
+    :class:`NodeStatus` (also kept in :attr:`bt_status`); a root that finished (SUCCESS or
+    FAILURE) is reset to IDLE afterwards, as in BT.CPP, so the next tick starts it again.
+    ``halt()`` is ``haltTree()``: every RUNNING node's ``terminate(INVALID)`` runs once, and
+    every node's ``_onHalted`` script runs.
     """
 
     def __init__(
@@ -66,14 +70,44 @@ class Tree:
         if isinstance(node, SubTree):
             self._wire(node.child, node.make_blackboard(bb))
             return
+        for port, binding in node.bindings.items():
+            if isinstance(binding, Ref):
+                info = node.port_info(port)
+                if info is not None:
+                    try:
+                        bb.declare(binding.key, info.data_type, node.PORT_TYPE_NAMES.get(port))
+                    except EntryTypeError as e:
+                        raise InputError.single(
+                            node.xml_file or self.source or "<tree>", node.xml_line,
+                            f"{node.NODE_ID} port '{port}': {e}") from None
         for child in node.bt_children():
             self._wire(child, bb)
 
-    def tick(self) -> Status:
-        """Tick the root once; returns its status as a py_trees status."""
+    def tick(self) -> NodeStatus:
+        """Tick the root, again while it is RUNNING and a wake-up is pending (``tickOnce``)."""
         self.tick_count += 1
-        self.bt_status = self.root.execute_tick()
-        return self.bt_status.to_py_trees()
+        root = self.root
+        context = self.context
+        if context.timers:
+            context.fire_timers()
+        status = root.execute_tick()
+        while status is NodeStatus.RUNNING and context.wake_up:
+            context.wake_up = False
+            status = root.execute_tick()
+        return self._finish(status)
+
+    def tick_exactly_once(self) -> NodeStatus:
+        """Tick the root once, even if a wake-up is pending (``tickExactlyOnce``)."""
+        self.tick_count += 1
+        if self.context.timers:
+            self.context.fire_timers()
+        return self._finish(self.root.execute_tick())
+
+    def _finish(self, status: NodeStatus) -> NodeStatus:
+        if status is NodeStatus.SUCCESS or status is NodeStatus.FAILURE:
+            self.root.reset_status()
+        self.bt_status = status
+        return status
 
     def tick_while_running(self, max_ticks: int = 1_000_000) -> NodeStatus:
         """Tick until the root is not RUNNING (or ``max_ticks``); for tests and scripts."""
@@ -86,10 +120,18 @@ class Tree:
         return status
 
     def halt(self) -> None:
-        """Halt every RUNNING node and make the whole tree IDLE."""
-        if self.root.bt_status is NodeStatus.RUNNING:
-            self.root.halt_node()
-        self.root.reset_status()
+        """Halt the whole tree and make it IDLE (BT.CPP's ``Tree::haltTree()``).
+
+        The root is halted (each RUNNING node's ``terminate(INVALID)`` runs once, then its
+        ``_onHalted``), then, as BT.CPP does to be sure, every node is halted again, parents
+        before children: a node's ``_onHalted`` script runs even if it was IDLE (twice for the
+        root and for the nodes that were RUNNING), while ``terminate`` never runs twice.
+        """
+        root = self.root
+        root.halt_node()
+        for node in self.nodes():
+            node.halt_node()
+        root.reset_status()
         self.bt_status = NodeStatus.IDLE
 
     def walk(self) -> Iterator[tuple[str, int, BtNode]]:

@@ -155,6 +155,13 @@ class _Checker:
         if n < lo or (hi is not None and n > hi):
             rule = children_rule(_Rule(lo, hi))  # type: ignore[arg-type]
             self.add(file, element, f"{spec.node_id} {rule}, found {n}")
+        if spec.node_id == "ReactiveSequence":  # BT.CPP's VerifyXML refuses these trees
+            async_children = [c for c in element.children if c.tag == "AsyncSequence"]
+            if len(async_children) > 1:
+                self.add(file, element,
+                         "a ReactiveSequence cannot have more than one AsyncSequence child "
+                         f"(found {len(async_children)}, as BehaviorTree.CPP requires); wrap "
+                         "them in one Sequence")
 
     def check_subtree(self, element: Element, tree: TreeDef, attributes: dict[str, str]) -> None:
         file = tree.file
@@ -358,7 +365,14 @@ def validate(path: str, models: Iterable[str] | None = None, tree_id: str | None
              text: str | None = None, reg: NodeRegistry | None = None
              ) -> tuple[list[Problem], list[Problem]]:
     """(problems, warnings) of a tree file: everything loading checks, without running."""
-    doc, _, problems = _prepare(path, text, models, tree_id, reg or registry, False)
+    reg = reg or registry
+    doc, main, problems = _prepare(path, text, models, tree_id, reg, False)
+    if not problems and main is not None:
+        allow_depth(_Builder.depth_of(doc, main))
+        try:  # building the tree checks the types of the entries that ports share
+            Tree(_Builder(doc, reg, True).tree_root(main), tree_id=main, source=path)
+        except InputError as e:
+            problems = list(e.problems)
     return problems, doc.warnings
 
 

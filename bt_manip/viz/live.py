@@ -30,7 +30,7 @@ from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
 from bt_manip.viz.overlay import FrameItem
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
-from bt_manip.viz.tree_state import FAILURE, STATUS_NAMES, TreeWatcher
+from bt_manip.viz.tree_state import FAILURE, TreeWatcher, run_result
 
 OVERLAY_ROOT = "/meshcat/bt_manip_overlay"
 HIGHLIGHT_RGBA = (0.15, 0.95, 0.55, 1.0)
@@ -282,8 +282,7 @@ class LiveViewer:
         sim_time = float(getattr(runner, "sim_time", 0.0)) if runner is not None else 0.0
         ticks = int(getattr(runner, "ticks", 0)) if runner is not None else 0
         statuses = list(self.watcher.statuses)
-        root = STATUS_NAMES[statuses[0]] if statuses else ""
-        result = root if root in ("SUCCESS", "FAILURE") else ""
+        result = run_result(self.watcher)
         self.state.publish(sim_time, ticks, statuses, list(self.watcher.reasons), result,
                            self._failures)
 

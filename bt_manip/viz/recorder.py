@@ -30,7 +30,7 @@ import numpy as np
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.overlay import FrameItem, item_json
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, SceneObject
-from bt_manip.viz.tree_state import TreeWatcher
+from bt_manip.viz.tree_state import TreeWatcher, run_result
 
 
 @dataclass
@@ -217,9 +217,9 @@ class Recorder:
             self._appeared = False
             self._sample(t)
         self._track_overlay(t)
-        root = self.watcher.statuses[0] if self.watcher.statuses else 0
-        if root in (2, 3):
-            self.rec.result = "SUCCESS" if root == 2 else "FAILURE"
+        result = run_result(self.watcher)
+        if result:
+            self.rec.result = result
 
     # -- output -----------------------------------------------------------------------------
     def close(self) -> None:

@@ -106,6 +106,19 @@ def shown_status(status: int, last: int) -> int:
     return status
 
 
+def run_result(watcher: TreeWatcher) -> str:
+    """'SUCCESS' or 'FAILURE' once the last tick finished the tree, else ''.
+
+    Read from the tree's last tick result (``bt_status``): a root that finished is reset to
+    IDLE by the tick, as in BehaviorTree.CPP, so its node status no longer shows it.
+    """
+    status = getattr(watcher.tree, "bt_status", None)
+    name = getattr(status, "name", None)
+    if name is None:
+        name = STATUS_NAMES[watcher.statuses[0]] if watcher.statuses else ""
+    return name if name in ("SUCCESS", "FAILURE") else ""
+
+
 def status_code(name: Any) -> int:
     """The page's code of a status name (py_trees or BehaviorTree.CPP spelling)."""
     text = getattr(name, "name", name)

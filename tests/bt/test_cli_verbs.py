@@ -11,7 +11,7 @@ import pytest
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt import ActionNode, ConditionNode, TreeContext, load_tree, registry
+from bt_manip.bt import ActionNode, ConditionNode, NodeStatus, TreeContext, load_tree, registry
 from bt_manip.bt.cli_verbs import add_verbs
 from bt_manip.bt.display import render_status
 from bt_manip.bt.documents import Document, read_model_file
@@ -140,7 +140,7 @@ def test_custom_node_in_a_tree(custom_nodes: None) -> None:
     t = load_tree_string('<root BTCPP_format="4"><BehaviorTree ID="T"><Sequence>'
                          '<MoveTo goal="1;2;0.5" reached="{ok}"/><GraspCheck object="box"/>'
                          "</Sequence></BehaviorTree></root>")
-    assert t.tick() == Status.SUCCESS
+    assert t.tick() is NodeStatus.SUCCESS
     assert t.blackboard.as_dict() == {"ok": True}
     assert t.root.children[0].get_input("goal") == [1.0, 2.0, 0.5]
 

@@ -147,7 +147,11 @@ CONTROLS = [
     Case("switch6_last_case",
          '<Switch6 variable="{v}" case_1="1" case_2="2" case_3="3" case_4="4" case_5="5" '
          'case_6="6">' + "".join(f'<Script code="r := {i}"/>' for i in range(1, 8))
-         + "</Switch6>", [S("SUCCESS", bb={"r": 6})], init={"v": 6}),
+         + "</Switch6>", [S("SUCCESS", bb={"r": 6})], init={"v": "6"}),
+    Case("switch_compares_a_number_text_as_a_number",
+         '<Switch2 variable="{v}" case_1="1" case_2="2.0"><Script code="r := 1"/>'
+         '<Script code="r := 2"/><Script code="r := 3"/></Switch2>',
+         [S("SUCCESS", bb={"r": 2})], init={"v": "2"}),
 ]
 
 DECORATORS = [
