@@ -179,3 +179,19 @@ def test_groot_model_lists_the_robot_nodes_with_their_ports(
         main(["validate", str(ROOT / "trees" / "husky_carry_wall.xml"), "--models", str(model)])
         == 0
     )
+
+
+def test_bb_numbers_feed_ports_of_any_number_type_and_scripts(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # `--bb t=3` holds the integer 3; a double port (CloseGripper's timeout) reads it, and a
+    # script computes with it, as with an entry a script created
+    tree = _tree(
+        tmp_path,
+        '    <Sequence><CloseGripper timeout="{t}"/><Script code="u := t + 0.5"/></Sequence>',
+    )
+    bb = tmp_path / "bb.json"
+    code = main(["run", str(tree), "--world", str(TABLE), "--quiet", "--bb", "t=3",
+                 "--bb-out", str(bb)])
+    assert code == 0, capsys.readouterr()
+    assert json.loads(bb.read_text())["u"] == 3.5
