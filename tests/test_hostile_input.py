@@ -145,6 +145,7 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         '      <Navigate goal="nan;0;0"/>',
         '      <Navigate goal="kitchen"/>',  # fine: a pose name is looked up at run time
         '      <MoveToPose position="1;2" orientation="0;0;1"/>',
+        '      <Delay delay_msec="-5"><AlwaysSuccess/></Delay>',
         "    </Sequence>",
     ]))
     runtime = _tree(tmp_path / "runtime.xml", "\n".join([
@@ -268,6 +269,7 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         "got 2",
         f"{literals}:15: bad value for port 'orientation' of MoveToPose: must hold 4 values, "
         "got 3",
+        f"{literals}:16: bad value for port 'delay_msec' of Delay: must be >= 0, got -5",
     ]
     for result in (val_lit, run_lit):
         assert result["code"] == 2

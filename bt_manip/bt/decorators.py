@@ -262,12 +262,13 @@ class Delay(_Decorator):
 
     The wait starts at the first tick, which always returns RUNNING (even with 0 ms: BT.CPP
     starts a timer there and looks at it again at the next tick). Once the time has passed,
-    the child is ticked and its status returned; the next start waits again.
+    the child is ticked and its status returned; the next start waits again. A negative
+    ``delay_msec`` is refused at load (an unsigned int in BT.CPP).
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "delay_msec": PortInformation(
-            int, description="Tick the child after a few milliseconds"),
+        "delay_msec": Port(
+            int, description="Tick the child after a few milliseconds", accepts=NON_NEGATIVE),
     }
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"delay_msec": "unsigned int"}
 
@@ -279,7 +280,12 @@ class Delay(_Decorator):
         self._timer: int | None = None
 
     def tick_node(self) -> NodeStatus:
-        delay = self.get_input("delay_msec")
+        try:
+            delay = self.get_input("delay_msec")
+        except PortError as e:  # a blackboard value it cannot take
+            self._started = False
+            self.feedback_message = str(e)
+            return FAILURE
         if not self._started:
             self._started = True
             self._start()
