@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import struct
 import zlib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,6 +36,9 @@ DEFAULT_BAND: ZBand = (0.02, 2.0)
 
 MAX_CELLS = 25_000_000
 """Largest grid built (cells): at 0.05 m, a world of 250 m x 250 m."""
+
+BLOCK_CELLS = 1 << 18
+"""Cells tested at a time when a shape is drawn (bounds the temporaries of a large shape)."""
 
 _EPS = 1e-9
 
@@ -129,8 +132,11 @@ class OccupancyGrid:
         return 0 <= cell[0] < rows and 0 <= cell[1] < cols
 
     # -- drawing ---------------------------------------------------------------------------------
-    def cells_of(self, outline: Outline) -> np.ndarray:
-        """Flat indices of the cells whose squares overlap ``outline`` with positive area."""
+    def _hit_blocks(self, outline: Outline) -> Iterator[tuple[int, int, np.ndarray]]:
+        """``(first row, first column, hit)`` per block of rows of the outline's bounding box:
+        ``hit`` marks the cells whose squares overlap ``outline`` with positive area. Blocks
+        hold at most :data:`BLOCK_CELLS` cells, so a shape as large as the grid needs no
+        temporaries the size of the grid."""
         rows, cols = self.shape
         res = self.resolution
         x0, y0 = self.origin
@@ -140,23 +146,37 @@ class OccupancyGrid:
         r0 = max(0, math.floor((ymin - y0) / res))
         r1 = min(rows - 1, math.floor((ymax - y0) / res))
         if c0 > c1 or r0 > r1:
-            return np.zeros(0, np.int64)
-        cc, rr = np.meshgrid(np.arange(c0, c1 + 1), np.arange(r0, r1 + 1))
-        lx = x0 + cc * res
-        ly = y0 + rr * res
-        if isinstance(outline, Disc):
-            hit = _disc_hits(outline, lx, ly, res)
-        else:
-            hit = _polygon_hits(outline, lx, ly, res)
-        return (rr[hit] * cols + cc[hit]).astype(np.int64)
+            return
+        lx = x0 + np.arange(c0, c1 + 1)[None, :] * res
+        step = max(1, BLOCK_CELLS // (c1 - c0 + 1))
+        for ra in range(r0, r1 + 1, step):
+            ly = y0 + np.arange(ra, min(r1 + 1, ra + step))[:, None] * res
+            if isinstance(outline, Disc):
+                hit = _disc_hits(outline, lx, ly, res)
+            else:
+                hit = _polygon_hits(outline, lx, ly, res)
+            yield ra, c0, hit
+
+    def cells_of(self, outline: Outline) -> np.ndarray:
+        """Flat indices of the cells whose squares overlap ``outline`` with positive area."""
+        cols = self.shape[1]
+        parts = [np.zeros(0, np.int64)]
+        for ra, c0, hit in self._hit_blocks(outline):
+            rr, cc = np.nonzero(hit)
+            parts.append((rr + ra).astype(np.int64) * cols + (cc + c0))
+        return np.concatenate(parts)
 
     def mark(self, outlines: Iterable[Outline], source: int | None = None) -> None:
         """Mark the cells of ``outlines`` occupied (remembered under ``source`` if given)."""
-        idx = [self.cells_of(o) for o in outlines]
-        flat = np.unique(np.concatenate(idx)) if idx else np.zeros(0, np.int64)
-        self.occupied.reshape(-1)[flat] = True
         if source is not None:
+            idx = [self.cells_of(o) for o in outlines]
+            flat = np.unique(np.concatenate(idx)) if idx else np.zeros(0, np.int64)
+            self.occupied.reshape(-1)[flat] = True
             self.sources[source] = flat
+            return
+        for outline in outlines:
+            for ra, c0, hit in self._hit_blocks(outline):
+                self.occupied[ra : ra + hit.shape[0], c0 : c0 + hit.shape[1]] |= hit
 
     def occupied_by(self, body: int) -> np.ndarray:
         """(n, 2) cells marked for ``body`` (empty if it was not drawn as a source)."""
@@ -174,21 +194,20 @@ class OccupancyGrid:
 
 
 def _disc_hits(d: Disc, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
-    """Cells (lower-left corners lx, ly) whose square overlaps the disc's interior."""
+    """Cells (lower-left corners lx (1, n), ly (m, 1)) whose square overlaps the disc's
+    interior, as an (m, n) mask."""
     nx = np.clip(d.cx, lx, lx + res)
     ny = np.clip(d.cy, ly, ly + res)
     return (nx - d.cx) ** 2 + (ny - d.cy) ** 2 < (d.radius - _EPS) ** 2
 
 
 def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
-    """Separating-axis test of each cell square against a convex polygon (strict overlap)."""
+    """Separating-axis test of each cell square against a convex polygon (strict overlap);
+    lower-left corners lx (1, n) and ly (m, 1), an (m, n) mask."""
     v = p.vertices
     xmin, ymin, xmax, ymax = p.extent()
-    hit = (
-        (lx < xmax - _EPS)
-        & (lx + res > xmin + _EPS)
-        & (ly < ymax - _EPS)
-        & (ly + res > ymin + _EPS)
+    hit = ((lx < xmax - _EPS) & (lx + res > xmin + _EPS)) & (
+        (ly < ymax - _EPS) & (ly + res > ymin + _EPS)
     )
     n = len(v)
     for i in range(n):
@@ -272,15 +291,17 @@ def rasterise(
     extent: tuple[float, float, float, float] | None = None,
     movable: Sequence[int] = (),
     pad: float = 0.5,
+    remember: bool = True,
 ) -> OccupancyGrid:
     """Occupancy grid of the collision shapes of ``obstacles`` (and ``movable``) in ``band``.
 
     ``extent`` defaults to the bounding rectangle of the obstacles, padded by ``pad``. Each
-    body's cells are remembered (:attr:`OccupancyGrid.sources`).
+    body's cells are remembered (:attr:`OccupancyGrid.sources`) unless ``remember`` is False
+    (then a shape is drawn straight into the grid, with no list of its cells).
     """
     if extent is None:
         extent = bodies_extent(client, list(obstacles) + list(movable), pad)
     grid = OccupancyGrid.empty(extent, resolution, band)
     for body in list(obstacles) + list(movable):
-        grid.mark(body_outlines(client, body, band), source=body)
+        grid.mark(body_outlines(client, body, band), source=body if remember else None)
     return grid

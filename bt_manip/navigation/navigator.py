@@ -111,7 +111,11 @@ class Navigator:
         )
         self.band: ZBand = options.band or (0.02, robot_top(robot) + 0.05)
         self.static: OccupancyGrid = rasterise(
-            self.client, list(obstacles), resolution=options.resolution, band=self.band
+            self.client,
+            list(obstacles),
+            resolution=options.resolution,
+            band=self.band,
+            remember=False,
         )
         self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.footprint = self.base_footprint
@@ -133,17 +137,41 @@ class Navigator:
         """Where the base turns about on the spot (m ahead of its frame)."""
 
     # -- map --------------------------------------------------------------------------------
-    def _compose(self) -> OccupancyGrid:
-        grid = self.static.copy()
+    def _movable_cells(self) -> dict[int, np.ndarray]:
+        """Per movable object not carried, the flat indices of the cells it occupies now."""
+        cells: dict[int, np.ndarray] = {}
         for body in self.movable:
             if body not in self.attached:
-                grid.mark(body_outlines(self.client, body, self.band), source=body)
+                outlines = body_outlines(self.client, body, self.band)
+                parts = [self.static.cells_of(o) for o in outlines]
+                cells[body] = np.unique(np.concatenate(parts)) if parts else np.zeros(0, np.int64)
+        return cells
+
+    def _compose(self, cells: dict[int, np.ndarray] | None = None) -> OccupancyGrid:
+        """The static grid with the movable objects drawn in (the static grid itself, not a
+        copy, when there are none: it is never drawn on)."""
+        if cells is None:
+            cells = self._movable_cells()
+        if not cells:
+            return self.static
+        s = self.static
+        grid = OccupancyGrid(s.origin, s.resolution, s.occupied.copy(), s.band)
+        flat = grid.occupied.reshape(-1)
+        for body, idx in cells.items():
+            flat[idx] = True
+            grid.sources[body] = idx
         return grid
 
     def refresh(self) -> bool:
         """Redraw the movable objects; True if the occupied cells changed."""
-        grid = self._compose()
-        if np.array_equal(grid.occupied, self.costmap.grid.occupied):
+        cells = self._movable_cells()
+        old = self.costmap.grid
+        if cells.keys() == old.sources.keys() and all(
+            np.array_equal(idx, old.sources[b]) for b, idx in cells.items()
+        ):
+            return False  # the same cells drawn on the same static grid
+        grid = self._compose(cells)
+        if np.array_equal(grid.occupied, old.occupied):
             return False
         self.costmap = self.costmap.with_grid(grid)
         return True
@@ -213,8 +241,10 @@ class Navigator:
         bodies = list(self._obstacles) + movers
         ext = self.static.extent
         res = self.options.resolution
-        low = rasterise(c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext)
-        high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext)
+        low = rasterise(
+            c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext, remember=False
+        )
+        high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
         self._carry = (low_fp, high_fp, low, clearance(low), clearance(high))
 
     # -- planning and following ---------------------------------------------------------------
