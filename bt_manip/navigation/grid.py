@@ -186,7 +186,8 @@ class OccupancyGrid:
     # -- output ----------------------------------------------------------------------------------
     def save_png(self, path: str | Path, path_cells: np.ndarray | None = None) -> None:
         """Write the grid as a PNG, north up: occupied black, free white, a path in red."""
-        img = np.where(self.occupied[..., None], 0, 255).astype(np.uint8).repeat(3, axis=2)
+        img = np.empty((*self.shape, 3), np.uint8)
+        img[...] = np.where(self.occupied, np.uint8(0), np.uint8(255))[..., None]
         if path_cells is not None and len(path_cells):
             p = np.asarray(path_cells)
             img[p[:, 0], p[:, 1]] = (220, 30, 30)
@@ -228,7 +229,8 @@ def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.
 def write_png(path: str | Path, rgb: np.ndarray) -> None:
     """Write an (h, w, 3) uint8 image as PNG with numpy and zlib only."""
     h, w, _ = rgb.shape
-    raw = b"".join(b"\x00" + rgb[i].tobytes() for i in range(h))
+    rows = np.zeros((h, 1 + 3 * w), np.uint8)  # each row: filter byte 0, then the pixels
+    rows[:, 1:] = rgb.reshape(h, 3 * w)
 
     def chunk(tag: bytes, data: bytes) -> bytes:
         body = tag + data
@@ -238,7 +240,7 @@ def write_png(path: str | Path, rgb: np.ndarray) -> None:
 
     png = b"\x89PNG\r\n\x1a\n"
     png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(raw, 6))
+    png += chunk(b"IDAT", zlib.compress(rows, 6))
     png += chunk(b"IEND", b"")
     Path(path).write_bytes(png)
 
@@ -252,13 +254,16 @@ def save_cost_png(
     blue, a path in red."""
     finite = np.isfinite(cost)
     top = float(cost[finite].max()) if finite.any() else 1.0
-    shade = np.zeros(cost.shape)
-    if top > 1.0:
-        shade[finite] = (cost[finite] - 1.0) / (top - 1.0)
     img = np.empty((*cost.shape, 3), np.uint8)
-    img[..., 0] = (255 * (1.0 - 0.8 * shade)).astype(np.uint8)
-    img[..., 1] = (255 * (1.0 - 0.6 * shade)).astype(np.uint8)
     img[..., 2] = 255
+    for a in range(0, cost.shape[0], max(1, BLOCK_CELLS // max(1, cost.shape[1]))):
+        block = slice(a, a + max(1, BLOCK_CELLS // max(1, cost.shape[1])))
+        ok = finite[block]
+        shade = np.zeros(ok.shape)
+        if top > 1.0:
+            shade[ok] = (cost[block][ok] - 1.0) / (top - 1.0)
+        img[block, :, 0] = (255 * (1.0 - 0.8 * shade)).astype(np.uint8)
+        img[block, :, 1] = (255 * (1.0 - 0.6 * shade)).astype(np.uint8)
     img[~finite] = 0
     if path_cells is not None and len(path_cells):
         p = np.asarray(path_cells)
