@@ -123,14 +123,31 @@ def _heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> tuple[float, int
 
 
 @numba.njit(cache=True)
+def _grown(a: np.ndarray, n: int) -> np.ndarray:
+    """A copy of the 1-D array ``a`` with room for ``n`` entries (the new ones uninitialised)."""
+    out = np.empty(n, a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@numba.njit(cache=True)
+def _grown_rows(a: np.ndarray, n: int) -> np.ndarray:
+    """A copy of the 2-D array ``a`` with room for ``n`` rows (the new ones uninitialised)."""
+    out = np.empty((n, a.shape[1]), a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@numba.njit(cache=True)
 def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
     """Shortest 8-connected distance (cells, no corner cutting) from every free cell to goal."""
     rows, cols = free.shape
     dist = np.full((rows, cols), np.inf)
     if not free[goal_r, goal_c]:
         return dist
-    heap_d = np.empty(rows * cols * 4 + 8)
-    heap_i = np.empty(rows * cols * 4 + 8, np.int64)
+    limit = rows * cols * 4 + 8  # most entries the heap may hold
+    heap_d = np.empty(min(limit, 1 << 16))
+    heap_i = np.empty(heap_d.shape[0], np.int64)
     size = 0
     dist[goal_r, goal_c] = 0.0
     heap_d[0] = 0.0
@@ -153,8 +170,11 @@ def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
             if k >= 4 and not (free[nr, c] and free[r, nc]):
                 continue
             nd = d + (sq2 if k >= 4 else 1.0)
-            if nd < dist[nr, nc] and size < heap_d.shape[0]:
+            if nd < dist[nr, nc] and size < limit:
                 dist[nr, nc] = nd
+                if size == heap_d.shape[0]:  # grow the heap (it starts small)
+                    heap_d = _grown(heap_d, min(limit, 2 * size))
+                    heap_i = _grown(heap_i, heap_d.shape[0])
                 size = _heap_push(heap_d, heap_i, size, nd, nr * cols + nc)
     return dist
 
@@ -257,12 +277,15 @@ def _search(
     pivot = params[11]
     rows, cols = clear.shape
     bx = math.ceil(cols * res / xyb) + 1
-    by = math.ceil(rows * res / xyb) + 1
-    nstates = bx * by * nh
-    best = np.full(nstates, np.inf)
-    parent = np.full(nstates, -1, np.int64)
-    move_of = np.full(nstates, -1, np.int64)
-    pose = np.zeros((nstates, 3))
+    # States are stored in the order they are first reached (slots), found by their bin key:
+    # memory grows with the search, not with the number of bins of a large map.
+    slot_of = numba.typed.Dict.empty(key_type=numba.types.int64, value_type=numba.types.int64)
+    room = 1 << 12
+    best = np.empty(room)
+    parent = np.empty(room, np.int64)
+    move_of = np.empty(room, np.int64)
+    pose = np.empty((room, 3))
+    used = 0
     cap = 1 << 16
     hf = np.empty(cap)
     hi = np.empty(cap, np.int64)
@@ -283,8 +306,12 @@ def _search(
         d = hfield[row, col]
         return d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
 
-    k0 = key(start[0], start[1], start[2])
+    k0 = 0
+    slot_of[key(start[0], start[1], start[2])] = k0
+    used = 1
     best[k0] = 0.0
+    parent[k0] = -1
+    move_of[k0] = -1
     pose[k0, 0] = start[0]
     pose[k0, 1] = start[1]
     pose[k0, 2] = start[2]
@@ -340,10 +367,22 @@ def _search(
                     break
             if not ok:
                 continue
-            nk = key(nx, ny, nt)
+            bin_key = key(nx, ny, nt)
             ng = g + costs[m]
-            if ng >= best[nk]:
-                continue
+            nk = np.int64(-1)
+            if bin_key in slot_of:
+                nk = slot_of[bin_key]
+                if ng >= best[nk]:
+                    continue
+            else:
+                if used == best.shape[0]:
+                    best = _grown(best, 2 * used)
+                    parent = _grown(parent, 2 * used)
+                    move_of = _grown(move_of, 2 * used)
+                    pose = _grown_rows(pose, 2 * used)
+                nk = used
+                used += 1
+                slot_of[bin_key] = nk
             best[nk] = ng
             parent[nk] = k
             move_of[nk] = m
