@@ -138,33 +138,46 @@ def _grown_rows(a: np.ndarray, n: int) -> np.ndarray:
     return out
 
 
+# Neighbour order of the goal field: four sides, then the four diagonals.
+DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
+DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
+
+
 @numba.njit(cache=True)
-def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
-    """Shortest 8-connected distance (cells, no corner cutting) from every free cell to goal."""
+def _settle(
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
+    row: int,
+    col: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Run the goal's Dijkstra search on ``free`` cells until cell (row, col) has its final
+    distance, or until the search is over (``row`` -1 runs it to the end).
+
+    ``dist`` holds the distances so far (cells, 8-connected, no corner cutting; ``inf`` where
+    not reached), ``heap_d``/``heap_i`` the open list and ``state[0]`` its size,
+    ``frontier[0]`` the last distance taken from it: every distance up to the frontier is
+    final, since later entries only add to larger ones. Pausing leaves the order of the work
+    unchanged, so the distances are those of one search run to the end. Returns the open list
+    (grown if it had to be)."""
     rows, cols = free.shape
-    dist = np.full((rows, cols), np.inf)
-    if not free[goal_r, goal_c]:
-        return dist
-    limit = rows * cols * 4 + 8  # most entries the heap may hold
-    heap_d = np.empty(min(limit, 1 << 16))
-    heap_i = np.empty(heap_d.shape[0], np.int64)
-    size = 0
-    dist[goal_r, goal_c] = 0.0
-    heap_d[0] = 0.0
-    heap_i[0] = goal_r * cols + goal_c
-    size = 1
-    dr = (-1, 1, 0, 0, -1, -1, 1, 1)
-    dc = (0, 0, -1, 1, -1, 1, -1, 1)
+    limit = rows * cols * 4 + 8  # most entries the open list may hold
+    size = state[0]
+    front = frontier[0]
     sq2 = math.sqrt(2.0)
-    while size > 0:
+    while size > 0 and (row < 0 or not dist[row, col] <= front):
         d, node, size = _heap_pop(heap_d, heap_i, size)
+        front = d
         r = node // cols
         c = node % cols
         if d > dist[r, c]:
             continue
         for k in range(8):
-            nr = r + dr[k]
-            nc = c + dc[k]
+            nr = r + DR8[k]
+            nc = c + DC8[k]
             if nr < 0 or nr >= rows or nc < 0 or nc >= cols or not free[nr, nc]:
                 continue
             if k >= 4 and not (free[nr, c] and free[r, nc]):
@@ -172,11 +185,65 @@ def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
             nd = d + (sq2 if k >= 4 else 1.0)
             if nd < dist[nr, nc] and size < limit:
                 dist[nr, nc] = nd
-                if size == heap_d.shape[0]:  # grow the heap (it starts small)
+                if size == heap_d.shape[0]:  # grow the open list (it starts small)
                     heap_d = _grown(heap_d, min(limit, 2 * size))
                     heap_i = _grown(heap_i, heap_d.shape[0])
                 size = _heap_push(heap_d, heap_i, size, nd, nr * cols + nc)
-    return dist
+    state[0] = size
+    frontier[0] = front
+    return heap_d, heap_i
+
+
+class _GoalField:
+    """The goal's distance field, computed as far as the pose search asks (see
+    :func:`_settle`)."""
+
+    def __init__(self, free: np.ndarray, goal: tuple[int, int] | None) -> None:
+        self.free = free
+        self.dist = np.full(free.shape, np.inf)
+        self.heap_d = np.empty(1 << 12)
+        self.heap_i = np.empty(1 << 12, np.int64)
+        self.state = np.zeros(1, np.int64)
+        self.frontier = np.full(1, -1.0)
+        if goal is not None and free[goal]:
+            self.dist[goal] = 0.0
+            self.heap_d[0] = 0.0
+            self.heap_i[0] = goal[0] * free.shape[1] + goal[1]
+            self.state[0] = 1
+
+    def whole(self) -> np.ndarray:
+        """The distance of every cell (the search run to the end)."""
+        self.heap_d, self.heap_i = _settle(
+            self.free, self.dist, self.heap_d, self.heap_i, self.state, self.frontier, -1, -1
+        )
+        return self.dist
+
+
+@numba.njit(cache=True)
+def _heuristic(
+    x: float,
+    y: float,
+    x0: float,
+    y0: float,
+    res: float,
+    goal: np.ndarray,
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """Obstacle-aware distance (m) from (x, y) to the goal, and the open list of the field."""
+    rows, cols = dist.shape
+    col = math.floor((x - x0) / res)
+    row = math.floor((y - y0) / res)
+    if row < 0 or row >= rows or col < 0 or col >= cols:
+        return np.inf, heap_d, heap_i
+    heap_d, heap_i = _settle(free, dist, heap_d, heap_i, state, frontier, row, col)
+    d = dist[row, col]
+    h = d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
+    return h, heap_d, heap_i
 
 
 @numba.njit(cache=True)
@@ -258,7 +325,12 @@ def _search(
     pts_high: np.ndarray,
     reach: float,
     need: float,
-    hfield: np.ndarray,
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
     start: np.ndarray,
     goal: np.ndarray,
     params: np.ndarray,
@@ -275,7 +347,7 @@ def _search(
     maxexp = int(params[9])
     spacing = params[10]
     pivot = params[11]
-    rows, cols = clear.shape
+    cols = clear.shape[1]
     bx = math.ceil(cols * res / xyb) + 1
     # States are stored in the order they are first reached (slots), found by their bin key:
     # memory grows with the search, not with the number of bins of a large map.
@@ -298,14 +370,6 @@ def _search(
         ih = math.floor(((th % two_pi) / two_pi) * nh + 0.5) % nh
         return (iy * bx + ix) * nh + ih
 
-    def heur(x: float, y: float) -> float:
-        col = math.floor((x - x0) / res)
-        row = math.floor((y - y0) / res)
-        if row < 0 or row >= rows or col < 0 or col >= cols:
-            return np.inf
-        d = hfield[row, col]
-        return d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
-
     k0 = 0
     slot_of[key(start[0], start[1], start[2])] = k0
     used = 1
@@ -315,7 +379,9 @@ def _search(
     pose[k0, 0] = start[0]
     pose[k0, 1] = start[1]
     pose[k0, 2] = start[2]
-    hf[0] = heur(start[0], start[1])
+    hf[0], heap_d, heap_i = _heuristic(
+        start[0], start[1], x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+    )
     hi[0] = k0
     size = 1
     expanded = 0
@@ -341,7 +407,10 @@ def _search(
         y = pose[k, 1]
         th = pose[k, 2]
         g = best[k]
-        if f > g + heur(x, y) + 1e-9:
+        h, heap_d, heap_i = _heuristic(
+            x, y, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+        )
+        if f > g + h + 1e-9:
             continue  # stale
         dyaw = (th - goal[2] + math.pi) % two_pi - math.pi
         if math.hypot(x - goal[0], y - goal[1]) <= gxy and abs(dyaw) <= gyaw:
@@ -396,7 +465,10 @@ def _search(
                 nhi[:size] = hi
                 hf = nhf
                 hi = nhi
-            nf = ng + heur(nx, ny)
+            h, heap_d, heap_i = _heuristic(
+                nx, ny, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+            )
+            nf = ng + h
             size = _heap_push(hf, hi, size, nf, nk)
     return parent, move_of, pose, -1, expanded
 
@@ -444,9 +516,7 @@ def plan_poses(
         return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
     free = clear >= footprint.half_width + o.min_clearance
     gc = grid.world_to_cell(goal[0], goal[1])
-    hfield = (
-        _distance_field(free, gc[0], gc[1]) if grid.inside(gc) else np.full(clear.shape, np.inf)
-    )
+    field = _GoalField(free, gc if grid.inside(gc) else None)
     params = np.array(
         [
             o.step,
@@ -473,7 +543,12 @@ def plan_poses(
         pts_high,
         reach,
         need,
-        hfield,
+        field.free,
+        field.dist,
+        field.heap_d,
+        field.heap_i,
+        field.state,
+        field.frontier,
         np.asarray(start, float),
         np.asarray(goal, float),
         params,
