@@ -26,7 +26,10 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
+from numba import types
+from numba.extending import overload
 
+from bt_manip.navigation.costmap import CHUNK_CELLS, clearance_of
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import OccupancyGrid
 
@@ -246,6 +249,36 @@ def _heuristic(
     return h, heap_d, heap_i
 
 
+def _clearance_value(value: float | int, res: float) -> float:
+    """A cell's clearance (m) from its entry in a clearance grid (m) or in a grid of squared
+    cell distances (integers, :func:`bt_manip.navigation.distance.squared_distances`)."""
+    if isinstance(value, float | np.floating):
+        return float(value)
+    return math.sqrt(float(value)) * res - res / math.sqrt(2.0)
+
+
+@overload(_clearance_value, jit_options={"cache": True})
+def _clearance_value_jit(value, res):  # type: ignore[no-untyped-def]  # numba wants them bare
+    """The compiled :func:`_clearance_value` for the cell type of the grid."""
+    if isinstance(value, types.Float):
+        return lambda value, res: value
+    # the float64 operations of costmap.clearance_of, so the same value to the last bit
+    return lambda value, res: math.sqrt(float(value)) * res - res / math.sqrt(2.0)
+
+
+def clearance_at_least(clear: np.ndarray, res: float, threshold: float) -> np.ndarray:
+    """Cells whose clearance is at least ``threshold`` (m), from a clearance grid or squared
+    cell distances (converted a block of rows at a time)."""
+    if clear.dtype.kind == "f":
+        return clear >= threshold
+    out = np.empty(clear.shape, bool)
+    step = max(1, CHUNK_CELLS // max(1, clear.shape[1]))
+    for a in range(0, clear.shape[0], step):
+        block = clear[a : a + step]
+        out[a : a + step] = clearance_of(block, block.shape, res) >= threshold
+    return out
+
+
 @numba.njit(cache=True)
 def _points_free(
     clear: np.ndarray,
@@ -268,7 +301,7 @@ def _points_free(
         row = math.floor((py - y0) / res)
         if row < 0 or row >= rows or col < 0 or col >= cols:
             return False
-        if clear[row, col] < need:
+        if _clearance_value(clear[row, col], res) < need:
             return False
     return True
 
@@ -488,7 +521,9 @@ def plan_poses(
 
     ``footprint`` (the robot) is checked against ``clear``; ``carried`` (objects held above
     the floor) against ``clear_high``, the clearance of the obstacles tall enough to reach
-    them, so a panel may pass over a low stand the wheels must avoid.
+    them, so a panel may pass over a low stand the wheels must avoid. Each is a clearance
+    grid (m, float) or, using half the memory, the grid's squared cell distances (integers,
+    :func:`bt_manip.navigation.distance.squared_distances`), which give the same clearances.
     """
     o = options
     pts = outline_samples(footprint, 0.05)
@@ -514,7 +549,7 @@ def plan_poses(
         return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
     if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *start, need):
         return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
-    free = clear >= footprint.half_width + o.min_clearance
+    free = clearance_at_least(clear, res, footprint.half_width + o.min_clearance)
     gc = grid.world_to_cell(goal[0], goal[1])
     field = _GoalField(free, gc if grid.inside(gc) else None)
     params = np.array(

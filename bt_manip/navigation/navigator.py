@@ -44,6 +44,7 @@ from bt_manip.navigation.controller import (
     Pose2D,
 )
 from bt_manip.navigation.costmap import CostMap, InflationOptions, clearance
+from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
 from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
@@ -68,6 +69,25 @@ class NavigatorOptions:
     pivot: float | None = None
     """Where the base turns about on the spot (m ahead of the base frame); ``None`` takes the
     descriptor's ``base.pivot_offset`` if it has one, else 0."""
+
+
+LATTICE_FLOAT_CELLS = 1 << 22
+"""Up to this many cells, the pose search reads a float64 clearance grid (8 bytes per cell);
+beyond, the squared cell distances (4 bytes per cell, the same clearances, a little more work
+per look-up)."""
+
+
+def lattice_clearance(grid: OccupancyGrid, d2: np.ndarray | None = None) -> np.ndarray:
+    """What the pose search checks footprints against for ``grid`` (``d2``: its squared cell
+    distances if known): a clearance grid on small grids, the squared distances on large ones,
+    a read-only view of ``inf`` when nothing is occupied."""
+    if grid.occupied.size <= LATTICE_FLOAT_CELLS:
+        return clearance(grid)
+    if d2 is None:
+        d2 = squared_distances(grid.occupied)
+    if d2 is None:
+        return np.broadcast_to(np.float64(np.inf), grid.shape)
+    return d2
 
 
 def split_links(robot: Any) -> tuple[list[int], list[int]]:
@@ -245,7 +265,7 @@ class Navigator:
             c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext, remember=False
         )
         high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
-        self._carry = (low_fp, high_fp, low, clearance(low), clearance(high))
+        self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
 
     # -- planning and following ---------------------------------------------------------------
     def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
@@ -270,7 +290,8 @@ class Navigator:
                     # the grid is inflated for turning anywhere; over poses the robot may
                     # still drive straight through a narrow doorway
                     grid = self.costmap.grid
-                    return self._follow_poses(pose, goal, self.footprint, grid, clearance(grid))
+                    clear = lattice_clearance(grid, self.costmap.d2)
+                    return self._follow_poses(pose, goal, self.footprint, grid, clear)
                 return self.plan
         if self._carry is not None:
             return self._start_carrying(pose, goal)

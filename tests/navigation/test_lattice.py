@@ -7,6 +7,7 @@ import math
 import numpy as np
 
 from bt_manip.navigation.costmap import clearance
+from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import OccupancyGrid
 from bt_manip.navigation.lattice import (
@@ -14,6 +15,7 @@ from bt_manip.navigation.lattice import (
     TURN,
     _GoalField,
     _heuristic,
+    clearance_at_least,
     outline_samples,
     plan_poses,
 )
@@ -119,3 +121,22 @@ def test_goal_field_computed_on_demand_equals_the_whole_search() -> None:
             if np.isfinite(whole[r, c]):
                 assert h == whole[r, c] * 0.05
         assert np.array_equal(lazy.whole(), whole)
+
+
+def test_squared_distances_plan_the_same_poses_as_the_clearance_grid() -> None:
+    grid = room(corridor=True)
+    d2 = squared_distances(grid.occupied)
+    assert d2 is not None
+    fp = PlanarFootprint.rectangle(1.6, 0.5, 0.5)
+    goals = ((6.0, 2.0, 0.0), (2.0, 2.0, math.pi / 2), (3.0, 1.0, math.pi), (5.5, 2.0, math.pi))
+    for goal in (*goals, (7.0, 3.5, 0.0)):  # the last one does not fit
+        a = plan_poses(grid, clearance(grid), fp, (1.5, 2.0, 0.0), goal, 0.1)
+        b = plan_poses(grid, d2, fp, (1.5, 2.0, 0.0), goal, 0.1)
+        assert (a.ok, a.reason, a.expanded) == (b.ok, b.reason, b.expanded)
+        assert a.ok == (goal in goals)
+        if a.ok:
+            assert a.poses is not None and b.poses is not None
+            assert a.poses.tobytes() == b.poses.tobytes()
+            assert np.array_equal(a.moves, b.moves)
+    half = clearance(grid) >= 0.3
+    assert np.array_equal(clearance_at_least(d2, grid.resolution, 0.3), half)
