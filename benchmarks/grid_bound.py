@@ -5,10 +5,12 @@ Run: ``.venv/bin/python benchmarks/grid_bound.py [--cells N] [--png DIR]``
 Writes a world file of a few hundred bytes: a square room whose occupancy grid (0.05 m cells,
 obstacles plus the 0.5 m margin) has just under ``--cells`` cells (default
 :data:`bt_manip.navigation.grid.MAX_CELLS`), four walls and a long wall across the middle with
-gaps at both ends. It loads the world with a Husky in the west half, builds the robot's
+gaps at both ends, and a crate. It loads the world with a Husky in the west half, builds the robot's
 :class:`~bt_manip.navigation.navigator.Navigator` (rasterising, clearance, cost grid) and plans
 to the far side of the middle wall (A*, shortcuts), the work a ``Navigate`` does before the
-robot moves. With ``--png DIR`` it also writes the occupancy and cost images.
+robot moves. With ``--png DIR`` it also writes the occupancy and cost images. With ``--carry``
+the navigator counts a crate beside the robot as carried, so the plan is the search over poses
+(:mod:`bt_manip.navigation.lattice`) to a goal 12 m away, with its two clearance layers.
 
 Prints one JSON line: the grid's shape and cell count, the plan's outcome and length, the CPU
 seconds (user + system) of each phase, the process's peak resident memory before the grid and
@@ -63,6 +65,11 @@ def world_text(cells: int) -> tuple[str, float]:
             f"  - {{name: {name}, from: [{a[0]:.2f}, {a[1]:.2f}], to: [{b[0]:.2f}, {b[1]:.2f}], "
             f"thickness: {THICKNESS}, height: 1.5}}"
         )
+    lines.append("objects:")
+    lines.append(
+        f"  - {{name: crate, shape: box, size: [0.3, 0.3, 0.3], mass: 1.0, "
+        f"pose: [{-half / 2 + 1.5:.2f}, 0, 0]}}"
+    )
     lines.append("robots:")
     lines.append(f"  - {{name: husky, description: husky_ur3, pose: [{-half / 2:.2f}, 0, 0]}}")
     return "\n".join(lines) + "\n", half
@@ -72,6 +79,11 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--cells", type=int, default=MAX_CELLS)
     ap.add_argument("--png", type=Path, default=None, help="write the grid images here")
+    ap.add_argument(
+        "--carry",
+        action="store_true",
+        help="count the crate as carried: the plan is a search over poses",
+    )
     args = ap.parse_args(argv)
     text, half = world_text(args.cells)
     with tempfile.TemporaryDirectory() as tmp:
@@ -82,11 +94,14 @@ def main(argv: list[str] | None = None) -> int:
         base_mb = peak_mb()
         t0 = cpu()
         nav = Navigator(robot, world.obstacle_body_ids(), world.movable)
+        if args.carry:  # the navigator's view of a held crate (nothing is gripped)
+            nav.attach(world.body_id("crate"), "crate")
         t1 = cpu()
         cost = nav.cost
         t2 = cpu()
         start = robot.base_pose2d()
-        plan = nav.start(start, (half / 2.0, half / 2.0, 0.0))
+        goal = (-half / 2.0 + 12.0, 4.0, 0.0) if args.carry else (half / 2.0, half / 2.0, 0.0)
+        plan = nav.start(start, goal)
         t3 = cpu()
         if args.png is not None:
             args.png.mkdir(parents=True, exist_ok=True)
@@ -97,7 +112,7 @@ def main(argv: list[str] | None = None) -> int:
         end_mb = peak_mb()
         world.close()
     row = {
-        "bench": "grid_bound",
+        "bench": "grid_bound" + (" carrying" if args.carry else ""),
         "world_bytes": len(text),
         "grid": list(nav.static.shape),
         "cells": cells,

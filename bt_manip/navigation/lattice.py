@@ -22,6 +22,7 @@ The result is a list of poses with the move that reaches each (:class:`PosePlan`
 from __future__ import annotations
 
 import math
+import mmap
 from dataclasses import dataclass
 
 import numba
@@ -146,6 +147,22 @@ DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
 DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
 
 
+@numba.njit(cache=True, inline="always")
+def _known(dist: np.ndarray, row: int, col: int, goal: int) -> float:
+    """The distance of a cell found so far (``inf`` if not reached: 0 stands for that, except
+    at the goal)."""
+    d = dist[row, col]
+    if d == 0.0 and row * dist.shape[1] + col != goal:
+        return np.inf
+    return d
+
+
+@numba.njit(cache=True, inline="always")
+def _final(dist: np.ndarray, row: int, col: int, goal: int, front: float) -> bool:
+    """Whether the cell's distance is final: reached, and not beyond the frontier."""
+    return _known(dist, row, col, goal) <= front
+
+
 @numba.njit(cache=True)
 def _settle(
     free: np.ndarray,
@@ -160,8 +177,9 @@ def _settle(
     """Run the goal's Dijkstra search on ``free`` cells until cell (row, col) has its final
     distance, or until the search is over (``row`` -1 runs it to the end).
 
-    ``dist`` holds the distances so far (cells, 8-connected, no corner cutting; ``inf`` where
-    not reached), ``heap_d``/``heap_i`` the open list and ``state[0]`` its size,
+    ``dist`` holds the distances so far (cells, 8-connected, no corner cutting; 0 where not
+    reached, except at the goal cell ``state[1]``), ``heap_d``/``heap_i`` the open list and
+    ``state[0]`` its size,
     ``frontier[0]`` the last distance taken from it: every distance up to the frontier is
     final, since later entries only add to larger ones. Pausing leaves the order of the work
     unchanged, so the distances are those of one search run to the end. Returns the open list
@@ -169,9 +187,10 @@ def _settle(
     rows, cols = free.shape
     limit = rows * cols * 4 + 8  # most entries the open list may hold
     size = state[0]
+    goal = state[1]
     front = frontier[0]
     sq2 = math.sqrt(2.0)
-    while size > 0 and (row < 0 or not dist[row, col] <= front):
+    while size > 0 and (row < 0 or not _final(dist, row, col, goal, front)):
         d, node, size = _heap_pop(heap_d, heap_i, size)
         front = d
         r = node // cols
@@ -186,7 +205,7 @@ def _settle(
             if k >= 4 and not (free[nr, c] and free[r, nc]):
                 continue
             nd = d + (sq2 if k >= 4 else 1.0)
-            if nd < dist[nr, nc] and size < limit:
+            if nd < _known(dist, nr, nc, goal) and size < limit:
                 dist[nr, nc] = nd
                 if size == heap_d.shape[0]:  # grow the open list (it starts small)
                     heap_d = _grown(heap_d, min(limit, 2 * size))
@@ -203,23 +222,28 @@ class _GoalField:
 
     def __init__(self, free: np.ndarray, goal: tuple[int, int] | None) -> None:
         self.free = free
-        self.dist = np.full(free.shape, np.inf)
+        # zeros from an anonymous map: pages become resident only where the search writes
+        size = max(1, free.size)
+        self.dist = np.frombuffer(mmap.mmap(-1, size * 8), np.float64)[: free.size]
+        self.dist = self.dist.reshape(free.shape)
         self.heap_d = np.empty(1 << 12)
         self.heap_i = np.empty(1 << 12, np.int64)
-        self.state = np.zeros(1, np.int64)
+        self.state = np.array([0, -1], np.int64)
         self.frontier = np.full(1, -1.0)
         if goal is not None and free[goal]:
-            self.dist[goal] = 0.0
             self.heap_d[0] = 0.0
-            self.heap_i[0] = goal[0] * free.shape[1] + goal[1]
+            self.heap_i[0] = self.state[1] = goal[0] * free.shape[1] + goal[1]
             self.state[0] = 1
 
     def whole(self) -> np.ndarray:
-        """The distance of every cell (the search run to the end)."""
+        """The distance of every cell, ``inf`` where unreachable (the search run to the end)."""
         self.heap_d, self.heap_i = _settle(
             self.free, self.dist, self.heap_d, self.heap_i, self.state, self.frontier, -1, -1
         )
-        return self.dist
+        out = np.where(self.dist == 0.0, np.inf, self.dist)
+        if self.state[1] >= 0:
+            out.reshape(-1)[self.state[1]] = 0.0
+        return out
 
 
 @numba.njit(cache=True)
@@ -244,7 +268,7 @@ def _heuristic(
     if row < 0 or row >= rows or col < 0 or col >= cols:
         return np.inf, heap_d, heap_i
     heap_d, heap_i = _settle(free, dist, heap_d, heap_i, state, frontier, row, col)
-    d = dist[row, col]
+    d = _known(dist, row, col, state[1])
     h = d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
     return h, heap_d, heap_i
 
