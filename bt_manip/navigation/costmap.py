@@ -149,6 +149,12 @@ class CostMap:
             )
         return self._costs[key]
 
+    @property
+    def clear(self) -> np.ndarray:
+        """The float64 clearance grid (m), built anew on each call (8 bytes per cell): for a
+        few cells, :meth:`clearance_of_cell` costs nothing."""
+        return clearance_of(self.d2, self.grid.shape, self.grid.resolution)
+
     def clearance_of_cell(self, cell: tuple[int, int]) -> float:
         """Clearance (m) of a cell inside the grid (``inf`` when nothing is occupied)."""
         if self.d2 is None:

@@ -139,6 +139,7 @@ def test_cost_grids_match_inflating_the_float_clearance(options: InflationOption
         ref_clear = reference_clearance(grid.occupied, res)
         assert same_bits(clearance(grid), ref_clear)
         cm = CostMap(grid, options)
+        assert same_bits(cm.clear, ref_clear)
         for w in (0.0, 0.1234567, 0.3, 0.55, 2.0):
             assert same_bits(cm.cost_for(w), inflate(ref_clear, round(w, 4), options)), (res, w)
         r, c = int(rng.integers(rows)), int(rng.integers(cols))
