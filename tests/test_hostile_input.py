@@ -465,6 +465,25 @@ def test_navigate_in_a_world_too_large_for_its_grid_fails_with_the_extent(tmp_pa
     ), result["out"]
 
 
+def test_navigate_in_a_world_at_the_grid_bound_stays_within_the_limits(tmp_path: Path) -> None:
+    # a square room whose grid has 4,999 x 4,999 cells, just under the bound: the walls' outer
+    # faces at +-124.465 m plus the 0.5 m margin span 249.93 m, 4,999 cells of 5 cm
+    world = tmp_path / "big_room.yaml"
+    h = 124.39
+    walls = [("north", -h, h, h, h), ("south", -h, -h, h, -h), ("east", h, -h, h, h),
+             ("west", -h, -h, -h, h), ("middle", 0, -100, 0, 100)]
+    world.write_text(
+        "name: big_room\nwalls:\n"
+        + "".join(f"  - {{name: {n}, from: [{a}, {b}], to: [{c}, {d}], thickness: 0.15, "
+                  "height: 1.5}\n" for n, a, b, c, d in walls)
+        + "robots:\n  - {name: husky, description: husky_ur3, pose: [-60, 0, 0]}\n"
+    )
+    tree = _tree(tmp_path / "nav.xml", '    <Navigate goal="-58;0.5;0"/>')
+    (result,) = run_cli(tmp_path, ["run", tree, "--world", world, "--quiet"])
+    assert result["code"] == 0, result["out"]
+    assert "result: SUCCESS" in result["out"]
+
+
 def test_the_console_script_refuses_a_device_without_a_traceback(tmp_path: Path) -> None:
     done = subprocess.run(
         [sys.executable, "-m", "bt_manip.cli", "run", "/dev/zero"],

@@ -27,7 +27,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bt_manip.navigation.astar_search import cost_range, search_buckets, search_heap, trace
+from bt_manip.navigation.astar_search import (
+    cost_range,
+    scratch,
+    search_buckets,
+    search_heap,
+    trace,
+)
 
 SQRT2 = math.sqrt(2.0)
 
@@ -115,13 +121,15 @@ def plan_verbose(
         # largest f increase along one move: step x (cost + hmin), step <= sqrt 2
         span = math.ceil(SQRT2 * (hmax + hmin) / delta) + 3
         parent, g_goal, expanded = search_buckets(
-            grid, si, ti, bool(diagonal), float(hmin), delta, span
+            grid, si, ti, bool(diagonal), float(hmin), delta, span, *scratch(grid.size)
         )
     else:
         dr, dc = abs(s[0] - t[0]), abs(s[1] - t[1])
         h0 = (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc)) if diagonal else float(dr + dc)
         quantum = HEAP_QUANTUM * h0 * float(hmin)
-        parent, g_goal, expanded = search_heap(grid, si, ti, bool(diagonal), float(hmin), quantum)
+        parent, g_goal, expanded = search_heap(
+            grid, si, ti, bool(diagonal), float(hmin), quantum, *scratch(grid.size)
+        )
     if not math.isfinite(g_goal):
         return PlanResult(PlanStatus.NO_PATH, None, math.inf, int(expanded))
     path = trace(parent, si, ti, cols)

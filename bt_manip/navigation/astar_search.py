@@ -24,6 +24,7 @@ not trigger re-expansions.
 from __future__ import annotations
 
 import math
+import mmap
 
 import numba
 import numpy as np
@@ -74,6 +75,28 @@ def cost_range(grid: np.ndarray) -> tuple[float, float]:
     return lo, float(hi)
 
 
+def scratch(cells: int) -> tuple[np.ndarray, np.ndarray]:
+    """Fresh ``g`` and ``parent`` arrays for a search over ``cells`` cells.
+
+    ``g`` is all zeros, read as "not reached" (every reached cell but the start has g > 0), so
+    both can live in an anonymous memory map: the system hands out zero pages on first touch,
+    in small pages (numpy would ask for huge pages on arrays this large), and a search that
+    explores a small part of a large grid keeps only that part resident. ``parent`` is read
+    only for reached cells.
+    """
+    g = np.frombuffer(mmap.mmap(-1, max(1, cells) * 8), np.float64)
+    parent = np.frombuffer(mmap.mmap(-1, max(1, cells) * 4), np.int32)
+    return g[:cells], parent[:cells]
+
+
+@numba.njit(cache=True, inline="always")
+def _improves(new_g: float, known: float, is_start: bool) -> bool:
+    """Whether ``new_g`` beats a cell's stored g (0 = not reached, except at the start)."""
+    if known == 0.0:
+        return not is_start
+    return new_g < known * KEEP
+
+
 @numba.njit(cache=True)
 def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
     """The (row, col) cells from ``start`` to ``goal`` following ``parent`` links."""
@@ -108,15 +131,16 @@ def search_buckets(
     hmin: float,
     delta: float,
     span: int,
+    g: np.ndarray,
+    parent: np.ndarray,
 ) -> tuple[np.ndarray, float, int]:
     """A* with f-buckets of width ``delta`` in a circular array of ``span`` buckets.
 
     ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
+    ``g`` and ``parent`` are the caller's scratch arrays (see :func:`scratch`).
     """
     rows, cols = cost.shape
     flat = cost.ravel()
-    g = np.full(rows * cols, np.inf)
-    parent = np.empty(rows * cols, np.int32)
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
@@ -179,7 +203,7 @@ def search_buckets(
                 ng_ = gn + sqrt2 * w
             else:
                 ng_ = gn + w
-            if ng_ >= g[nb] * KEEP:
+            if not _improves(ng_, g[nb], nb == start):
                 continue
             g[nb] = ng_
             parent[nb] = node
@@ -216,16 +240,22 @@ def _before(fa: float, ga: float, fb: float, gb: float) -> bool:
 
 @numba.njit(cache=True)
 def search_heap(
-    cost: np.ndarray, start: int, goal: int, diagonal: bool, hmin: float, quantum: float
+    cost: np.ndarray,
+    start: int,
+    goal: int,
+    diagonal: bool,
+    hmin: float,
+    quantum: float,
+    g: np.ndarray,
+    parent: np.ndarray,
 ) -> tuple[np.ndarray, float, int]:
     """A* with a binary heap on (f rounded down to ``quantum``, larger g first).
 
-    The returned cost exceeds the optimum by less than ``quantum``.
+    The returned cost exceeds the optimum by less than ``quantum``. ``g`` and ``parent`` are
+    the caller's scratch arrays (see :func:`scratch`).
     """
     rows, cols = cost.shape
     flat = cost.ravel()
-    g = np.full(rows * cols, np.inf)
-    parent = np.empty(rows * cols, np.int32)
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
@@ -289,7 +319,7 @@ def search_heap(
                 ng_ = g_top + sqrt2 * w
             else:
                 ng_ = g_top + w
-            if ng_ >= g[nb] * KEEP:
+            if not _improves(ng_, g[nb], nb == start):
                 continue
             g[nb] = ng_
             parent[nb] = node

@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 import struct
 import zlib
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -36,6 +36,9 @@ DEFAULT_BAND: ZBand = (0.02, 2.0)
 
 MAX_CELLS = 25_000_000
 """Largest grid built (cells): at 0.05 m, a world of 250 m x 250 m."""
+
+BLOCK_CELLS = 1 << 18
+"""Cells tested at a time when a shape is drawn (bounds the temporaries of a large shape)."""
 
 _EPS = 1e-9
 
@@ -129,8 +132,11 @@ class OccupancyGrid:
         return 0 <= cell[0] < rows and 0 <= cell[1] < cols
 
     # -- drawing ---------------------------------------------------------------------------------
-    def cells_of(self, outline: Outline) -> np.ndarray:
-        """Flat indices of the cells whose squares overlap ``outline`` with positive area."""
+    def _hit_blocks(self, outline: Outline) -> Iterator[tuple[int, int, np.ndarray]]:
+        """``(first row, first column, hit)`` per block of rows of the outline's bounding box:
+        ``hit`` marks the cells whose squares overlap ``outline`` with positive area. Blocks
+        hold at most :data:`BLOCK_CELLS` cells, so a shape as large as the grid needs no
+        temporaries the size of the grid."""
         rows, cols = self.shape
         res = self.resolution
         x0, y0 = self.origin
@@ -140,23 +146,37 @@ class OccupancyGrid:
         r0 = max(0, math.floor((ymin - y0) / res))
         r1 = min(rows - 1, math.floor((ymax - y0) / res))
         if c0 > c1 or r0 > r1:
-            return np.zeros(0, np.int64)
-        cc, rr = np.meshgrid(np.arange(c0, c1 + 1), np.arange(r0, r1 + 1))
-        lx = x0 + cc * res
-        ly = y0 + rr * res
-        if isinstance(outline, Disc):
-            hit = _disc_hits(outline, lx, ly, res)
-        else:
-            hit = _polygon_hits(outline, lx, ly, res)
-        return (rr[hit] * cols + cc[hit]).astype(np.int64)
+            return
+        lx = x0 + np.arange(c0, c1 + 1)[None, :] * res
+        step = max(1, BLOCK_CELLS // (c1 - c0 + 1))
+        for ra in range(r0, r1 + 1, step):
+            ly = y0 + np.arange(ra, min(r1 + 1, ra + step))[:, None] * res
+            if isinstance(outline, Disc):
+                hit = _disc_hits(outline, lx, ly, res)
+            else:
+                hit = _polygon_hits(outline, lx, ly, res)
+            yield ra, c0, hit
+
+    def cells_of(self, outline: Outline) -> np.ndarray:
+        """Flat indices of the cells whose squares overlap ``outline`` with positive area."""
+        cols = self.shape[1]
+        parts = [np.zeros(0, np.int64)]
+        for ra, c0, hit in self._hit_blocks(outline):
+            rr, cc = np.nonzero(hit)
+            parts.append((rr + ra).astype(np.int64) * cols + (cc + c0))
+        return np.concatenate(parts)
 
     def mark(self, outlines: Iterable[Outline], source: int | None = None) -> None:
         """Mark the cells of ``outlines`` occupied (remembered under ``source`` if given)."""
-        idx = [self.cells_of(o) for o in outlines]
-        flat = np.unique(np.concatenate(idx)) if idx else np.zeros(0, np.int64)
-        self.occupied.reshape(-1)[flat] = True
         if source is not None:
+            idx = [self.cells_of(o) for o in outlines]
+            flat = np.unique(np.concatenate(idx)) if idx else np.zeros(0, np.int64)
+            self.occupied.reshape(-1)[flat] = True
             self.sources[source] = flat
+            return
+        for outline in outlines:
+            for ra, c0, hit in self._hit_blocks(outline):
+                self.occupied[ra : ra + hit.shape[0], c0 : c0 + hit.shape[1]] |= hit
 
     def occupied_by(self, body: int) -> np.ndarray:
         """(n, 2) cells marked for ``body`` (empty if it was not drawn as a source)."""
@@ -166,7 +186,8 @@ class OccupancyGrid:
     # -- output ----------------------------------------------------------------------------------
     def save_png(self, path: str | Path, path_cells: np.ndarray | None = None) -> None:
         """Write the grid as a PNG, north up: occupied black, free white, a path in red."""
-        img = np.where(self.occupied[..., None], 0, 255).astype(np.uint8).repeat(3, axis=2)
+        img = np.empty((*self.shape, 3), np.uint8)
+        img[...] = np.where(self.occupied, np.uint8(0), np.uint8(255))[..., None]
         if path_cells is not None and len(path_cells):
             p = np.asarray(path_cells)
             img[p[:, 0], p[:, 1]] = (220, 30, 30)
@@ -174,21 +195,20 @@ class OccupancyGrid:
 
 
 def _disc_hits(d: Disc, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
-    """Cells (lower-left corners lx, ly) whose square overlaps the disc's interior."""
+    """Cells (lower-left corners lx (1, n), ly (m, 1)) whose square overlaps the disc's
+    interior, as an (m, n) mask."""
     nx = np.clip(d.cx, lx, lx + res)
     ny = np.clip(d.cy, ly, ly + res)
     return (nx - d.cx) ** 2 + (ny - d.cy) ** 2 < (d.radius - _EPS) ** 2
 
 
 def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
-    """Separating-axis test of each cell square against a convex polygon (strict overlap)."""
+    """Separating-axis test of each cell square against a convex polygon (strict overlap);
+    lower-left corners lx (1, n) and ly (m, 1), an (m, n) mask."""
     v = p.vertices
     xmin, ymin, xmax, ymax = p.extent()
-    hit = (
-        (lx < xmax - _EPS)
-        & (lx + res > xmin + _EPS)
-        & (ly < ymax - _EPS)
-        & (ly + res > ymin + _EPS)
+    hit = ((lx < xmax - _EPS) & (lx + res > xmin + _EPS)) & (
+        (ly < ymax - _EPS) & (ly + res > ymin + _EPS)
     )
     n = len(v)
     for i in range(n):
@@ -209,7 +229,8 @@ def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.
 def write_png(path: str | Path, rgb: np.ndarray) -> None:
     """Write an (h, w, 3) uint8 image as PNG with numpy and zlib only."""
     h, w, _ = rgb.shape
-    raw = b"".join(b"\x00" + rgb[i].tobytes() for i in range(h))
+    rows = np.zeros((h, 1 + 3 * w), np.uint8)  # each row: filter byte 0, then the pixels
+    rows[:, 1:] = rgb.reshape(h, 3 * w)
 
     def chunk(tag: bytes, data: bytes) -> bytes:
         body = tag + data
@@ -219,7 +240,7 @@ def write_png(path: str | Path, rgb: np.ndarray) -> None:
 
     png = b"\x89PNG\r\n\x1a\n"
     png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(raw, 6))
+    png += chunk(b"IDAT", zlib.compress(rows, 6))
     png += chunk(b"IEND", b"")
     Path(path).write_bytes(png)
 
@@ -233,13 +254,16 @@ def save_cost_png(
     blue, a path in red."""
     finite = np.isfinite(cost)
     top = float(cost[finite].max()) if finite.any() else 1.0
-    shade = np.zeros(cost.shape)
-    if top > 1.0:
-        shade[finite] = (cost[finite] - 1.0) / (top - 1.0)
     img = np.empty((*cost.shape, 3), np.uint8)
-    img[..., 0] = (255 * (1.0 - 0.8 * shade)).astype(np.uint8)
-    img[..., 1] = (255 * (1.0 - 0.6 * shade)).astype(np.uint8)
     img[..., 2] = 255
+    for a in range(0, cost.shape[0], max(1, BLOCK_CELLS // max(1, cost.shape[1]))):
+        block = slice(a, a + max(1, BLOCK_CELLS // max(1, cost.shape[1])))
+        ok = finite[block]
+        shade = np.zeros(ok.shape)
+        if top > 1.0:
+            shade[ok] = (cost[block][ok] - 1.0) / (top - 1.0)
+        img[block, :, 0] = (255 * (1.0 - 0.8 * shade)).astype(np.uint8)
+        img[block, :, 1] = (255 * (1.0 - 0.6 * shade)).astype(np.uint8)
     img[~finite] = 0
     if path_cells is not None and len(path_cells):
         p = np.asarray(path_cells)
@@ -272,15 +296,17 @@ def rasterise(
     extent: tuple[float, float, float, float] | None = None,
     movable: Sequence[int] = (),
     pad: float = 0.5,
+    remember: bool = True,
 ) -> OccupancyGrid:
     """Occupancy grid of the collision shapes of ``obstacles`` (and ``movable``) in ``band``.
 
     ``extent`` defaults to the bounding rectangle of the obstacles, padded by ``pad``. Each
-    body's cells are remembered (:attr:`OccupancyGrid.sources`).
+    body's cells are remembered (:attr:`OccupancyGrid.sources`) unless ``remember`` is False
+    (then a shape is drawn straight into the grid, with no list of its cells).
     """
     if extent is None:
         extent = bodies_extent(client, list(obstacles) + list(movable), pad)
     grid = OccupancyGrid.empty(extent, resolution, band)
     for body in list(obstacles) + list(movable):
-        grid.mark(body_outlines(client, body, band), source=body)
+        grid.mark(body_outlines(client, body, band), source=body if remember else None)
     return grid

@@ -22,11 +22,15 @@ The result is a list of poses with the move that reaches each (:class:`PosePlan`
 from __future__ import annotations
 
 import math
+import mmap
 from dataclasses import dataclass
 
 import numba
 import numpy as np
+from numba import types
+from numba.extending import overload
 
+from bt_manip.navigation.costmap import CHUNK_CELLS, clearance_of
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import OccupancyGrid
 
@@ -123,40 +127,180 @@ def _heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> tuple[float, int
 
 
 @numba.njit(cache=True)
-def _distance_field(free: np.ndarray, goal_r: int, goal_c: int) -> np.ndarray:
-    """Shortest 8-connected distance (cells, no corner cutting) from every free cell to goal."""
+def _grown(a: np.ndarray, n: int) -> np.ndarray:
+    """A copy of the 1-D array ``a`` with room for ``n`` entries (the new ones uninitialised)."""
+    out = np.empty(n, a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+@numba.njit(cache=True)
+def _grown_rows(a: np.ndarray, n: int) -> np.ndarray:
+    """A copy of the 2-D array ``a`` with room for ``n`` rows (the new ones uninitialised)."""
+    out = np.empty((n, a.shape[1]), a.dtype)
+    out[: a.shape[0]] = a
+    return out
+
+
+# Neighbour order of the goal field: four sides, then the four diagonals.
+DR8 = np.array([-1, 1, 0, 0, -1, -1, 1, 1], np.int64)
+DC8 = np.array([0, 0, -1, 1, -1, 1, -1, 1], np.int64)
+
+
+@numba.njit(cache=True, inline="always")
+def _known(dist: np.ndarray, row: int, col: int, goal: int) -> float:
+    """The distance of a cell found so far (``inf`` if not reached: 0 stands for that, except
+    at the goal)."""
+    d = dist[row, col]
+    if d == 0.0 and row * dist.shape[1] + col != goal:
+        return np.inf
+    return d
+
+
+@numba.njit(cache=True, inline="always")
+def _final(dist: np.ndarray, row: int, col: int, goal: int, front: float) -> bool:
+    """Whether the cell's distance is final: reached, and not beyond the frontier."""
+    return _known(dist, row, col, goal) <= front
+
+
+@numba.njit(cache=True)
+def _settle(
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
+    row: int,
+    col: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Run the goal's Dijkstra search on ``free`` cells until cell (row, col) has its final
+    distance, or until the search is over (``row`` -1 runs it to the end).
+
+    ``dist`` holds the distances so far (cells, 8-connected, no corner cutting; 0 where not
+    reached, except at the goal cell ``state[1]``), ``heap_d``/``heap_i`` the open list and
+    ``state[0]`` its size,
+    ``frontier[0]`` the last distance taken from it: every distance up to the frontier is
+    final, since later entries only add to larger ones. Pausing leaves the order of the work
+    unchanged, so the distances are those of one search run to the end. Returns the open list
+    (grown if it had to be)."""
     rows, cols = free.shape
-    dist = np.full((rows, cols), np.inf)
-    if not free[goal_r, goal_c]:
-        return dist
-    heap_d = np.empty(rows * cols * 4 + 8)
-    heap_i = np.empty(rows * cols * 4 + 8, np.int64)
-    size = 0
-    dist[goal_r, goal_c] = 0.0
-    heap_d[0] = 0.0
-    heap_i[0] = goal_r * cols + goal_c
-    size = 1
-    dr = (-1, 1, 0, 0, -1, -1, 1, 1)
-    dc = (0, 0, -1, 1, -1, 1, -1, 1)
+    limit = rows * cols * 4 + 8  # most entries the open list may hold
+    size = state[0]
+    goal = state[1]
+    front = frontier[0]
     sq2 = math.sqrt(2.0)
-    while size > 0:
+    while size > 0 and (row < 0 or not _final(dist, row, col, goal, front)):
         d, node, size = _heap_pop(heap_d, heap_i, size)
+        front = d
         r = node // cols
         c = node % cols
         if d > dist[r, c]:
             continue
         for k in range(8):
-            nr = r + dr[k]
-            nc = c + dc[k]
+            nr = r + DR8[k]
+            nc = c + DC8[k]
             if nr < 0 or nr >= rows or nc < 0 or nc >= cols or not free[nr, nc]:
                 continue
             if k >= 4 and not (free[nr, c] and free[r, nc]):
                 continue
             nd = d + (sq2 if k >= 4 else 1.0)
-            if nd < dist[nr, nc] and size < heap_d.shape[0]:
+            if nd < _known(dist, nr, nc, goal) and size < limit:
                 dist[nr, nc] = nd
+                if size == heap_d.shape[0]:  # grow the open list (it starts small)
+                    heap_d = _grown(heap_d, min(limit, 2 * size))
+                    heap_i = _grown(heap_i, heap_d.shape[0])
                 size = _heap_push(heap_d, heap_i, size, nd, nr * cols + nc)
-    return dist
+    state[0] = size
+    frontier[0] = front
+    return heap_d, heap_i
+
+
+class _GoalField:
+    """The goal's distance field, computed as far as the pose search asks (see
+    :func:`_settle`)."""
+
+    def __init__(self, free: np.ndarray, goal: tuple[int, int] | None) -> None:
+        self.free = free
+        # zeros from an anonymous map: pages become resident only where the search writes
+        size = max(1, free.size)
+        self.dist = np.frombuffer(mmap.mmap(-1, size * 8), np.float64)[: free.size]
+        self.dist = self.dist.reshape(free.shape)
+        self.heap_d = np.empty(1 << 12)
+        self.heap_i = np.empty(1 << 12, np.int64)
+        self.state = np.array([0, -1], np.int64)
+        self.frontier = np.full(1, -1.0)
+        if goal is not None and free[goal]:
+            self.heap_d[0] = 0.0
+            self.heap_i[0] = self.state[1] = goal[0] * free.shape[1] + goal[1]
+            self.state[0] = 1
+
+    def whole(self) -> np.ndarray:
+        """The distance of every cell, ``inf`` where unreachable (the search run to the end)."""
+        self.heap_d, self.heap_i = _settle(
+            self.free, self.dist, self.heap_d, self.heap_i, self.state, self.frontier, -1, -1
+        )
+        out = np.where(self.dist == 0.0, np.inf, self.dist)
+        if self.state[1] >= 0:
+            out.reshape(-1)[self.state[1]] = 0.0
+        return out
+
+
+@numba.njit(cache=True)
+def _heuristic(
+    x: float,
+    y: float,
+    x0: float,
+    y0: float,
+    res: float,
+    goal: np.ndarray,
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
+) -> tuple[float, np.ndarray, np.ndarray]:
+    """Obstacle-aware distance (m) from (x, y) to the goal, and the open list of the field."""
+    rows, cols = dist.shape
+    col = math.floor((x - x0) / res)
+    row = math.floor((y - y0) / res)
+    if row < 0 or row >= rows or col < 0 or col >= cols:
+        return np.inf, heap_d, heap_i
+    heap_d, heap_i = _settle(free, dist, heap_d, heap_i, state, frontier, row, col)
+    d = _known(dist, row, col, state[1])
+    h = d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
+    return h, heap_d, heap_i
+
+
+def _clearance_value(value: float | int, res: float) -> float:
+    """A cell's clearance (m) from its entry in a clearance grid (m) or in a grid of squared
+    cell distances (integers, :func:`bt_manip.navigation.distance.squared_distances`)."""
+    if isinstance(value, float | np.floating):
+        return float(value)
+    return math.sqrt(float(value)) * res - res / math.sqrt(2.0)
+
+
+@overload(_clearance_value, jit_options={"cache": True})
+def _clearance_value_jit(value, res):  # type: ignore[no-untyped-def]  # numba wants them bare
+    """The compiled :func:`_clearance_value` for the cell type of the grid."""
+    if isinstance(value, types.Float):
+        return lambda value, res: value
+    # the float64 operations of costmap.clearance_of, so the same value to the last bit
+    return lambda value, res: math.sqrt(float(value)) * res - res / math.sqrt(2.0)
+
+
+def clearance_at_least(clear: np.ndarray, res: float, threshold: float) -> np.ndarray:
+    """Cells whose clearance is at least ``threshold`` (m), from a clearance grid or squared
+    cell distances (converted a block of rows at a time)."""
+    if clear.dtype.kind == "f":
+        return clear >= threshold
+    out = np.empty(clear.shape, bool)
+    step = max(1, CHUNK_CELLS // max(1, clear.shape[1]))
+    for a in range(0, clear.shape[0], step):
+        block = clear[a : a + step]
+        out[a : a + step] = clearance_of(block, block.shape, res) >= threshold
+    return out
 
 
 @numba.njit(cache=True)
@@ -181,7 +325,7 @@ def _points_free(
         row = math.floor((py - y0) / res)
         if row < 0 or row >= rows or col < 0 or col >= cols:
             return False
-        if clear[row, col] < need:
+        if _clearance_value(clear[row, col], res) < need:
             return False
     return True
 
@@ -238,7 +382,12 @@ def _search(
     pts_high: np.ndarray,
     reach: float,
     need: float,
-    hfield: np.ndarray,
+    free: np.ndarray,
+    dist: np.ndarray,
+    heap_d: np.ndarray,
+    heap_i: np.ndarray,
+    state: np.ndarray,
+    frontier: np.ndarray,
     start: np.ndarray,
     goal: np.ndarray,
     params: np.ndarray,
@@ -255,14 +404,17 @@ def _search(
     maxexp = int(params[9])
     spacing = params[10]
     pivot = params[11]
-    rows, cols = clear.shape
+    cols = clear.shape[1]
     bx = math.ceil(cols * res / xyb) + 1
-    by = math.ceil(rows * res / xyb) + 1
-    nstates = bx * by * nh
-    best = np.full(nstates, np.inf)
-    parent = np.full(nstates, -1, np.int64)
-    move_of = np.full(nstates, -1, np.int64)
-    pose = np.zeros((nstates, 3))
+    # States are stored in the order they are first reached (slots), found by their bin key:
+    # memory grows with the search, not with the number of bins of a large map.
+    slot_of = numba.typed.Dict.empty(key_type=numba.types.int64, value_type=numba.types.int64)
+    room = 1 << 12
+    best = np.empty(room)
+    parent = np.empty(room, np.int64)
+    move_of = np.empty(room, np.int64)
+    pose = np.empty((room, 3))
+    used = 0
     cap = 1 << 16
     hf = np.empty(cap)
     hi = np.empty(cap, np.int64)
@@ -275,20 +427,18 @@ def _search(
         ih = math.floor(((th % two_pi) / two_pi) * nh + 0.5) % nh
         return (iy * bx + ix) * nh + ih
 
-    def heur(x: float, y: float) -> float:
-        col = math.floor((x - x0) / res)
-        row = math.floor((y - y0) / res)
-        if row < 0 or row >= rows or col < 0 or col >= cols:
-            return np.inf
-        d = hfield[row, col]
-        return d * res if d < np.inf else math.hypot(x - goal[0], y - goal[1]) + 5.0
-
-    k0 = key(start[0], start[1], start[2])
+    k0 = 0
+    slot_of[key(start[0], start[1], start[2])] = k0
+    used = 1
     best[k0] = 0.0
+    parent[k0] = -1
+    move_of[k0] = -1
     pose[k0, 0] = start[0]
     pose[k0, 1] = start[1]
     pose[k0, 2] = start[2]
-    hf[0] = heur(start[0], start[1])
+    hf[0], heap_d, heap_i = _heuristic(
+        start[0], start[1], x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+    )
     hi[0] = k0
     size = 1
     expanded = 0
@@ -314,7 +464,10 @@ def _search(
         y = pose[k, 1]
         th = pose[k, 2]
         g = best[k]
-        if f > g + heur(x, y) + 1e-9:
+        h, heap_d, heap_i = _heuristic(
+            x, y, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+        )
+        if f > g + h + 1e-9:
             continue  # stale
         dyaw = (th - goal[2] + math.pi) % two_pi - math.pi
         if math.hypot(x - goal[0], y - goal[1]) <= gxy and abs(dyaw) <= gyaw:
@@ -340,10 +493,22 @@ def _search(
                     break
             if not ok:
                 continue
-            nk = key(nx, ny, nt)
+            bin_key = key(nx, ny, nt)
             ng = g + costs[m]
-            if ng >= best[nk]:
-                continue
+            nk = np.int64(-1)
+            if bin_key in slot_of:
+                nk = slot_of[bin_key]
+                if ng >= best[nk]:
+                    continue
+            else:
+                if used == best.shape[0]:
+                    best = _grown(best, 2 * used)
+                    parent = _grown(parent, 2 * used)
+                    move_of = _grown(move_of, 2 * used)
+                    pose = _grown_rows(pose, 2 * used)
+                nk = used
+                used += 1
+                slot_of[bin_key] = nk
             best[nk] = ng
             parent[nk] = k
             move_of[nk] = m
@@ -357,7 +522,10 @@ def _search(
                 nhi[:size] = hi
                 hf = nhf
                 hi = nhi
-            nf = ng + heur(nx, ny)
+            h, heap_d, heap_i = _heuristic(
+                nx, ny, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
+            )
+            nf = ng + h
             size = _heap_push(hf, hi, size, nf, nk)
     return parent, move_of, pose, -1, expanded
 
@@ -377,7 +545,9 @@ def plan_poses(
 
     ``footprint`` (the robot) is checked against ``clear``; ``carried`` (objects held above
     the floor) against ``clear_high``, the clearance of the obstacles tall enough to reach
-    them, so a panel may pass over a low stand the wheels must avoid.
+    them, so a panel may pass over a low stand the wheels must avoid. Each is a clearance
+    grid (m, float) or, using half the memory, the grid's squared cell distances (integers,
+    :func:`bt_manip.navigation.distance.squared_distances`), which give the same clearances.
     """
     o = options
     pts = outline_samples(footprint, 0.05)
@@ -403,11 +573,9 @@ def plan_poses(
         return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
     if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *start, need):
         return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
-    free = clear >= footprint.half_width + o.min_clearance
+    free = clearance_at_least(clear, res, footprint.half_width + o.min_clearance)
     gc = grid.world_to_cell(goal[0], goal[1])
-    hfield = (
-        _distance_field(free, gc[0], gc[1]) if grid.inside(gc) else np.full(clear.shape, np.inf)
-    )
+    field = _GoalField(free, gc if grid.inside(gc) else None)
     params = np.array(
         [
             o.step,
@@ -434,7 +602,12 @@ def plan_poses(
         pts_high,
         reach,
         need,
-        hfield,
+        field.free,
+        field.dist,
+        field.heap_d,
+        field.heap_i,
+        field.state,
+        field.frontier,
         np.asarray(start, float),
         np.asarray(goal, float),
         params,

@@ -44,6 +44,7 @@ from bt_manip.navigation.controller import (
     Pose2D,
 )
 from bt_manip.navigation.costmap import CostMap, InflationOptions, clearance
+from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
 from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
@@ -68,6 +69,25 @@ class NavigatorOptions:
     pivot: float | None = None
     """Where the base turns about on the spot (m ahead of the base frame); ``None`` takes the
     descriptor's ``base.pivot_offset`` if it has one, else 0."""
+
+
+LATTICE_FLOAT_CELLS = 1 << 22
+"""Up to this many cells, the pose search reads a float64 clearance grid (8 bytes per cell);
+beyond, the squared cell distances (4 bytes per cell, the same clearances, a little more work
+per look-up)."""
+
+
+def lattice_clearance(grid: OccupancyGrid, d2: np.ndarray | None = None) -> np.ndarray:
+    """What the pose search checks footprints against for ``grid`` (``d2``: its squared cell
+    distances if known): a clearance grid on small grids, the squared distances on large ones,
+    a read-only view of ``inf`` when nothing is occupied."""
+    if grid.occupied.size <= LATTICE_FLOAT_CELLS:
+        return clearance(grid)
+    if d2 is None:
+        d2 = squared_distances(grid.occupied)
+    if d2 is None:
+        return np.broadcast_to(np.float64(np.inf), grid.shape)
+    return d2
 
 
 def split_links(robot: Any) -> tuple[list[int], list[int]]:
@@ -111,7 +131,11 @@ class Navigator:
         )
         self.band: ZBand = options.band or (0.02, robot_top(robot) + 0.05)
         self.static: OccupancyGrid = rasterise(
-            self.client, list(obstacles), resolution=options.resolution, band=self.band
+            self.client,
+            list(obstacles),
+            resolution=options.resolution,
+            band=self.band,
+            remember=False,
         )
         self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.footprint = self.base_footprint
@@ -133,17 +157,41 @@ class Navigator:
         """Where the base turns about on the spot (m ahead of its frame)."""
 
     # -- map --------------------------------------------------------------------------------
-    def _compose(self) -> OccupancyGrid:
-        grid = self.static.copy()
+    def _movable_cells(self) -> dict[int, np.ndarray]:
+        """Per movable object not carried, the flat indices of the cells it occupies now."""
+        cells: dict[int, np.ndarray] = {}
         for body in self.movable:
             if body not in self.attached:
-                grid.mark(body_outlines(self.client, body, self.band), source=body)
+                outlines = body_outlines(self.client, body, self.band)
+                parts = [self.static.cells_of(o) for o in outlines]
+                cells[body] = np.unique(np.concatenate(parts)) if parts else np.zeros(0, np.int64)
+        return cells
+
+    def _compose(self, cells: dict[int, np.ndarray] | None = None) -> OccupancyGrid:
+        """The static grid with the movable objects drawn in (the static grid itself, not a
+        copy, when there are none: it is never drawn on)."""
+        if cells is None:
+            cells = self._movable_cells()
+        if not cells:
+            return self.static
+        s = self.static
+        grid = OccupancyGrid(s.origin, s.resolution, s.occupied.copy(), s.band)
+        flat = grid.occupied.reshape(-1)
+        for body, idx in cells.items():
+            flat[idx] = True
+            grid.sources[body] = idx
         return grid
 
     def refresh(self) -> bool:
         """Redraw the movable objects; True if the occupied cells changed."""
-        grid = self._compose()
-        if np.array_equal(grid.occupied, self.costmap.grid.occupied):
+        cells = self._movable_cells()
+        old = self.costmap.grid
+        if cells.keys() == old.sources.keys() and all(
+            np.array_equal(idx, old.sources[b]) for b, idx in cells.items()
+        ):
+            return False  # the same cells drawn on the same static grid
+        grid = self._compose(cells)
+        if np.array_equal(grid.occupied, old.occupied):
             return False
         self.costmap = self.costmap.with_grid(grid)
         return True
@@ -213,9 +261,11 @@ class Navigator:
         bodies = list(self._obstacles) + movers
         ext = self.static.extent
         res = self.options.resolution
-        low = rasterise(c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext)
-        high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext)
-        self._carry = (low_fp, high_fp, low, clearance(low), clearance(high))
+        low = rasterise(
+            c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext, remember=False
+        )
+        high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
+        self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
 
     # -- planning and following ---------------------------------------------------------------
     def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
@@ -240,7 +290,8 @@ class Navigator:
                     # the grid is inflated for turning anywhere; over poses the robot may
                     # still drive straight through a narrow doorway
                     grid = self.costmap.grid
-                    return self._follow_poses(pose, goal, self.footprint, grid, clearance(grid))
+                    clear = lattice_clearance(grid, self.costmap.d2)
+                    return self._follow_poses(pose, goal, self.footprint, grid, clear)
                 return self.plan
         if self._carry is not None:
             return self._start_carrying(pose, goal)

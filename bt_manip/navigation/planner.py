@@ -122,7 +122,8 @@ def plan_path(
         return NavPlan(
             PlanOutcome.FOOTPRINT,
             f"goal ({goal[0]:.2f}, {goal[1]:.2f}) is too close to obstacles for the footprint: "
-            f"{costmap.clear[t]:.2f} m clearance, {footprint.describe()} needs {need:.2f} m",
+            f"{costmap.clearance_of_cell(t):.2f} m clearance, {footprint.describe()} needs "
+            f"{need:.2f} m",
         )
     search_start = s
     if not math.isfinite(cost[s]):
@@ -137,7 +138,7 @@ def plan_path(
         search_start = free
     res = plan_verbose(cost, search_start, t)
     if res.status is not PlanStatus.FOUND:
-        bare = np.where(grid.occupied, np.inf, 1.0).astype(np.float32)
+        bare = np.where(grid.occupied, np.float32(np.inf), np.float32(1.0))
         if plan_verbose(bare, s, t).found:
             return NavPlan(
                 PlanOutcome.FOOTPRINT,

@@ -7,9 +7,18 @@ import math
 import numpy as np
 
 from bt_manip.navigation.costmap import clearance
+from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import OccupancyGrid
-from bt_manip.navigation.lattice import BACKWARD, TURN, outline_samples, plan_poses
+from bt_manip.navigation.lattice import (
+    BACKWARD,
+    TURN,
+    _GoalField,
+    _heuristic,
+    clearance_at_least,
+    outline_samples,
+    plan_poses,
+)
 
 
 def room(corridor: bool = False) -> OccupancyGrid:
@@ -63,3 +72,71 @@ def test_outline_samples_cover_the_boundary() -> None:
     # consecutive samples at most 5 cm apart around the outline
     ring = np.vstack([pts, pts[:1]])
     assert np.hypot(*np.diff(ring, axis=0).T).max() <= 0.05 + 1e-9
+
+
+def reference_goal_distances(free: np.ndarray, goal: tuple[int, int]) -> np.ndarray:
+    """Dijkstra (scipy) over free cells, 8-connected, no diagonal past a blocked side cell."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import dijkstra
+
+    rows, cols = free.shape
+    ids = np.arange(rows * cols).reshape(rows, cols)
+    pad = np.zeros((rows + 2, cols + 2), bool)
+    pad[1:-1, 1:-1] = free
+    src, dst, wts = [], [], []
+    for dr in (-1, 0, 1):
+        for dc in (-1, 0, 1):
+            if not (dr or dc):
+                continue
+            ok = free & pad[1 + dr : 1 + dr + rows, 1 + dc : 1 + dc + cols]
+            if dr and dc:
+                ok &= pad[1 + dr : 1 + dr + rows, 1 : 1 + cols]
+                ok &= pad[1 : 1 + rows, 1 + dc : 1 + dc + cols]
+            r, c = np.nonzero(ok)
+            src.append(ids[r, c])
+            dst.append(ids[r + dr, c + dc])
+            wts.append(np.full(len(r), math.sqrt(2.0) if dr and dc else 1.0))
+    n = rows * cols
+    graph = coo_matrix((np.concatenate(wts), (np.concatenate(src), np.concatenate(dst))), (n, n))
+    return dijkstra(graph.tocsr(), directed=True, indices=ids[goal]).reshape(rows, cols)
+
+
+def test_goal_field_computed_on_demand_equals_the_whole_search() -> None:
+    rng = np.random.default_rng(5)
+    for _ in range(30):
+        rows, cols = (int(v) for v in rng.integers(2, 50, 2))
+        free = rng.random((rows, cols)) > float(rng.choice([0.0, 0.1, 0.3, 0.5]))
+        goal = (int(rng.integers(rows)), int(rng.integers(cols)))
+        whole = _GoalField(free, goal).whole()
+        ref = reference_goal_distances(free, goal) if free[goal] else np.full(free.shape, np.inf)
+        assert np.array_equal(np.isinf(whole), np.isinf(ref))
+        assert np.allclose(whole[np.isfinite(ref)], ref[np.isfinite(ref)], rtol=1e-12, atol=0)
+        lazy = _GoalField(free, goal)
+        for _ in range(40):  # queries in any order get the final distance at once
+            r, c = int(rng.integers(rows)), int(rng.integers(cols))
+            h, lazy.heap_d, lazy.heap_i = _heuristic(
+                (c + 0.5) * 0.05, (r + 0.5) * 0.05, 0.0, 0.0, 0.05, np.array([0.0, 0.0, 0.0]),
+                lazy.free, lazy.dist, lazy.heap_d, lazy.heap_i, lazy.state, lazy.frontier,
+            )
+            if np.isfinite(whole[r, c]):
+                assert h == whole[r, c] * 0.05
+        assert np.array_equal(lazy.whole(), whole)
+
+
+def test_squared_distances_plan_the_same_poses_as_the_clearance_grid() -> None:
+    grid = room(corridor=True)
+    d2 = squared_distances(grid.occupied)
+    assert d2 is not None
+    fp = PlanarFootprint.rectangle(1.6, 0.5, 0.5)
+    goals = ((6.0, 2.0, 0.0), (2.0, 2.0, math.pi / 2), (3.0, 1.0, math.pi), (5.5, 2.0, math.pi))
+    for goal in (*goals, (7.0, 3.5, 0.0)):  # the last one does not fit
+        a = plan_poses(grid, clearance(grid), fp, (1.5, 2.0, 0.0), goal, 0.1)
+        b = plan_poses(grid, d2, fp, (1.5, 2.0, 0.0), goal, 0.1)
+        assert (a.ok, a.reason, a.expanded) == (b.ok, b.reason, b.expanded)
+        assert a.ok == (goal in goals)
+        if a.ok:
+            assert a.poses is not None and b.poses is not None
+            assert a.poses.tobytes() == b.poses.tobytes()
+            assert np.array_equal(a.moves, b.moves)
+    half = clearance(grid) >= 0.3
+    assert np.array_equal(clearance_at_least(d2, grid.resolution, 0.3), half)
