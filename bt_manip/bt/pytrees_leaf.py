@@ -54,6 +54,7 @@ PORT_PREFIX = "/__bt_manip_port__/"
 _BT_FROM_PY = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,
                Status.RUNNING: NodeStatus.RUNNING}
 _NONE_TEXT = ("", "null", "none")
+_UNKNOWN = object()  # a constructor argument of a wrapped object that its attributes hide
 
 
 # ---------------------------------------------------------------------- blackboard bridge
@@ -309,11 +310,16 @@ class PyTreesLeaf(LeafNode):
 
     def __init__(self, name: str | None = None, behaviour: Behaviour | None = None,
                  **attributes: Any) -> None:
-        if behaviour is not None:
+        if behaviour is not None:  # arguments it was built with, where its attributes tell
             name = behaviour.name
             given = recover_arguments(behaviour, self.PARAMS)
-            attributes = {**{k: Literal(v) for k, v in given.items()}, **attributes}
+            unknown = {p: Literal(_UNKNOWN) for p in self.PARAMS if p not in given}
+            attributes = {**unknown, **{k: Literal(v) for k, v in given.items()}, **attributes}
         super().__init__(name or self.NODE_ID, **attributes)
+        for port, binding in list(self.bindings.items()):
+            if isinstance(binding, Literal) and binding.value is _UNKNOWN:
+                del self.bindings[port]
+                self.attribute_texts.pop(port, None)
         if behaviour is None:
             kwargs = {p: b.value for p, b in self.bindings.items()
                       if p in self.PARAMS and isinstance(b, Literal)}
@@ -400,11 +406,18 @@ class PyTreesLeaf(LeafNode):
     def stop(self, new_status: Status = Status.INVALID) -> None:
         """py_trees' stop: a py_trees parent stopping the leaf stops the behaviour too (its
         ``terminate(INVALID)`` runs, also when it had finished, as in py_trees)."""
-        super().stop(new_status)
-        behaviour = self.behaviour
-        if new_status == Status.INVALID and behaviour.status != Status.INVALID:
-            with py_trees_storage(self._view()):
-                behaviour.stop(Status.INVALID)
+        if new_status != Status.INVALID:
+            super().stop(new_status)
+            return
+        was_running = self.bt_status is NodeStatus.RUNNING
+        with py_trees_storage(self._view()):
+            self.behaviour.stop(Status.INVALID)
+        self.feedback_message = self.behaviour.feedback_message
+        self.reset_status()
+        self.status = Status.INVALID
+        script = self._post.get("_onHalted") if was_running and self._post else None
+        if script is not None:
+            self._run_script("_onHalted", script)
 
     def setup(self, **kwargs: Any) -> None:
         with py_trees_storage(self._view()):
