@@ -476,9 +476,18 @@ def _port_info(p: Param) -> PortInformation:
 
 
 def _clock_counterparts() -> dict[type, type[PyTreesLeaf]]:
+    """py_trees classes replaced by bt-manip nodes reading the tree's clock (registered
+    under the py_trees class name)."""
     from bt_manip.bt.pytrees_composites import PyTreesTimer
 
-    return {py_trees.timers.Timer: PyTreesTimer}  # type: ignore[dict-item]
+    if py_trees.timers.Timer not in _COUNTERPARTS:
+        _COUNTERPARTS[py_trees.timers.Timer] = type(
+            "Timer", (PyTreesTimer,), {"NODE_ID": "Timer", "__module__": __name__,
+                                       "__doc__": PyTreesTimer.__doc__})
+    return _COUNTERPARTS
+
+
+_COUNTERPARTS: dict[type, Any] = {}
 
 
 def wrap(behaviour: Behaviour) -> LeafNode:
