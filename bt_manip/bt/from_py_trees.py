@@ -44,8 +44,9 @@ from bt_manip.bt import pytrees_composites as ptc
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
-from bt_manip.bt.pytrees_leaf import PyTreesLeaf, wrap
+from bt_manip.bt.pytrees_leaf import wrap
 from bt_manip.bt.registry import registry
+from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 
 D = py_trees.decorators
@@ -170,12 +171,11 @@ def _original(condition: Any) -> Any:
 
 
 def _register_leaves(root: BtNode) -> None:
-    """Register the wrapper classes of the tree's leaves whose IDs are free (for to_xml)."""
+    """Register the classes of the tree's leaves whose IDs are free, so the XML that
+    ``to_xml`` writes loads back."""
     stack = [root]
     while stack:
         node = stack.pop()
         stack.extend(node.bt_children())
-        if isinstance(node, PyTreesLeaf):
-            existing = registry.get(node.NODE_ID)
-            if existing is None:
-                registry.register(type(node))
+        if not isinstance(node, SubTree) and registry.get(node.NODE_ID) is None:
+            registry.register(type(node))

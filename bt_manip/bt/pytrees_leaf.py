@@ -287,7 +287,13 @@ _STORED_AS = {"n": ("every_n", "period")}
 def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[str, Any]:
     """Constructor arguments of an existing behaviour, as far as its attributes tell."""
     found: dict[str, Any] = {}
+    generator = vars(behaviour).get("variable_value_generator")
+    if "variable_value" in params and callable(generator) and \
+            "SetBlackboardVariable.__init__" in getattr(generator, "__qualname__", ""):
+        found["variable_value"] = generator()  # py_trees' wrapper around a plain value
     for name in params:
+        if name in found:
+            continue
         for attribute in (name, "_" + name, *_STORED_AS.get(name, ())):
             if attribute in vars(behaviour):
                 found[name] = vars(behaviour)[attribute]
@@ -467,8 +473,12 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
 def _port_info(p: Param) -> PortInformation:
     description = "constructor argument"
     default = p.default
+    data_type = p.annotation  # as the model shows it; conversion uses the annotation itself
+    optional, options = _is_optional(data_type)
+    if get_origin(data_type) is typing.Union or optional:
+        data_type = options[0] if len(options) == 1 else object
     try:
-        return PortInformation(p.annotation, required=p.required, description=description,
+        return PortInformation(data_type, required=p.required, description=description,
                                default_value=default)
     except TypeError:
         return PortInformation(object, required=p.required, description=description,
