@@ -28,12 +28,15 @@ from bt_manip.bt.node import (
     TreeRuntimeError,
 )
 from bt_manip.bt.ports import InOutPortInformation
+from bt_manip.bt.pytrees_leaf import register_py_trees_behaviours
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import NodeRecord, Tree
 from bt_manip.bt.xml_loader import load_tree, load_tree_string, validate, validate_file
 from bt_manip.bt.xml_writer import to_xml
+
+register_py_trees_behaviours()  # py_trees' own leaves: <SuccessEveryN n="3"/> in XML
 
 __all__ = [
     "ActionNode",

@@ -521,7 +521,9 @@ PY_TREES_LEAVES: tuple[type[Behaviour], ...] = (
 
 
 def register_py_trees_behaviours() -> list[str]:
-    """Register py_trees' own leaves (:data:`PY_TREES_LEAVES`); returns their node IDs."""
+    """Register py_trees' own leaves (:data:`PY_TREES_LEAVES`); returns their node IDs.
+
+    Done when :mod:`bt_manip.bt` is imported; calling it again changes nothing."""
     from bt_manip.bt.registry import registry
 
     ids = []
