@@ -443,6 +443,10 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
     """The bt-manip leaf class wrapping py_trees behaviour class ``cls`` (made once)."""
     if cls in _CLASSES and node_id in (None, _CLASSES[cls].NODE_ID):
         return _CLASSES[cls]
+    if issubclass(cls, (py_trees.composites.Composite, py_trees.decorators.Decorator)):
+        raise TypeError(f"{cls.__qualname__} is a py_trees composite or decorator: only leaves "
+                        "can be registered; convert a tree that uses py_trees' own composites "
+                        "and decorators with bt_manip.bt.from_py_trees")
     clock_reading = _clock_counterparts().get(cls)
     if clock_reading is not None:
         return clock_reading

@@ -229,16 +229,20 @@ def test_py_trees_ports_are_ports(doubler: None) -> None:
 
 
 class Keys(py_trees.behaviour.Behaviour):
-    """Copies blackboard entry /source into target, through a py_trees client."""
+    """Copies blackboard entry /source into target, through a py_trees client, and counts
+    its runs in the root blackboard's entry 'runs'."""
 
     def __init__(self, name: str) -> None:
         super().__init__(name)
         self.client = self.attach_blackboard_client()
         self.client.register_key("/source", access=py_trees.common.Access.READ)
         self.client.register_key("target", access=py_trees.common.Access.WRITE)
+        self.client.register_key("@runs", access=py_trees.common.Access.WRITE)
 
     def update(self) -> Status:
         self.client.target = self.client.get("/source") + 1
+        runs = self.client.get("@runs") if self.client.exists("@runs") else 0
+        self.client.set("@runs", runs + 1)
         return Status.SUCCESS
 
 
@@ -256,6 +260,7 @@ def test_blackboard_clients_use_the_blackboard_of_their_subtree() -> None:
         registry.unregister("Keys")
     assert tree.blackboard.get("target") == 2  # /source and target are entries of Main
     assert tree.blackboard.get("out") == 3  # inside the SubTree they follow its remapping
+    assert tree.blackboard.get("runs") == 2  # @runs is the root blackboard's entry
     assert "/target" not in py_trees.blackboard.Blackboard.storage
 
 
@@ -294,3 +299,11 @@ def test_to_xml_declares_py_trees_nodes_and_loads_back(tmp_path: Any) -> None:
     assert expected == [R, S, R, S, R, S]  # what py_trees itself gives
     assert [reloaded.tick().value for _ in range(6)] == expected
     assert ReactiveSequence.NODE_ID in text  # Sequence(memory=False) is BT.CPP's
+
+
+def test_composites_and_decorators_cannot_be_registered_as_leaves() -> None:
+    class Mine(py_trees.composites.Sequence):
+        pass
+
+    with pytest.raises(TypeError, match="Mine is a py_trees composite or decorator: only leaves"):
+        registry.register(Mine)
