@@ -22,7 +22,10 @@ deciding, BT.CPP's Parallel stops at its thresholds and has no SuccessOnSelected
 and ``Retry`` (py_trees returns RUNNING between cycles), ``Timeout`` (checked after ticking
 the child, on the tree's clock), ``OneShot``, ``Count``, ``Condition``, ``EternalGuard``,
 ``ForEach``, ``StatusToBlackboard``, ``PassThrough``, ``RunningIs*``, ``*IsRunning``, and
-composites without children (BT.CPP controls need one). With ``builtins=False`` every
+composites without children (BT.CPP controls need one). A composite or decorator of a class of
+your own (or a subclass of py_trees' ones) becomes an instance of a subclass of that class
+ticked by its own py_trees code, its state copied; such a node is written by ``to_xml`` but
+cannot be loaded back from XML. With ``builtins=False`` every
 composite and decorator gets its py_trees counterpart. One difference remains with built-ins:
 py_trees stops a child that had finished when its parent starts again (its
 ``terminate(INVALID)`` runs once more); a BT.CPP parent resets it without calling it.
@@ -34,6 +37,7 @@ reads the tree's clock. Nodes that already are bt-manip nodes are kept.
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import py_trees
@@ -78,8 +82,8 @@ def from_py_trees(
 ) -> Tree:
     """A bt-manip tree ticking like the py_trees tree under ``root`` (see the module doc).
 
-    Raises TypeError for a py_trees composite or decorator class it does not know (a user's
-    own composite); a user's leaf class is wrapped like any behaviour.
+    Raises TypeError for a composite or decorator of a user's class that keeps a blackboard
+    client in ``self.blackboard`` (bt-manip nodes use that name for their blackboard).
     """
     node = convert_node(root, builtins=builtins)
     tree = Tree(node, context=context, blackboard=blackboard, tree_id=tree_id)
@@ -117,8 +121,7 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
             attributes["selected"] = [originals.index(c) for c in policy.children]
         return ptc.PyTreesParallel(name, children, **attributes)
     if kind not in (py_trees.composites.Sequence, py_trees.composites.Selector):
-        raise TypeError(f"cannot convert composite '{name}' of class {kind.__qualname__}: "
-                        "only py_trees' Sequence, Selector and Parallel are known")
+        return _own_class(node, builtins)
     memory = bool(node.memory)
     children = _children(node, builtins)
     if builtins and children:
@@ -161,9 +164,50 @@ def _decorator(node: py_trees.decorators.Decorator, builtins: bool) -> BtNode:
         guard.blackboards.extend(node.blackboards)
         made = guard
     else:
-        raise TypeError(f"cannot convert decorator '{name}' of class {kind.__qualname__}: "
-                        "not one of py_trees' decorators")
+        return _own_class(node, builtins)
     return made
+
+
+_OWN_CLASSES: dict[type, type[BtNode]] = {}
+
+
+def _own_class(node: Behaviour, builtins: bool) -> BtNode:
+    """A user's composite or decorator class (or a subclass of py_trees' own): the node
+    becomes an instance of a subclass of that class, with the object's state copied, ticked
+    by the class's own py_trees code. It can be saved as XML but not loaded back."""
+    user_class = type(node)
+    if "blackboard" in vars(node):
+        raise TypeError(f"cannot convert '{node.name}' of class {user_class.__qualname__}: it "
+                        "keeps a blackboard client in self.blackboard, the name bt-manip nodes "
+                        "use for their blackboard; rename the attribute")
+    composite = isinstance(node, py_trees.composites.Composite)
+    made_class = _OWN_CLASSES.get(user_class)
+    if made_class is None:
+        base = ptc._PyTreesComposite if composite else ptc._PyTreesDecorator
+        made_class = type(user_class.__name__, (base, user_class), {
+            "PY": user_class, "NODE_ID": user_class.__name__, "PYTHON_ONLY": True,
+            "__module__": user_class.__module__, "__qualname__": user_class.__qualname__,
+            "__doc__": user_class.__doc__ or f"py_trees node {user_class.__qualname__}"})
+        _OWN_CLASSES[user_class] = made_class
+    made: Any = made_class.__new__(made_class)
+    made.__dict__.update(vars(node))
+    kids = [convert_node(child, builtins) for child in node.children]
+    made.children = []
+    for kid in kids:
+        kid.parent = made
+        made.children.append(kid)
+    if composite:
+        made.current_child = None
+        policy = getattr(node, "policy", None)
+        if policy is not None and hasattr(policy, "children"):
+            made.policy = copy.copy(policy)
+            made.policy.children = [kids[node.children.index(c)] for c in policy.children]
+    else:
+        made.decorated = kids[0]
+    made.parent = None
+    made.status = py_trees.common.Status.INVALID
+    made._init_node({})
+    return made  # type: ignore[no-any-return]
 
 
 def _original(condition: Any) -> Any:
@@ -177,5 +221,7 @@ def _register_leaves(root: BtNode) -> None:
     while stack:
         node = stack.pop()
         stack.extend(node.bt_children())
-        if not isinstance(node, SubTree) and registry.get(node.NODE_ID) is None:
+        if isinstance(node, SubTree) or getattr(node, "PYTHON_ONLY", False):
+            continue
+        if registry.get(node.NODE_ID) is None:
             registry.register(type(node))

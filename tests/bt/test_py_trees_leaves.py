@@ -307,3 +307,46 @@ def test_composites_and_decorators_cannot_be_registered_as_leaves() -> None:
 
     with pytest.raises(TypeError, match="Mine is a py_trees composite or decorator: only leaves"):
         registry.register(Mine)
+
+
+class EveryOther(py_trees.decorators.Decorator):
+    """A user's decorator: passes the child's status on odd ticks, RUNNING on even ones."""
+
+    def __init__(self, name: str, child: py_trees.behaviour.Behaviour) -> None:
+        super().__init__(name=name, child=child)
+        self.ticks = 0
+
+    def update(self) -> Status:
+        self.ticks += 1
+        return self.decorated.status if self.ticks % 2 else Status.RUNNING
+
+
+class CountingSequence(py_trees.composites.Sequence):
+    """A user's composite: a py_trees Sequence counting how often it starts."""
+
+    def __init__(self, name: str, children: list[py_trees.behaviour.Behaviour]) -> None:
+        super().__init__(name, memory=True, children=children)
+        self.starts = 0
+
+    def initialise(self) -> None:
+        super().initialise()
+        self.starts += 1
+
+
+def test_users_own_composites_and_decorators_convert_and_tick_like_py_trees() -> None:
+    def build() -> py_trees.behaviour.Behaviour:
+        b = py_trees.behaviours
+        return CountingSequence("seq", [
+            EveryOther("other", b.SuccessEveryN("every2", 2)),
+            py_trees.decorators.Repeat("rep", b.TickCounter("tc", 1, Status.SUCCESS), 2)])
+
+    original = build()
+    expected = []
+    for _ in range(10):
+        original.tick_once()
+        expected.append(original.status.name)
+    converted = build()
+    tree = from_py_trees(converted)
+    assert [tree.tick().value for _ in range(10)] == expected
+    assert isinstance(tree.root, CountingSequence) and tree.root.starts == original.starts
+    assert 'CountingSequence name="seq"' in to_xml(tree)
