@@ -1,11 +1,12 @@
 """Differential test: random py_trees trees, ticked by py_trees and converted by from_py_trees.
 
 Each seed builds the same random tree twice (every composite and decorator of py_trees, its own
-leaves, blackboard reads and writes, clock-based nodes): py_trees ticks one, the other is
-converted with ``from_py_trees`` and ticked by bt-manip. After every tick the root statuses
-must be equal, and so must the log of what the leaves did (each ``initialise()``, each
-``update()`` with its result, each ``terminate()``); at the end the blackboards hold the same
-values. Both engines read one manual clock, advanced by the same step after every tick.
+leaves, blackboard reads and writes, clock-based nodes, subclasses of py_trees' nodes): py_trees
+ticks one, the other is converted with ``from_py_trees`` and ticked by bt-manip. After every
+tick the root statuses must be equal, and so must the log of what the leaves did (each
+``initialise()``, each ``update()`` with its result, each ``terminate()``); at the end the
+blackboards hold the same values. Both engines read one manual clock, advanced by the same step
+after every tick.
 
 Half of the seeds convert with BT.CPP built-ins where they tick alike (``builtins=True``);
 there py_trees' extra ``terminate(INVALID)`` on an already finished child (see
@@ -51,9 +52,9 @@ class Builder:
 
     def tree(self, depth: int = 0) -> py_trees.behaviour.Behaviour:
         roll = self.rng.random()
-        if depth >= 4 or roll < 0.35:
+        if depth >= 4 or (depth > 0 and roll < 0.1 + 0.15 * depth):
             return self.leaf()
-        if roll < 0.7:
+        if roll < 0.65:
             return self.composite(depth)
         return self.decorator(depth)
 
@@ -68,7 +69,8 @@ class Builder:
         if kind == "seq":
             return py_trees.composites.Sequence(self.name("Seq"), memory, children)
         if kind == "sel":
-            return py_trees.composites.Selector(self.name("Sel"), memory, children)
+            selector = OwnSelector if rng.random() < 0.2 else py_trees.composites.Selector
+            return selector(self.name("Sel"), memory, children)
         policies = py_trees.common.ParallelPolicy
         which = rng.choice(["all", "one", "selected"])
         if which == "all":
@@ -92,7 +94,8 @@ class Builder:
         if kind < len(simple):
             return simple[kind](name=name, child=child)
         if kind == 9:
-            return d.Repeat(name, child, rng.choice([1, 2, 3, -1]))
+            repeat = OwnRepeat if rng.random() < 0.3 else d.Repeat
+            return repeat(name, child, rng.choice([1, 2, 3, -1]))
         if kind == 10:
             return d.Retry(name, child, rng.choice([1, 2, 3]))
         if kind == 11:
@@ -162,6 +165,17 @@ class Builder:
             node.initialise = logged_initialise  # type: ignore[method-assign]
             node.update = logged_update  # type: ignore[method-assign]
             node.terminate = logged_terminate  # type: ignore[method-assign]
+
+
+class OwnRepeat(py_trees.decorators.Repeat):
+    """A user's subclass of a py_trees decorator (converted as the user's own class)."""
+
+
+class OwnSelector(py_trees.composites.Selector):
+    """A user's subclass of a py_trees composite, with an initialise of its own."""
+
+    def initialise(self) -> None:
+        self.feedback_message = "started"
 
 
 def has_a(blackboard: Any) -> bool:
@@ -294,3 +308,4 @@ def test_the_generator_covers_every_composite_decorator_and_leaf(clock: ManualCl
     assert decorators - seen == set()
     assert composites - seen == set()
     assert leaves - seen == set()
+    assert {"OwnRepeat", "OwnSelector"} <= seen
