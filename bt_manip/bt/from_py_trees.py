@@ -159,8 +159,8 @@ def _decorator(node: py_trees.decorators.Decorator, builtins: bool) -> BtNode:
         made = ptc.PyTreesForEach(name, child, source_key=node.source_key,
                                   target_key=node.target_key)
     elif kind is D.EternalGuard:
-        guard = ptc.PyTreesEternalGuard(name, child, condition=_original(node.condition))
-        guard.condition = node.condition  # already bound to the guard's own client
+        guard = ptc.PyTreesEternalGuard(name, child, condition=node.condition)
+        guard.condition = node.condition  # already bound to the original guard's client
         guard.blackboards.extend(node.blackboards)
         made = guard
     else:
@@ -208,10 +208,6 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
     made.status = py_trees.common.Status.INVALID
     made._init_node({})
     return made  # type: ignore[no-any-return]
-
-
-def _original(condition: Any) -> Any:
-    return getattr(condition, "func", condition)
 
 
 def _register_leaves(root: BtNode) -> None:

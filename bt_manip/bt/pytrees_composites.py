@@ -33,9 +33,11 @@ from bt_manip.bt.node import (
     DecoratorNode,
     LeafNode,
     TreeRuntimeError,
+    _truth,
 )
 from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage
 from bt_manip.bt.registry import registry
+from bt_manip.bt.script import Script
 from bt_manip.bt.status import NodeStatus
 
 Ports = dict[str, PortInformation]
@@ -395,36 +397,42 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
 
 @registry.register
 class PyTreesEternalGuard(_ClientDecorator):
-    """py_trees' ``EternalGuard``: checks ``condition`` (a Python callable, optionally taking
-    the blackboard client) at every tick before the child; false stops the child and returns
-    FAILURE, true ticks the child and returns its status. Built in Python only."""
+    """py_trees' ``EternalGuard``: checks ``condition`` at every tick before the child; false
+    stops the child and returns FAILURE, true ticks the child and returns its status.
+
+    In Python the condition is a callable returning a bool or a py_trees Status (given the
+    blackboard client when it takes a ``blackboard`` argument); in XML it is a bt-manip script
+    evaluated on the blackboard (``condition="battery > 20"``).
+    """
 
     PY = py_trees.decorators.EternalGuard
     INPUT_PORTS: ClassVar[Ports] = {
-        "condition": PortInformation(object, description="Python callable (bool or Status)"),
+        "condition": PortInformation(object, description="script (XML) or Python callable"),
         "blackboard_keys": PortInformation(list[str], required=False,
-                                           description="entries the condition reads"),
+                                           description="entries a Python condition reads"),
     }
-
-    @classmethod
-    def check_attributes(cls, attributes: Any) -> AttributeCheck:
-        check = super().check_attributes(attributes)
-        condition = attributes.get("condition")
-        if condition is not None and not callable(getattr(condition, "value", condition)):
-            check.errors.append((f"{cls.NODE_ID}: condition must be a Python callable; this "
-                                 "node can only be built in Python", None))
-        return check
+    SCRIPT_PORTS = ("condition",)
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
-                 condition: Callable[..., Any] | None = None, **attributes: Any) -> None:
+                 **attributes: Any) -> None:
         keys = attributes.get("blackboard_keys") or []
-        super().__init__(name, child, condition=condition, **attributes)
+        super().__init__(name, child, **attributes)
         client = self._client({k: py_trees.common.Access.READ for k in keys})
-        assert condition is not None
-        if "blackboard" in inspect.signature(condition).parameters:
-            self.condition: Callable[[], Any] = functools.partial(condition, client)
+        condition = self.bindings["condition"]
+        value = getattr(condition, "value", None)
+        if isinstance(value, Script):
+            script = value
+            self.condition: Callable[[], Any] = lambda: _truth(self, "condition", script)
+        elif callable(value):
+            if "blackboard" in inspect.signature(value).parameters:
+                self.condition = functools.partial(value, client)
+            else:
+                self.condition = value
+            function = getattr(value, "func", value)
+            self.attribute_texts["condition"] = getattr(function, "__qualname__", str(value))
         else:
-            self.condition = condition
+            raise ValueError(f"{self.NODE_ID}: condition must be a script or a Python "
+                             "callable, got a blackboard reference or a value")
 
     def _py_tick(self) -> Any:
         result = self.condition()

@@ -350,3 +350,17 @@ def test_users_own_composites_and_decorators_convert_and_tick_like_py_trees() ->
     assert [tree.tick().value for _ in range(10)] == expected
     assert isinstance(tree.root, CountingSequence) and tree.root.starts == original.starts
     assert 'CountingSequence name="seq"' in to_xml(tree)
+
+
+def test_eternal_guard_takes_a_script_in_xml() -> None:
+    tree = load_tree_string(xml(
+        '<PyTreesEternalGuard condition="battery > 20"><TickCounter duration="5" '
+        'completion_status="SUCCESS"/></PyTreesEternalGuard>'), blackboard={"battery": 50})
+    counter = tree.root.child.behaviour
+    assert [tree.tick().value for _ in range(2)] == [R, R]
+    tree.blackboard.set("battery", 10)
+    assert tree.tick().value == F
+    assert counter.status == Status.INVALID  # the guard stopped the RUNNING child
+    with pytest.raises(InputError, match="script syntax error in condition"):
+        load_tree_string(xml('<PyTreesEternalGuard condition="battery >"><Success/>'
+                             '</PyTreesEternalGuard>'))
