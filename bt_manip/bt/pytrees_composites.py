@@ -35,7 +35,7 @@ from bt_manip.bt.node import (
     TreeRuntimeError,
     _truth,
 )
-from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage
+from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage, raised_as_tree_error
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script
 from bt_manip.bt.status import NodeStatus
@@ -64,7 +64,7 @@ class _PyTreesNode:
         return py_trees_storage(EntryView(self.blackboard))  # type: ignore[attr-defined]
 
     def tick_node(self) -> NodeStatus:
-        with self._storage():
+        with self._storage(), raised_as_tree_error(self):
             for _ in self._py_tick():
                 pass
         return _result(self)  # type: ignore[arg-type]

@@ -122,6 +122,18 @@ def py_trees_storage(view: MutableMapping) -> Iterator[None]:  # type: ignore[ty
         storage.storage = saved
 
 
+@contextlib.contextmanager
+def raised_as_tree_error(node: Any) -> Iterator[None]:
+    """An exception raised by py_trees code (a behaviour's ``update()``...) becomes a
+    :class:`TreeRuntimeError` naming the node, so a run ends with an error, not a traceback."""
+    try:
+        yield
+    except TreeRuntimeError:
+        raise
+    except Exception as e:
+        raise TreeRuntimeError(f"{node.describe()}: {type(e).__name__}: {e}") from e
+
+
 # ---------------------------------------------------------------------- constructor arguments
 
 
@@ -391,7 +403,7 @@ class PyTreesLeaf(LeafNode):
 
     def tick_node(self) -> NodeStatus:
         behaviour = self.behaviour
-        with py_trees_storage(self._view()):
+        with py_trees_storage(self._view()), raised_as_tree_error(self):
             for _ in behaviour.tick():
                 pass
         self.feedback_message = behaviour.feedback_message

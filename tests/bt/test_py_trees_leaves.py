@@ -11,7 +11,15 @@ import pytest
 from py_trees.common import Status
 from py_trees.ports import BehaviourWithPorts, PortInformation
 
-from bt_manip.bt import Tree, from_py_trees, load_tree_string, registry, to_xml, validate
+from bt_manip.bt import (
+    Tree,
+    TreeRuntimeError,
+    from_py_trees,
+    load_tree_string,
+    registry,
+    to_xml,
+    validate,
+)
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.controls import ReactiveSequence, Sequence
 from bt_manip.bt.decorators import Inverter
@@ -364,3 +372,12 @@ def test_eternal_guard_takes_a_script_in_xml() -> None:
     with pytest.raises(InputError, match="script syntax error in condition"):
         load_tree_string(xml('<PyTreesEternalGuard condition="battery >"><Success/>'
                              '</PyTreesEternalGuard>'))
+
+
+def test_an_exception_in_a_behaviour_is_a_tree_error_naming_the_node() -> None:
+    tree = load_tree_string(xml('<BlackboardToStatus name="read" variable_name="missing"/>'))
+    with pytest.raises(TreeRuntimeError) as caught:
+        tree.tick()
+    assert str(caught.value).startswith(
+        "BlackboardToStatus 'read' (line 1): KeyError: \"client 'read' tried to access "
+        "'/missing' but it does not yet exist on the blackboard\"")
