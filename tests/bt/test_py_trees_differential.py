@@ -159,7 +159,7 @@ class Builder:
             return result
 
         def logged_terminate(new_status: Status) -> None:
-            was = "" if node.status == Status.RUNNING else " (had finished)"
+            was = "" if node.status == Status.RUNNING else " (was not RUNNING)"
             log.append(("terminate", name, new_status.name + was))
             terminate(new_status)
 
@@ -255,7 +255,7 @@ def run_converted(seed: int, clock: ManualClock, builtins: bool
 def comparable(log: Log, builtins: bool) -> Log:
     if not builtins:
         return log
-    return [entry for entry in log if entry[2] != "INVALID (had finished)"]
+    return [entry for entry in log if entry[2] != "INVALID (was not RUNNING)"]
 
 
 def test_random_py_trees_trees_tick_alike_after_conversion(clock: ManualClock) -> None:
