@@ -4,6 +4,7 @@ Public API::
 
     from bt_manip.bt import load_tree, validate_file, Tree, TreeContext, registry, to_xml
     from bt_manip.bt import ActionNode, ConditionNode   # base classes for robot behaviours
+    from bt_manip.bt import from_py_trees               # a py_trees tree as a bt-manip Tree
 """
 
 from bt_manip.bt import (  # noqa: F401  (register the built-ins)
@@ -15,6 +16,7 @@ from bt_manip.bt import (  # noqa: F401  (register the built-ins)
 )
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
+from bt_manip.bt.from_py_trees import from_py_trees
 from bt_manip.bt.node import (
     ActionNode,
     BtNode,
@@ -26,12 +28,15 @@ from bt_manip.bt.node import (
     TreeRuntimeError,
 )
 from bt_manip.bt.ports import InOutPortInformation
+from bt_manip.bt.pytrees_leaf import register_py_trees_behaviours
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import NodeRecord, Tree
 from bt_manip.bt.xml_loader import load_tree, load_tree_string, validate, validate_file
 from bt_manip.bt.xml_writer import to_xml
+
+register_py_trees_behaviours()  # py_trees' own leaves: <SuccessEveryN n="3"/> in XML
 
 __all__ = [
     "ActionNode",
@@ -49,6 +54,7 @@ __all__ = [
     "Tree",
     "TreeContext",
     "TreeRuntimeError",
+    "from_py_trees",
     "load_tree",
     "load_tree_string",
     "registry",

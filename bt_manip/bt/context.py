@@ -28,6 +28,10 @@ class TreeContext:
     timers: dict[int, tuple[float, Callable[[], None] | None]] = field(default_factory=dict)
     """Pending timers of Sleep, Delay and Timeout: id -> (deadline, callback)."""
     _timer_ids: int = 0
+    visited: list[Any] | None = None
+    """Nodes ticked in the current tree tick, in the order they returned (set by Tree)."""
+    tree: Any = None
+    """The Tree that ticks this context (for py_trees tools ticking the root)."""
 
     def now(self) -> float:
         return self.clock.now()

@@ -355,6 +355,9 @@ class BtNode(PortsMixin):
         if new is not NodeStatus.SKIPPED:
             self.bt_status = new
             self.status = _PY_BY_ID[id(new)]
+        visited = self.context.visited
+        if visited is not None:  # for py_trees tools: the nodes that ran in this tick
+            visited.append(self)
         return new
 
     def tick_node(self) -> NodeStatus:
@@ -392,10 +395,24 @@ class BtNode(PortsMixin):
             self._run_script("_onHalted", script)
 
     def reset_status(self) -> None:
+        """Make the node IDLE. py_trees' ``status`` keeps a finished node's SUCCESS or FAILURE
+        for py_trees tools (``py_trees.display``) until the next ``Tree.tick()`` clears it."""
         self.bt_status = NodeStatus.IDLE
-        self.status = Status.INVALID
+        if self.status is _RUNNING:
+            self.status = Status.INVALID
 
-    def tick(self) -> Any:  # py_trees' generator protocol, for py_trees tools
+    def tick(self) -> Any:
+        """py_trees' generator protocol, for py_trees tools (``py_trees.trees.BehaviourTree``).
+
+        The root of a :class:`~bt_manip.bt.tree.Tree` runs one ``Tree.tick()`` and yields every
+        node that ran in it, children before parents, the root last; another node runs one
+        tick of itself and yields itself.
+        """
+        tree = self.context.tree
+        if tree is not None and tree.root is self:
+            tree.tick()
+            yield from tree.visited_nodes()
+            return
         self.execute_tick()
         yield self
 
@@ -405,6 +422,7 @@ class BtNode(PortsMixin):
             if self.bt_status is NodeStatus.RUNNING:
                 self.halt_node()
             self.reset_status()
+            self.status = Status.INVALID
         else:
             self.status = new_status
             self.bt_status = _BT_FROM_PY[new_status]
@@ -502,7 +520,8 @@ class ControlNode(BtNode, py_trees.composites.Composite):
     def __init__(
         self, name: str | None = None, children: list[BtNode] | None = None, **attributes: Any
     ) -> None:
-        super().__init__(name or self.NODE_ID, children=list(children or []))  # type: ignore[arg-type]
+        kids = [as_bt_node(c) for c in children or []]
+        super().__init__(name or self.NODE_ID, children=kids)  # type: ignore[arg-type]
         self._init_node(attributes)
         self._check_children()
 
@@ -544,7 +563,7 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
     ) -> None:
         if child is None:
             raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got 0")
-        super().__init__(name or self.NODE_ID, child)  # type: ignore[arg-type]
+        super().__init__(name or self.NODE_ID, as_bt_node(child))  # type: ignore[arg-type]
         self._init_node(attributes)
 
     @property
@@ -581,3 +600,12 @@ def children_rule(cls: type[BtNode]) -> str:
     if hi is None:
         return f"must have at least {lo} child" + ("" if lo == 1 else "ren")
     return f"must have {lo} to {hi} children"
+
+
+def as_bt_node(node: Any) -> BtNode:
+    """``node`` itself, or a plain py_trees behaviour (or whole py_trees tree) converted."""
+    if isinstance(node, BtNode) or not isinstance(node, py_trees.behaviour.Behaviour):
+        return node  # type: ignore[return-value]
+    from bt_manip.bt.from_py_trees import convert_node
+
+    return convert_node(node)

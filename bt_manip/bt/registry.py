@@ -8,12 +8,17 @@ behaviours) register themselves when their module is imported::
     @registry.register
     class OpenGripper(ActionNode):
         ...
+
+A py_trees behaviour class (any ``py_trees.behaviour.Behaviour`` subclass) can be registered
+too: it is wrapped as a leaf (see :mod:`bt_manip.bt.pytrees_leaf`) under its class name.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from typing import TypeVar
+
+import py_trees
 
 from bt_manip.bt.node import BtNode
 
@@ -35,8 +40,15 @@ class NodeRegistry:
         """Register ``cls`` under its ``NODE_ID``; usable as a decorator (with or without args)."""
 
         def add(node_cls: N) -> N:
+            if isinstance(node_cls, type) and issubclass(node_cls, py_trees.behaviour.Behaviour) \
+                    and not issubclass(node_cls, BtNode):
+                from bt_manip.bt.pytrees_leaf import leaf_class_for
+
+                add(leaf_class_for(node_cls))  # type: ignore[arg-type]
+                return node_cls  # the user's class stays as it is
             if not (isinstance(node_cls, type) and issubclass(node_cls, BtNode)):
-                raise TypeError(f"{node_cls!r} is not a bt-manip node class")
+                raise TypeError(f"{node_cls!r} is neither a bt-manip node class nor a "
+                                "py_trees.behaviour.Behaviour subclass")
             node_id = node_cls.NODE_ID
             existing = self._classes.get(node_id)
             if existing is not None and existing is not node_cls and not _same_origin(

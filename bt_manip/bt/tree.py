@@ -6,6 +6,8 @@ from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
+from py_trees.common import Status
+
 from bt_manip.bt.blackboard import Blackboard, EntryTypeError
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
@@ -13,6 +15,8 @@ from bt_manip.bt.ports import Ref
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
 from bt_manip.errors import InputError
+
+INVALID = Status.INVALID
 
 
 @dataclass
@@ -62,6 +66,8 @@ class Tree:
         self.source = source
         self.bt_status = NodeStatus.IDLE
         self.tick_count = 0
+        self.context.tree = self
+        self.context.visited = []
         self._wire(root, self.blackboard)
 
     def _wire(self, node: BtNode, bb: Blackboard) -> None:
@@ -88,6 +94,7 @@ class Tree:
         self.tick_count += 1
         root = self.root
         context = self.context
+        self._new_visit()
         if context.timers:
             context.fire_timers()
         status = root.execute_tick()
@@ -99,9 +106,30 @@ class Tree:
     def tick_exactly_once(self) -> NodeStatus:
         """Tick the root once, even if a wake-up is pending (``tickExactlyOnce``)."""
         self.tick_count += 1
+        self._new_visit()
         if self.context.timers:
             self.context.fire_timers()
         return self._finish(self.root.execute_tick())
+
+    def _new_visit(self) -> None:
+        """Start a tick's list of visited nodes; nodes of the previous tick that finished and
+        were reset stop showing their status to py_trees tools (see ``BtNode.reset_status``)."""
+        visited = self.context.visited
+        if visited:
+            idle = NodeStatus.IDLE
+            for node in visited:
+                if node.bt_status is idle:
+                    node.status = INVALID
+        self.context.visited = []
+
+    def visited_nodes(self) -> list[BtNode]:
+        """Every node that ran in the last tick once, in the order it last returned (children
+        before their parent, the root last)."""
+        seen: dict[int, BtNode] = {}
+        for node in self.context.visited or []:
+            seen.pop(id(node), None)
+            seen[id(node)] = node
+        return list(seen.values())
 
     def _finish(self, status: NodeStatus) -> NodeStatus:
         if status is NodeStatus.SUCCESS or status is NodeStatus.FAILURE:
@@ -132,6 +160,8 @@ class Tree:
         for node in self.nodes():
             node.halt_node()
         root.reset_status()
+        for node in self.nodes():
+            node.status = INVALID
         self.bt_status = NodeStatus.IDLE
 
     def walk(self) -> Iterator[tuple[str, int, BtNode]]:

@@ -406,12 +406,15 @@ class _Builder:
         else:
             cls = self.reg.get(node_id) or self._stand_in(node_id)
             children = [self.node(child, file) for child in element.children]
-            if issubclass(cls, ControlNode):
-                node = cls(name, children=children, **attributes)
-            elif issubclass(cls, DecoratorNode):
-                node = cls(name, child=children[0], **attributes)
-            else:
-                node = cls(name, **attributes)
+            try:
+                if issubclass(cls, ControlNode):
+                    node = cls(name, children=children, **attributes)
+                elif issubclass(cls, DecoratorNode):
+                    node = cls(name, child=children[0], **attributes)
+                else:
+                    node = cls(name, **attributes)
+            except ValueError as e:  # a constructor refused its arguments
+                raise InputError.single(file, element.line, str(e)) from None
         node.xml_file = file
         node.xml_line = element.line
         return node

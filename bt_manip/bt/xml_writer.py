@@ -1,7 +1,8 @@
 """Saving a tree as BT.CPP v4 XML (for trees built in Python).
 
-``to_xml(tree)`` writes the main tree and one ``<BehaviorTree>`` per distinct SubTree ID;
-loading the result with :func:`~bt_manip.bt.load_tree` gives an equivalent tree.
+``to_xml(tree)`` writes the main tree and one ``<BehaviorTree>`` per distinct SubTree ID, then a
+``<TreeNodesModel>`` declaring the nodes that are not BT.CPP built-ins; loading the result
+with :func:`~bt_manip.bt.load_tree` gives an equivalent tree.
 """
 
 from __future__ import annotations
@@ -55,8 +56,30 @@ def root_to_xml(root: BtNode, tree_id: str = "MainTree") -> str:
         for sub_id, sub_root in subtrees.items():
             if sub_id not in written:
                 pending.append((sub_id, sub_root))
+    out += _models(root)
     out += ["</root>", ""]
     return "\n".join(out)
+
+
+def _models(root: BtNode) -> list[str]:
+    """A ``<TreeNodesModel>`` declaring the tree's nodes that are not BT.CPP built-ins (so
+    Groot2 knows their kind and ports)."""
+    from bt_manip.bt.models import write_models
+    from bt_manip.bt.registry import registry
+
+    classes: dict[str, type[BtNode]] = {}
+    stack = [root]
+    while stack:
+        node = stack.pop()
+        stack.extend(node.bt_children())
+        if not isinstance(node, SubTree) and not registry.is_builtin(node.NODE_ID):
+            classes.setdefault(node.NODE_ID, type(node))
+    if not classes:
+        return []
+    lines = write_models(list(classes.values())).split("\n")
+    start = lines.index("  <TreeNodesModel>")
+    end = lines.index("  </TreeNodesModel>")
+    return lines[start:end + 1]
 
 
 def to_xml(tree: Tree | BtNode) -> str:
