@@ -328,7 +328,10 @@ class RunOnce(_Decorator):
         self._returned = NodeStatus.IDLE
 
     def tick_node(self) -> NodeStatus:
-        skip = self.get_input("then_skip", True)  # BT.CPP: true unless the port gives a value
+        try:  # BT.CPP: true unless the port gives a bool (no value, or text that is none)
+            skip = self.get_input("then_skip", True)
+        except PortError:
+            skip = True
         if self._done:
             return SKIPPED if skip else self._returned
         self._start()

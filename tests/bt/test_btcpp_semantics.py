@@ -276,6 +276,8 @@ def test_an_integer_assigned_to_a_double_entry_keeps_it_double() -> None:
 def test_run_once_reads_then_skip_as_true_when_its_entry_has_no_value() -> None:
     statuses, _, _ = same('<RunOnce then_skip="{b}"><AlwaysSuccess/></RunOnce>', 2)
     assert statuses == ["SUCCESS", "SKIPPED"]
+    statuses, _, _ = same('<RunOnce then_skip="{b}"><AlwaysSuccess/></RunOnce>', 2, {"b": "a"})
+    assert statuses == ["SUCCESS", "SKIPPED"]  # nor when it holds text that is no bool
     statuses, _, _ = same('<Parallel success_count="{k}"><AlwaysSuccess/></Parallel>', 1)
     assert statuses == ["ERROR"]  # other ports without a value are errors
 
