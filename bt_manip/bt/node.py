@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import copy
 import difflib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -119,6 +119,14 @@ class BtNode(PortsMixin):
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
+
+    _bt_status: NodeStatus = NodeStatus.IDLE
+    status_listeners: tuple[Callable[[BtNode, NodeStatus, NodeStatus], None], ...] = ()
+    """Called as ``fn(node, previous, new)`` on every change of :attr:`bt_status` (BT.CPP's
+    status-change subscribers: the Groot2 publisher, the .btlog writer)."""
+    pre_tick: Callable[[BtNode], NodeStatus] | None = None
+    """BT.CPP's pre-tick callback: called before the tick of a node that is not finished and
+    not decided by a pre-condition; a SUCCESS or FAILURE it returns replaces the tick."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
@@ -216,6 +224,19 @@ class BtNode(PortsMixin):
         self.xml_file: str | None = None
         self.xml_line: int | None = None
 
+    @property
+    def bt_status(self) -> NodeStatus:
+        """The node's BT.CPP status (IDLE again once its parent reset it)."""
+        return self._bt_status
+
+    @bt_status.setter
+    def bt_status(self, value: NodeStatus) -> None:
+        previous = self._bt_status
+        self._bt_status = value
+        if value is not previous and self.status_listeners:
+            for listener in self.status_listeners:
+                listener(self, previous, value)
+
     # ------------------------------------------------------------------ ports
 
     def get_input(self, port_name: str, default: Any = _MISSING) -> Any:
@@ -311,6 +332,10 @@ class BtNode(PortsMixin):
     def execute_tick(self) -> NodeStatus:
         """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
         new = self._check_preconditions() if self._pre else None
+        if new is None and self.pre_tick is not None and not self._bt_status.completed:
+            forced = self.pre_tick(self)
+            if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
+                new = forced
         if new is None and self.bt_status is NodeStatus.IDLE and self._fault_injected():
             new = NodeStatus.FAILURE
         if new is None:
