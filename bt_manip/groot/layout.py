@@ -19,6 +19,8 @@ from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 
 INDENT = "    "
+SUBTREE_AUTOREMAP = ("if true, every entry whose key does not start with '_' is shared "
+                     "with the parent")
 
 
 @dataclass
@@ -110,18 +112,23 @@ def _node_xml(node: BtNode, layout: TreeLayout, depth: int, out: list[str]) -> N
 
 
 def models_xml(classes: list[type[BtNode]], depth: int = 1) -> list[str]:
-    """``<TreeNodesModel>`` lines declaring ``classes`` (ports with type, default, text)."""
+    """``<TreeNodesModel>`` lines declaring ``classes`` and SubTree (whose ``_autoremap`` port
+    BT.CPP declares), sorted by ID; ports with type, default and description."""
     pad = INDENT * depth
-    out = [f"{pad}<TreeNodesModel>"]
-    for cls in sorted(classes, key=lambda c: c.NODE_ID):
+    entries: dict[str, list[str]] = {
+        "SubTree": [f'{pad}{INDENT}<SubTree ID="SubTree">',
+                    f'{pad}{INDENT * 2}<input_port name="_autoremap" type="bool" '
+                    f'default="false">{escape(SUBTREE_AUTOREMAP)}</input_port>',
+                    f"{pad}{INDENT}</SubTree>"]}
+    for cls in classes:
         if cls.NODE_ID == "SubTree":
             continue
         spec = spec_of(cls)
         head = f"{pad}{INDENT}<{spec.kind} ID={quoteattr(spec.node_id)}"
         if not spec.ports:
-            out.append(head + "/>")
+            entries[spec.node_id] = [head + "/>"]
             continue
-        out.append(head + ">")
+        lines = [head + ">"]
         for port in spec.ports.values():
             pairs = [("name", port.name)]
             if port.type_name:
@@ -131,8 +138,12 @@ def models_xml(classes: list[type[BtNode]], depth: int = 1) -> list[str]:
             tag = f"{port.direction}_port"
             text = escape(port.description)
             line = f"{pad}{INDENT * 2}<{tag}{_attrs(pairs)}"
-            out.append(f"{line}>{text}</{tag}>" if text else f"{line}/>")
-        out.append(f"{pad}{INDENT}</{spec.kind}>")
+            lines.append(f"{line}>{text}</{tag}>" if text else f"{line}/>")
+        lines.append(f"{pad}{INDENT}</{spec.kind}>")
+        entries[spec.node_id] = lines
+    out = [f"{pad}<TreeNodesModel>"]
+    for node_id in sorted(entries):
+        out += entries[node_id]
     out.append(f"{pad}</TreeNodesModel>")
     return out
 
