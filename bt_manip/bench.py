@@ -62,7 +62,9 @@ def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float,
 
 
 def run_one(spec: EpisodeSpec) -> EpisodeResult:
-    """Run one episode (in a worker process) and condense its report."""
+    """Run one episode (in a worker process) and condense its report.
+
+    With ``spec.btlog`` set, the episode's .btlog is kept only when it did not succeed."""
     with Episode(spec) as episode:
         report = episode.run()
         metrics = {
@@ -70,6 +72,8 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             for k, v in episode.tree.blackboard.as_dict().items()
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
+    if spec.btlog and report.status == "SUCCESS":
+        Path(spec.btlog).unlink(missing_ok=True)
     failed = [n for n in report.nodes if n.status == "FAILURE"]
     deepest = max(failed, key=lambda n: n.path.count("/")) if failed else None
     return EpisodeResult(
@@ -197,9 +201,18 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
     return log
 
 
-def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
-    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed."""
+def run_bench(
+    base: EpisodeSpec, runs: int, jobs: int = 1, btlog_failures: str | None = None
+) -> list[EpisodeResult]:
+    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
+
+    With ``btlog_failures`` (a folder), each episode that does not succeed leaves
+    ``seed-N.btlog`` there, to replay in Groot2."""
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
+    if btlog_failures:
+        Path(btlog_failures).mkdir(parents=True, exist_ok=True)
+        specs = [replace(s, btlog=str(Path(btlog_failures) / f"seed-{s.seed}.btlog"))
+                 for s in specs]
     progress = _progress(runs)
     results: list[EpisodeResult] = []
     if jobs <= 1:

@@ -45,6 +45,17 @@ def _positive(kind: type) -> Any:
     return convert
 
 
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got '{text}'") from None
+    if not 0 <= value <= 65534:
+        raise argparse.ArgumentTypeError(
+            f"must be a port from 1 to 65534 (PUB uses the next one), or 0 for any, got {text}")
+    return value
+
+
 def _bb_pair(text: str) -> tuple[str, str]:
     key, sep, value = text.partition("=")
     if not sep or not key.strip():
@@ -150,6 +161,27 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument(
         "--record", metavar="FILE.html", help="write a self-contained replay page of the run"
     )
+    run.add_argument(
+        "--groot",
+        type=_port,
+        nargs="?",
+        const=1667,
+        default=None,
+        metavar="PORT",
+        help="serve the run to Groot2 (default port 1667, PUB on PORT+1): live statuses, "
+        "blackboards, breakpoints; 0 picks free ports",
+    )
+    run.add_argument(
+        "--bind",
+        default="127.0.0.1",
+        metavar="ADDR",
+        help="address the servers of the run listen on (default 127.0.0.1: this machine only)",
+    )
+    run.add_argument(
+        "--btlog",
+        metavar="FILE.btlog",
+        help="write the run's status changes as a Groot2 log (FileLogger2 format)",
+    )
     _add_inject(run)
     run.set_defaults(func=cmd_run)
 
@@ -166,6 +198,11 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--max-ticks", type=_positive(int))
     bench.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S")
     bench.add_argument("--tick-hz", type=_positive(float), default=20.0)
+    bench.add_argument(
+        "--btlog-failures",
+        metavar="DIR",
+        help="write DIR/seed-N.btlog for every episode that does not succeed (Groot2 replays it)",
+    )
     _add_inject(bench)
     bench.set_defaults(func=cmd_bench)
 
@@ -236,6 +273,7 @@ def _episode_spec(args: argparse.Namespace) -> Any:
         blackboard=dict(args.bb),
         inject=list(args.inject),
         options=options,
+        btlog=getattr(args, "btlog", None),
     )
 
 
@@ -249,6 +287,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         hooks: list[Any] = [] if args.quiet else [_live_view(tree)]
         from bt_manip.viz.hooks import setup_viz
 
+        publisher = _start_groot(args, episode)
         viz = setup_viz(args, world, tree)
         hooks += viz.hooks
         episode.spec.options.realtime = viz.realtime
@@ -259,6 +298,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 close = getattr(hook, "close", None)
                 if callable(close):
                     close()
+            if publisher is not None:
+                publisher.close()
         print(report.summary())
         if report.extra.get("injected"):
             print(f"  faults injected: {len(report.extra['injected'])}")
@@ -272,6 +313,33 @@ def cmd_run(args: argparse.Namespace) -> int:
         return report.exit_code
 
 
+def _start_groot(args: argparse.Namespace, episode: Any) -> Any:
+    """The Groot2 publisher asked for by ``--groot`` (None without it)."""
+    if args.groot is None:
+        return None
+    from bt_manip.groot import GrootPublisher
+    from bt_manip.groot.publisher import GrootError
+
+    layout = episode.monitor().layout
+
+    def paused(uid: int | None) -> None:
+        if uid is None:
+            print("groot2: breakpoint released, the run goes on", flush=True)
+            return
+        node = layout.nodes_by_uid[uid]
+        print(f"groot2: paused at the breakpoint on {node.describe()} (uid {uid}); "
+              "sim time stopped until Groot2 unlocks it", flush=True)
+
+    try:
+        publisher = GrootPublisher(
+            episode.monitor(), port=args.groot, bind=args.bind, on_pause=paused)
+    except GrootError as e:
+        raise InputError.single("--groot", None, str(e)) from None
+    print(f"groot2: serving the tree on {args.bind}:{publisher.port} "
+          f"(PUB {publisher.port + 1}); connect Groot2's monitor to it", flush=True)
+    return publisher
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from bt_manip.bench import run_bench, summarise, write_outputs
     from bt_manip.episode import Episode
@@ -283,12 +351,15 @@ def cmd_bench(args: argparse.Namespace) -> int:
         f"bench: {args.runs} episodes of {args.tree} on {args.world}, seeds "
         f"{args.seed}..{args.seed + args.runs - 1}, {args.jobs} process(es)"
     )
-    results = run_bench(base, args.runs, jobs=args.jobs)
+    results = run_bench(base, args.runs, jobs=args.jobs, btlog_failures=args.btlog_failures)
     summary = summarise(results, base)
     print(summary.text())
     out = Path(args.out)
     write_outputs(results, summary, out)
     print(f"wrote {out}/episodes.json, episodes.csv, summary.json, outcomes.png")
+    if args.btlog_failures:
+        failed = sum(1 for r in results if not r.success)
+        print(f"wrote {failed} .btlog file(s) of failed episodes to {args.btlog_failures}")
     return 0 if summary.successes == summary.runs else 1
 
 

@@ -374,12 +374,14 @@ class GrootPublisher:
             hook = self._hooks.get(uid) if uid is not None else None
             if hook is None or not hook.enabled:
                 return NodeStatus.SKIPPED
-            self._pub.send_multipart(
-                [request_header(RequestType.BREAKPOINT_REACHED), str(uid).encode()])
-            if hook.mode == hk.BREAKPOINT:
+            breakpoint = hook.mode == hk.BREAKPOINT
+            if breakpoint:
                 self.paused_uid = uid
                 if self.on_pause is not None:
                     self.on_pause(uid)
+            self._pub.send_multipart(
+                [request_header(RequestType.BREAKPOINT_REACHED), str(uid).encode()])
+            if breakpoint:
                 while not (hook.ready or not hook.enabled):
                     self._cond.wait(0.2)
                 hook.ready = False
