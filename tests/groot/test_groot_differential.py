@@ -249,3 +249,44 @@ def test_btlog_has_the_transition_sequence_of_file_logger2(tmp_path: Path) -> No
     stamps = sorted({stamp for stamp, _, _ in log.transitions})
     assert stamps == [0, 50_000, 100_000, 150_000]  # sim time of each tick and the halt (us)
     assert structure(log.xml)[0] == structure(read_btlog(tmp_path / "btcpp.btlog").xml)[0]
+
+
+def test_replace_hooks_force_statuses_as_in_btcpp() -> None:
+    """A replace-hook (mode 1) makes a node return its desired status without ticking it; a
+    ``once`` hook goes away after its first use. Both engines, same hooks, same ticks."""
+    ref, ours = Reference(), Ours()
+    clients = GrootClient(ref.port), GrootClient(ours.port)
+    try:
+        fulltree = both(clients, "T")[1][1].decode()
+        assert '<AlwaysFailure name="close" _uid="8"/>' in fulltree
+        assert '_uid="15" num_cycles="2">\n' \
+               '                <AlwaysSuccess name="AlwaysSuccess" _uid="16"/>' in fulltree
+        hooks = [  # Grasp's AlwaysFailure 'close' succeeds; Repeat's child fails once
+            {"enabled": True, "uid": 8, "mode": 1, "once": False,
+             "desired_status": "SUCCESS", "position": 0},
+            {"enabled": True, "uid": 16, "mode": 1, "once": True,
+             "desired_status": "FAILURE", "position": 0},
+        ]
+        same_header(*both(clients, "I", json.dumps(hooks)))
+        same_header(*both(clients, "r", "start"))
+        seen: list[bytes] = []
+        for _ in range(TICKS):
+            ref.tick()
+            ours.tick()
+            ref_reply, our_reply = both(clients, "S")
+            assert our_reply[1] == ref_reply[1]
+            ref_reply, our_reply = both(clients, "t")
+            changes = [our_reply[1][i + 6:i + 9] for i in range(0, len(our_reply[1]), 9)]
+            assert changes == [
+                ref_reply[1][i + 6:i + 9] for i in range(0, len(ref_reply[1]), 9)]
+            seen += changes
+        assert b"\x08\x00\x02" in seen and b"\x08\x00\x03" not in seen  # 'close' forced
+        assert seen.count(b"\x10\x00\x03") == 1  # the once hook failed the child once
+        ref_dump, our_dump = both(clients, "D")
+        assert json.loads(our_dump[1]) == json.loads(ref_dump[1]) == hooks[:1]
+    finally:
+        for client in clients:
+            client.close()
+        ours.publisher.close()
+        ours.monitor.close()
+        del ref.publisher
