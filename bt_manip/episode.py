@@ -80,9 +80,14 @@ class Episode:
         runner = Runner(self.tree, self.world, self.spec.options, on_tick=hooks)
         writer = None
         if self.spec.btlog:
+            from bt_manip.errors import InputError
             from bt_manip.groot import BtlogWriter
 
-            writer = BtlogWriter(self.spec.btlog, self.monitor())
+            try:
+                writer = BtlogWriter(self.spec.btlog, self.monitor())
+            except OSError as e:
+                raise InputError.single(
+                    "--btlog", None, f"cannot write {self.spec.btlog}: {e.strerror}") from None
         try:
             report = runner.run()
         finally:

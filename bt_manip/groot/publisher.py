@@ -117,7 +117,10 @@ class GrootPublisher:
             self._bind_one(self._pub, address, port + 1)
             return port
         for _ in range(50):
-            chosen = self._server.bind_to_random_port(f"tcp://{address}", 20000, 60000)
+            try:
+                chosen = self._server.bind_to_random_port(f"tcp://{address}", 20000, 60000)
+            except zmq.ZMQError as e:
+                raise GrootError(f"cannot listen on {address}: {e}") from None
             try:
                 self._pub.bind(f"tcp://{address}:{chosen + 1}")
                 return chosen
@@ -382,12 +385,14 @@ class GrootPublisher:
             self._pub.send_multipart(
                 [request_header(RequestType.BREAKPOINT_REACHED), str(uid).encode()])
             if breakpoint:
-                while not (hook.ready or not hook.enabled):
-                    self._cond.wait(0.2)
-                hook.ready = False
-                self.paused_uid = None
-                if self.on_pause is not None:
-                    self.on_pause(None)
+                try:
+                    while not (hook.ready or not hook.enabled):
+                        self._cond.wait(0.2)  # short waits: Ctrl-C still interrupts
+                finally:
+                    hook.ready = False
+                    self.paused_uid = None
+                    if self.on_pause is not None:
+                        self.on_pause(None)
                 if not hook.enabled:
                     return NodeStatus.SKIPPED
             if hook.remove_when_done:
