@@ -59,3 +59,33 @@ class GrootClient:
         self.req.close()
         self.sub.close()
         self.context.term()
+
+
+def sync_subscription(client: GrootClient, publisher: Any, limit_s: float = 30.0) -> None:
+    """Wait until ``client``'s SUB socket gets what the in-process ``publisher`` publishes.
+
+    ZMQ drops what a PUB socket sends before a subscriber's connection is made; Groot2
+    subscribes long before any breakpoint, a test that ticks at once must wait for it. Call
+    before the tree's thread starts (the PUB socket is then free to use from here).
+    """
+    import time
+
+    deadline = time.monotonic() + limit_s
+    client.sub.setsockopt(zmq.RCVTIMEO, 50)
+    try:
+        while time.monotonic() < deadline:
+            publisher._pub.send(b"sync")
+            try:
+                if client.sub.recv() == b"sync":
+                    break
+            except zmq.Again:
+                continue
+        else:
+            raise RuntimeError("the subscription never connected")
+        while True:
+            try:
+                client.sub.recv()
+            except zmq.Again:
+                break
+    finally:
+        client.sub.setsockopt(zmq.RCVTIMEO, client.timeout_ms)

@@ -9,7 +9,8 @@ import time
 from pathlib import Path
 from typing import Any
 
-from groot_client import GrootClient
+import zmq
+from groot_client import GrootClient, sync_subscription
 
 from bt_manip.bt.xml_parse import parse_xml_text
 from bt_manip.episode import Episode, EpisodeSpec
@@ -40,11 +41,11 @@ def status_of(status_reply: bytes, uid: int) -> int:
 def wait_for_breakpoint(client: GrootClient, run: threading.Thread, limit_s: float = 600) -> list:
     """Poll STATUS as Groot2 does (each request is a heartbeat) until the PUB message."""
     deadline = time.monotonic() + limit_s
-    client.sub.setsockopt(__import__("zmq").RCVTIMEO, 200)
+    client.sub.setsockopt(zmq.RCVTIMEO, 200)
     while time.monotonic() < deadline and run.is_alive():
         try:
             return client.sub.recv_multipart()
-        except Exception:
+        except zmq.Again:
             client.request("S")
     raise AssertionError("no breakpoint reached")
 
@@ -56,6 +57,7 @@ def test_breakpoint_on_attach_panel_freezes_sim_time_and_unlock_decides() -> Non
     with Episode(spec) as episode:
         publisher = GrootPublisher(episode.monitor(), port=0)
         client = GrootClient(publisher.port)
+        sync_subscription(client, publisher)
         outcome: dict[str, Any] = {}
         run = threading.Thread(target=lambda: outcome.update(report=episode.run()))
         try:

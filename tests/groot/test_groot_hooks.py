@@ -9,7 +9,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
-from groot_client import GrootClient
+from groot_client import GrootClient, sync_subscription
 
 from bt_manip.bt import TreeContext, load_tree_string
 from bt_manip.bt.status import NodeStatus
@@ -28,6 +28,7 @@ class Rig:
         self.monitor = TreeMonitor(self.tree, self.tree.context.clock.now)
         self.publisher = GrootPublisher(self.monitor, port=0, max_heartbeat_delay=heartbeat)
         self.client = GrootClient(self.publisher.port)
+        sync_subscription(self.client, self.publisher)
         self.result: dict[str, Any] = {}
         self.thread = threading.Thread(
             target=lambda: self.result.update(status=self.tree.tick()))

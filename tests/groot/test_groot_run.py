@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from groot_client import GrootClient
+from groot_client import GrootClient, sync_subscription
 from test_groot_breakpoints import status_of, uid_of, wait_for_breakpoint
 
 from bt_manip import runner as runner_module
@@ -123,6 +123,7 @@ def test_groot_publisher_and_meshcat_viewer_serve_the_same_run() -> None:
     monitor = TreeMonitor(tree, world.clock.now)
     publisher = GrootPublisher(monitor, port=0)
     client = GrootClient(publisher.port)
+    sync_subscription(client, publisher)
     outcome: dict[str, Any] = {}
     try:
         assert live.start() and live.page is not None
