@@ -120,10 +120,6 @@ class BtNode(PortsMixin):
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
 
-    _bt_status: NodeStatus = NodeStatus.IDLE
-    status_listeners: tuple[Callable[[BtNode, NodeStatus, NodeStatus], None], ...] = ()
-    """Called as ``fn(node, previous, new)`` on every change of :attr:`bt_status` (BT.CPP's
-    status-change subscribers: the Groot2 publisher, the .btlog writer)."""
     pre_tick: Callable[[BtNode], NodeStatus] | None = None
     """BT.CPP's pre-tick callback: called before the tick of a node that is not finished and
     not decided by a pre-condition; a SUCCESS or FAILURE it returns replaces the tick."""
@@ -224,19 +220,6 @@ class BtNode(PortsMixin):
         self.xml_file: str | None = None
         self.xml_line: int | None = None
 
-    @property
-    def bt_status(self) -> NodeStatus:
-        """The node's BT.CPP status (IDLE again once its parent reset it)."""
-        return self._bt_status
-
-    @bt_status.setter
-    def bt_status(self, value: NodeStatus) -> None:
-        previous = self._bt_status
-        self._bt_status = value
-        if value is not previous and self.status_listeners:
-            for listener in self.status_listeners:
-                listener(self, previous, value)
-
     # ------------------------------------------------------------------ ports
 
     def get_input(self, port_name: str, default: Any = _MISSING) -> Any:
@@ -332,7 +315,7 @@ class BtNode(PortsMixin):
     def execute_tick(self) -> NodeStatus:
         """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
         new = self._check_preconditions() if self._pre else None
-        if new is None and self.pre_tick is not None and not self._bt_status.completed:
+        if new is None and self.pre_tick is not None and not self.bt_status.completed:
             forced = self.pre_tick(self)
             if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
                 new = forced

@@ -19,9 +19,10 @@ from typing import BinaryIO
 from bt_manip.bt.status import NodeStatus
 from bt_manip.groot.layout import registered_classes, tree_xml
 from bt_manip.groot.monitor import TreeMonitor
-from bt_manip.groot.protocol import STATUS_CODES, decode_transitions, encode_transitions
+from bt_manip.groot.protocol import STATUS_CODES, decode_transitions
 
 MAGIC = b"BTCPP4-FileLogger2"
+_TRANSITION = struct.Struct("<IHHB")  # 48-bit timestamp as 32 + 16 bits, uid, status
 VERSION = 1
 
 
@@ -41,7 +42,8 @@ class BtlogWriter:
 
     def _record(self, uid: int, previous: NodeStatus, new: NodeStatus, stamp: int) -> None:
         if self._file is not None:
-            self._file.write(encode_transitions([(stamp, uid, STATUS_CODES[new])]))
+            self._file.write(_TRANSITION.pack(stamp & 0xFFFF_FFFF, (stamp >> 32) & 0xFFFF, uid,
+                                              STATUS_CODES[new]))
 
     def close(self) -> None:
         """Flush and close the file (further changes are not written)."""

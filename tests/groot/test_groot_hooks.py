@@ -123,3 +123,21 @@ def test_malformed_hook_requests_get_an_error_reply(rig: Rig, kind: str, body: s
     assert reply[0] == b"error"
     assert reply[1].decode().startswith(message)
     assert json.loads(rig.client.request("D")[1]) == []
+
+
+def test_a_closed_monitor_gives_the_nodes_their_own_classes_back() -> None:
+    tree = load_tree_string(XML, context=TreeContext(clock=ManualClock()))
+    classes = [type(node) for node in tree.nodes()]
+    monitor = TreeMonitor(tree, tree.context.clock.now)
+    seen: list[tuple[int, NodeStatus, NodeStatus]] = []
+    monitor.consumers.append(lambda uid, old, new, _: seen.append((uid, old, new)))
+    pairs = zip(tree.nodes(), classes, strict=True)
+    assert all(isinstance(n, c) and type(n) is not c for n, c in pairs)
+    assert tree.tick() is NodeStatus.SUCCESS
+    assert seen[:3] == [(1, NodeStatus.IDLE, NodeStatus.RUNNING),
+                        (2, NodeStatus.IDLE, NodeStatus.SUCCESS),
+                        (3, NodeStatus.IDLE, NodeStatus.SUCCESS)]
+    monitor.close()
+    assert [type(node) for node in tree.nodes()] == classes
+    assert tree.tick() is NodeStatus.SUCCESS and len(seen) == 7
+    assert tree.root.last_status is NodeStatus.SUCCESS
