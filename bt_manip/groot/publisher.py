@@ -13,6 +13,7 @@ physics nor advances the sim clock until Groot2 unlocks it.
 from __future__ import annotations
 
 import json
+import os
 import threading
 import time
 from collections import deque
@@ -382,8 +383,9 @@ class GrootPublisher:
                 self.paused_uid = uid
                 if self.on_pause is not None:
                     self.on_pause(uid)
-            self._pub.send_multipart(
-                [request_header(RequestType.BREAKPOINT_REACHED), str(uid).encode()])
+            notice = request_header(RequestType.BREAKPOINT_REACHED,
+                                    int.from_bytes(os.urandom(4), "little"))
+            self._pub.send_multipart([notice, str(uid).encode()])
             if breakpoint:
                 try:
                     while not (hook.ready or not hook.enabled):

@@ -70,7 +70,8 @@ def test_breakpoint_on_attach_panel_freezes_sim_time_and_unlock_decides() -> Non
 
             # First grasp attempt: paused before attach_panel ticks.
             message = wait_for_breakpoint(client, run)
-            assert message == [b"\x02N\x00\x00\x00\x00", str(attach).encode()]
+            assert len(message[0]) == 6 and message[0][:2] == b"\x02N"  # then a random id
+            assert message[1] == str(attach).encode()
             assert publisher.paused_uid == attach
             frozen = episode.world.time
             status = client.request("S")[1]

@@ -290,3 +290,4 @@ def test_replace_hooks_force_statuses_as_in_btcpp() -> None:
         ours.publisher.close()
         ours.monitor.close()
         del ref.publisher
+
