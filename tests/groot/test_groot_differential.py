@@ -291,3 +291,97 @@ def test_replace_hooks_force_statuses_as_in_btcpp() -> None:
         ours.monitor.close()
         del ref.publisher
 
+
+
+def test_a_breakpoint_unlocked_with_failure_as_in_btcpp(tmp_path: Path) -> None:
+    """Both publishers announce the breakpoint on PUB alike, answer STATUS alike while the
+    tree waits, and a FAILURE unlock fails the node in both (BT.CPP in its own process)."""
+    import subprocess
+    import sys
+    import threading
+
+    from groot_client import sync_subscription
+
+    tree_file = tmp_path / "tree.xml"
+    tree_file.write_text(XML)
+    port = free_port_pair()
+    worker = subprocess.Popen(
+        [sys.executable, str(Path(__file__).with_name("btcpp_worker.py")), str(tree_file),
+         str(port)], stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    ours = Ours()
+    clients: tuple[GrootClient, ...] = ()
+    thread = threading.Thread(target=ours.tick)
+    try:
+        assert worker.stdin is not None and worker.stdout is not None
+        read_until(worker.stdout, "ready")
+        clients = GrootClient(port), GrootClient(ours.port)
+        sync_subscription(clients[1], ours.publisher)
+        time.sleep(1.0)  # BT.CPP's PUB socket: let the subscription connect
+        hook = {"enabled": True, "uid": 5, "mode": 0, "once": False,
+                "desired_status": "IDLE", "position": 0}
+        same_header(*both(clients, "I", json.dumps(hook)))
+        worker.stdin.write("tick\n")
+        worker.stdin.flush()
+        thread.start()
+        notices = [wait_notice(client, clients) for client in clients]
+        assert [len(n[0]) for n in notices] == [6, 6]
+        assert notices[0][0][:2] == notices[1][0][:2] == b"\x02N"
+        assert notices[0][1] == notices[1][1] == b"5"
+        ref_status, our_status = both(clients, "S")
+        assert our_status[1] == ref_status[1]
+        assert status_byte(our_status[1], 4) == 1  # paused: its Sequence is RUNNING
+        unlock = {"uid": 5, "desired_status": "FAILURE", "position": 0, "remove_when_done": True}
+        same_header(*both(clients, "U", json.dumps(unlock)))
+        read_until(worker.stdout, "ticked")
+        thread.join(30)
+        ref_status, our_status = both(clients, "S")
+        assert our_status[1] == ref_status[1]
+        assert status_byte(our_status[1], 5) == 13  # failed (forced), then reset
+        ref_dump, our_dump = both(clients, "D")
+        assert json.loads(our_dump[1]) == json.loads(ref_dump[1]) == []
+    finally:
+        for client in clients:
+            client.close()
+        ours.publisher.close()
+        if thread.is_alive():
+            thread.join(30)
+        ours.monitor.close()
+        if worker.stdin is not None:
+            worker.stdin.close()
+        try:
+            worker.wait(30)
+        except subprocess.TimeoutExpired:
+            worker.kill()
+
+
+def read_until(stream: Any, word: str) -> None:
+    for line in stream:
+        if line.strip() == word:
+            return
+    raise AssertionError(f"the BT.CPP worker ended before saying '{word}'")
+
+
+def wait_notice(client: GrootClient, clients: tuple[GrootClient, ...]) -> list[bytes]:
+    """The next PUB message of ``client``; meanwhile poll STATUS on every publisher, as
+    Groot2 does (each request is a heartbeat that keeps the hooks enabled)."""
+    import zmq
+
+    client.sub.setsockopt(zmq.RCVTIMEO, 100)
+    deadline = time.monotonic() + 60
+    try:
+        while time.monotonic() < deadline:
+            try:
+                return client.sub.recv_multipart()
+            except zmq.Again:
+                for other in clients:
+                    other.request("S")
+        raise AssertionError("no breakpoint notice")
+    finally:
+        client.sub.setsockopt(zmq.RCVTIMEO, client.timeout_ms)
+
+
+def status_byte(reply: bytes, uid: int) -> int:
+    for offset in range(0, len(reply), 3):
+        if int.from_bytes(reply[offset:offset + 2], "little") == uid:
+            return reply[offset + 2]
+    raise KeyError(uid)
