@@ -68,7 +68,9 @@ def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float,
 
 
 def run_one(spec: EpisodeSpec) -> EpisodeResult:
-    """Run one episode (in a worker process) and condense its report."""
+    """Run one episode (in a worker process) and condense its report.
+
+    With ``spec.btlog`` set, the episode's .btlog is kept only when it did not succeed."""
     with Episode(spec) as episode:
         report = episode.run()
         metrics = {
@@ -76,6 +78,8 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             for k, v in episode.tree.blackboard.as_dict().items()
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
+    if spec.btlog and report.status == "SUCCESS":
+        Path(spec.btlog).unlink(missing_ok=True)
     failed_node = ""
     if report.status == "FAILURE" and report.cause:
         name, node_id = report.cause["name"], report.cause["node"]
@@ -240,14 +244,23 @@ def _start_workers(jobs: int, wait: float = 20.0) -> Any:
     return pool
 
 
-def run_bench(base: EpisodeSpec, runs: int, jobs: int = 1) -> list[EpisodeResult]:
+def run_bench(
+    base: EpisodeSpec, runs: int, jobs: int = 1, btlog_failures: str | None = None
+) -> list[EpisodeResult]:
     """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
+
+    With ``btlog_failures`` (a folder whose parent exists), each episode that does not succeed
+    leaves ``seed-N.btlog`` there, to replay in Groot2.
 
     With ``jobs`` > 1 the episodes run in spawned worker processes (each builds its own
     PyBullet world). The workers never take a Ctrl-C (one interrupted while it starts up would
     print a traceback); a Ctrl-C, or an error, in the main process stops them.
     """
     specs = [replace(base, seed=base.seed + i) for i in range(runs)]
+    if btlog_failures:
+        make_folder(btlog_failures)
+        specs = [replace(s, btlog=str(Path(btlog_failures) / f"seed-{s.seed}.btlog"))
+                 for s in specs]
     results: list[EpisodeResult] = []
     if jobs <= 1 or runs <= 1:
         progress = _progress(runs)

@@ -103,6 +103,18 @@ def _address(text: str) -> str:
     return str(address)
 
 
+def _groot_port(text: str) -> int:
+    """A Groot2 port: PORT serves requests, PORT+1 publishes, so at most 65534 (0: any)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a port number, got '{text}'") from None
+    if not 0 <= value <= 65534:
+        raise argparse.ArgumentTypeError(
+            f"must be a port from 1 to 65534 (PUB uses the next one), or 0 for any, got {text}")
+    return value
+
+
 def _bb_pair(text: str) -> tuple[str, Any]:
     """``KEY=VALUE``; VALUE is read as a JSON scalar when it is one, else kept as text."""
     key, sep, value = text.partition("=")
@@ -226,8 +238,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_address,
         default=None,
         metavar="ADDR",
-        help="address the tree page and the meshcat server listen on (default 127.0.0.1; "
-        "0.0.0.0 serves every interface)",
+        help="address the run's servers (tree page, meshcat, Groot2) listen on (default "
+        "127.0.0.1; 0.0.0.0 serves every interface)",
     )
     run.add_argument(
         "--keep-serving",
@@ -236,6 +248,21 @@ def build_parser() -> argparse.ArgumentParser:
     )
     run.add_argument(
         "--record", metavar="FILE.html", help="write a self-contained replay page of the run"
+    )
+    run.add_argument(
+        "--groot",
+        type=_groot_port,
+        nargs="?",
+        const=1667,
+        default=None,
+        metavar="PORT",
+        help="serve the run to Groot2 (default port 1667, PUB on PORT+1): live statuses, "
+        "blackboards, breakpoints; 0 picks free ports",
+    )
+    run.add_argument(
+        "--btlog",
+        metavar="FILE.btlog",
+        help="write the run's status changes as a Groot2 log (FileLogger2 format)",
     )
     _add_inject(run)
     add_import_flag(run)
@@ -260,6 +287,11 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--max-ticks", type=_positive(int))
     bench.add_argument("--max-sim-time", type=_positive(float), default=600.0, metavar="S")
     bench.add_argument("--tick-hz", type=TICK_HZ, default=20.0)
+    bench.add_argument(
+        "--btlog-failures",
+        metavar="DIR",
+        help="write DIR/seed-N.btlog for every episode that does not succeed (Groot2 replays it)",
+    )
     _add_inject(bench)
     add_import_flag(bench)
     bench.set_defaults(func=cmd_bench)
@@ -332,6 +364,7 @@ def _episode_spec(args: argparse.Namespace) -> Any:
         inject=list(args.inject),
         options=options,
         imports=list(args.imports),
+        btlog=getattr(args, "btlog", None),
     )
 
 
@@ -361,7 +394,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from bt_manip.episode import Episode
     from bt_manip.outputs import write_text
 
-    _check_outputs(args, ("--report", "--bb-out", "--record"))
+    _check_outputs(args, ("--report", "--bb-out", "--record", "--btlog"))
     with Episode(_episode_spec(args)) as episode:
         tree, world = episode.tree, episode.world
         if world is not None and not args.quiet:
@@ -369,6 +402,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         hooks: list[Any] = [] if args.quiet else [_live_view(tree)]
         from bt_manip.viz.hooks import setup_viz
 
+        publisher = _start_groot(args, episode)
         viz = setup_viz(args, world, tree)
         hooks += viz.hooks
         episode.spec.options.realtime = viz.realtime
@@ -383,6 +417,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 close = getattr(hook, "close", None)
                 if hook not in viz.hooks and callable(close):
                     close()
+            if publisher is not None:
+                publisher.close()
         viz.close(keep_viewer=keep)
         print(report.summary())
         if report.extra.get("injected"):
@@ -399,6 +435,34 @@ def cmd_run(args: argparse.Namespace) -> int:
         return status
 
 
+def _start_groot(args: argparse.Namespace, episode: Any) -> Any:
+    """The Groot2 publisher asked for by ``--groot`` (None without it)."""
+    if args.groot is None:
+        return None
+    from bt_manip.groot import GrootPublisher
+    from bt_manip.groot.publisher import GrootError
+
+    layout = episode.monitor().layout
+
+    def paused(uid: int | None) -> None:
+        if uid is None:
+            print("groot2: breakpoint released, the run goes on", flush=True)
+            return
+        node = layout.nodes_by_uid[uid]
+        print(f"groot2: paused at the breakpoint on {node.describe()} (uid {uid}); "
+              "sim time stopped until Groot2 unlocks it", flush=True)
+
+    bind = args.bind or "127.0.0.1"
+    try:
+        publisher = GrootPublisher(
+            episode.monitor(), port=args.groot, bind=bind, on_pause=paused)
+    except GrootError as e:
+        raise InputError.single("--groot", None, str(e)) from None
+    print(f"groot2: serving the tree on {bind}:{publisher.port} "
+          f"(PUB {publisher.port + 1}); connect Groot2's monitor to it", flush=True)
+    return publisher
+
+
 def cmd_bench(args: argparse.Namespace) -> int:
     from bt_manip.bench import run_bench, summarise, write_outputs
     from bt_manip.episode import Episode
@@ -407,6 +471,8 @@ def cmd_bench(args: argparse.Namespace) -> int:
     if args.out == DEFAULT_BENCH_OUT and not Path(DEFAULT_BENCH_OUT).parent.exists():
         make_folder(Path(DEFAULT_BENCH_OUT).parent)  # out/, bt-manip's own default folder
     check_output_folder("--out", args.out)
+    if args.btlog_failures:
+        check_output_folder("--btlog-failures", args.btlog_failures)
     base = _episode_spec(args)
     with Episode(base):  # check the tree and world once, before starting workers
         pass
@@ -414,13 +480,16 @@ def cmd_bench(args: argparse.Namespace) -> int:
         f"bench: {args.runs} episodes of {args.tree} on {args.world}, seeds "
         f"{args.seed}..{args.seed + args.runs - 1}, {args.jobs} process(es)"
     )
-    results = run_bench(base, args.runs, jobs=args.jobs)
+    results = run_bench(base, args.runs, jobs=args.jobs, btlog_failures=args.btlog_failures)
     summary = summarise(results, base)
     print(summary.text())
     out = Path(args.out)
     if _write_outputs([("--out", str(out), lambda: write_outputs(results, summary, out))]):
         return EXIT_BAD_INPUT
     print(f"wrote {out}/episodes.json, episodes.csv, summary.json, outcomes.png")
+    if args.btlog_failures:
+        failed = sum(1 for r in results if not r.success)
+        print(f"wrote {failed} .btlog file(s) of failed episodes to {args.btlog_failures}")
     return 0 if summary.successes == summary.runs else 1
 
 

@@ -30,6 +30,8 @@ class EpisodeSpec:
     options: RunOptions = field(default_factory=RunOptions)
     imports: list[str] = field(default_factory=list)
     """User modules that register nodes (``--import``), imported before the tree loads."""
+    btlog: str | None = None
+    """Write the run's status changes to this .btlog file (Groot2 replays it)."""
 
 
 class Episode:
@@ -68,11 +70,35 @@ class Episode:
         except BaseException:
             self.close()
             raise
+        self._monitor: Any = None
+
+    def monitor(self) -> Any:
+        """The tree's :class:`~bt_manip.groot.TreeMonitor` (made on first use), stamping status
+        changes with the run's time: the sim clock with a world, the monotonic clock without."""
+        if self._monitor is None:
+            from bt_manip.groot import TreeMonitor
+
+            self._monitor = TreeMonitor(self.tree, self.context.clock.now)
+        return self._monitor
 
     def run(self, hooks: Sequence[Callable[[Runner], None]] = ()) -> RunReport:
         """Tick to the end and return the report (faults injected are in ``extra``)."""
         runner = Runner(self.tree, self.world, self.spec.options, on_tick=hooks)
-        report = runner.run()
+        writer = None
+        if self.spec.btlog:
+            from bt_manip.errors import InputError
+            from bt_manip.groot import BtlogWriter
+
+            try:
+                writer = BtlogWriter(self.spec.btlog, self.monitor())
+            except OSError as e:
+                raise InputError.single(
+                    "--btlog", None, f"cannot write {self.spec.btlog}: {e.strerror}") from None
+        try:
+            report = runner.run()
+        finally:
+            if writer is not None:
+                writer.close()
         report.tree = self.spec.tree
         report.world = self.spec.world or ""
         report.seed = self.spec.seed if self.world is not None else None
@@ -82,6 +108,9 @@ class Episode:
         return report
 
     def close(self) -> None:
+        if getattr(self, "_monitor", None) is not None:
+            self._monitor.close()
+            self._monitor = None
         if self.world is not None:
             self.world.close()
             self.world = None

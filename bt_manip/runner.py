@@ -37,6 +37,8 @@ EXIT_SUCCESS = 0
 EXIT_FAILURE = 1
 EXIT_BAD_INPUT = 2
 EXIT_INTERRUPTED = 130
+MAX_PACING_LAG = 0.25
+"""Seconds a paced run may lag behind real time before the lag is forgotten."""
 EXIT_CODES = {
     "SUCCESS": EXIT_SUCCESS,
     "FAILURE": EXIT_FAILURE,
@@ -66,7 +68,10 @@ class RunOptions:
     max_sim_time: float | None = 600.0
     max_ticks: int | None = None
     realtime: float | None = None
-    """Pace sim time to ``realtime`` x wall time (1.0 = real time); None runs flat out."""
+    """Pace sim time to ``realtime`` x wall time (1.0 = real time); None runs flat out.
+
+    A run that falls behind (paused on a Groot2 breakpoint, or a slow tick) goes on at the
+    same pace from where it is, without rushing to catch up."""
 
 
 @dataclass
@@ -187,6 +192,7 @@ class Runner:
         else:
             self.steps_per_tick = 0
         self._start_sim = self._now()
+        self._pace_wall0 = time.perf_counter()
 
     def _now(self) -> float:
         if self.world is not None:
@@ -201,6 +207,7 @@ class Runner:
         """Run to the end; Ctrl-C halts the tree and gives status INTERRUPTED."""
         opts = self.options
         wall0 = time.perf_counter()
+        self._pace_wall0 = wall0
         self._start_sim = self._now()
         status, reason = "BUDGET", ""
         try:
@@ -254,9 +261,11 @@ class Runner:
         if self.world is not None:
             self.world.step(self.steps_per_tick)
             if opts.realtime:
-                ahead = self.sim_time / opts.realtime - (time.perf_counter() - wall0)
+                ahead = self.sim_time / opts.realtime - (time.perf_counter() - self._pace_wall0)
                 if ahead > 0:
                     time.sleep(ahead)
+                elif ahead < -MAX_PACING_LAG:
+                    self._pace_wall0 -= ahead  # forget the lag: no catching up
         else:
             time.sleep(1.0 / opts.tick_hz)
 

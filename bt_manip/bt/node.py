@@ -28,7 +28,7 @@ from __future__ import annotations
 import copy
 import difflib
 import itertools
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -130,6 +130,10 @@ class BtNode(PortsMixin):
     on one counter (0: never); they tell the failures of a node's last run from older ones
     (see :mod:`bt_manip.failure_cause`)."""
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
+
+    pre_tick: Callable[[BtNode], NodeStatus] | None = None
+    """BT.CPP's pre-tick callback: called before the tick of a node that is not finished and
+    not decided by a pre-condition; a SUCCESS or FAILURE it returns replaces the tick."""
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
@@ -338,6 +342,10 @@ class BtNode(PortsMixin):
         if self.bt_status is NodeStatus.IDLE:
             self.started_order = next(_ORDER)
         new = self._check_preconditions() if self._pre else None
+        if new is None and self.pre_tick is not None and not self.bt_status.completed:
+            forced = self.pre_tick(self)
+            if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
+                new = forced
         if new is None and self.bt_status is NodeStatus.IDLE and self._fault_injected():
             new = NodeStatus.FAILURE
         if new is None:
