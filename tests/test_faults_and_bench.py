@@ -114,6 +114,51 @@ def test_injected_failures_reach_the_tree_and_the_report(tmp_path: Path) -> None
     assert main(["run", str(tree), "--quiet", "--inject", "step:failure:0"]) == 0
 
 
+def test_a_tree_with_injected_failures_looks_node_for_node_like_the_tree(tmp_path: Path) -> None:
+    from bt_manip.bt import to_xml
+    from bt_manip.episode import Episode
+    from bt_manip.viz.tree_state import TreeWatcher
+
+    tree = tmp_path / "nested.xml"
+    tree.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Main">'
+        '<BehaviorTree ID="Main"><Sequence name="mission"><Script code="fails := 0"/>'
+        '<RetryUntilSuccessful num_attempts="3">'
+        '<AlwaysSuccess name="step" _onFailure="fails += 1"/></RetryUntilSuccessful>'
+        '<Fallback><AlwaysFailure name="plan_a"/><SubTree ID="PlanB"/></Fallback>'
+        "</Sequence></BehaviorTree>"
+        '<BehaviorTree ID="PlanB"><Sequence><AlwaysSuccess name="plan_b"/>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    inject = [parse_fault("step:failure:1"), parse_fault("plan_b:failure:0.5")]
+
+    def seen(spec: EpisodeSpec) -> tuple[object, ...]:
+        with Episode(spec) as episode:
+            nodes = episode.tree.nodes()
+            shape = (
+                [(type(n), n.name, n.NODE_ID) for n in nodes],
+                TreeWatcher(episode.tree).structure(),
+                to_xml(episode.tree),
+            )
+            report = episode.run()
+            fails = episode.tree.blackboard.get("fails")
+        return shape, [(n.path, n.node) for n in report.nodes], report, fails
+
+    plain_shape, plain_paths, plain, _ = seen(EpisodeSpec(tree=str(tree)))
+    faulty_shape, faulty_paths, faulty, fails = seen(EpisodeSpec(tree=str(tree), inject=inject))
+    assert faulty_shape == plain_shape
+    assert faulty_paths == plain_paths
+    assert any(path.endswith("/plan_b") for path, _ in plain_paths)  # inside the subtree
+    assert plain.status == "SUCCESS"
+    # the failures still happen: the step fails each of its three attempts, and its
+    # _onFailure script runs as for any failure
+    assert faulty.status == "FAILURE"
+    assert [e["target"] for e in faulty.extra["injected"]] == ["step"] * 3
+    assert fails == 3
+    step = next(n for n in faulty.nodes if n.path.endswith("/step"))
+    assert step.reason == "injected failure (--inject)"
+
+
 def test_bench_runs_episodes_in_processes_and_writes_outputs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

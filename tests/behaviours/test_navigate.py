@@ -10,8 +10,9 @@ import pybullet as pb
 import pytest
 from bhelpers import place_robot, reasons, run_xml
 
-from bt_manip.bt import TreeContext, load_tree_string
+from bt_manip.bt import load_tree_string
 from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
@@ -49,7 +50,7 @@ def test_a_crate_dropped_on_the_route_is_not_pushed_along() -> None:
             '<MoveJoints state="tuck"/><Navigate goal="goal"/></Sequence>'
             "</BehaviorTree></root>"
         )
-        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        context = RunContext.for_world(world, faults=faults)
         tree = load_tree_string(xml, context=context)
         landed: dict[str, np.ndarray] = {}
 
@@ -101,7 +102,7 @@ def test_the_bare_robot_drives_through_a_one_metre_doorway() -> None:
             '<MoveJoints state="tuck"/><Navigate goal="-4.6;2.6;3.14"/></Sequence>'
             "</BehaviorTree></root>"
         )
-        tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+        tree = load_tree_string(xml, context=RunContext.for_world(world))
         report = Runner(tree, world, RunOptions(max_sim_time=60), on_tick=[watch]).run()
         assert report.status == "SUCCESS", report.reason
         x, y, _ = robot.base_pose2d()
