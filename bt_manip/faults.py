@@ -296,6 +296,6 @@ def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) 
     )
     try:
         world.spawn(spec)
-    except ValueError:  # the name is taken: the crate is not dropped
+    except ValueError:  # it would start inside a body (or the name is taken): none falls
         return None
     return spec.name

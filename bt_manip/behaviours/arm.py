@@ -32,6 +32,8 @@ SETTLE_SPEED = 0.05
 """A joint counts as arrived when within tolerance and slower than this (rad/s)."""
 VIA_TOLERANCE = 0.05
 """A pass-through waypoint counts as reached within this (rad), without stopping there."""
+CORRECTION_SPEED = 0.2
+"""Every joint may correct at no less than this fraction of its allowed speed."""
 
 
 @dataclass
@@ -121,11 +123,11 @@ class JointMove(RobotAction):
 
     def _send(self, joints: list[int], travel: np.ndarray, t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
-        every joint may correct at no less than a fifth of its allowed speed, so a joint that
-        a load pushes away can come back."""
+        every joint may correct at no less than :data:`CORRECTION_SPEED` of its allowed speed, so
+        a joint that a load pushes away can come back."""
         robot = self.robot()
         vmax = np.asarray(robot.description.arm.velocity_limits, dtype=float) * self.speed
-        floor = 0.2 * vmax
+        floor = CORRECTION_SPEED * vmax
         speeds = floor.copy()
         if t > 1e-9:
             speeds[joints] = np.maximum(travel / t, floor[joints])

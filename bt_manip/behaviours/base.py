@@ -50,7 +50,7 @@ class WorldAccess:
         ``RunContext.for_world(world)``."""
         context = self.context  # type: ignore[attr-defined]
         if not isinstance(context, RunContext):
-            self.world  # noqa: B018  (no world at all: say so first)
+            _ = self.world  # without a world, that is the problem to report
             raise ActionFailed(
                 "this node needs the services of a run: give the tree "
                 "bt_manip.run_context.RunContext.for_world(world) as its context"

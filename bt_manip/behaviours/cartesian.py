@@ -18,6 +18,8 @@ from bt_manip.run_context import ArmIK, RobotServices
 
 STEP = 0.02
 """Spacing (m) of the waypoints of a straight-line move."""
+TURN_STEP = 0.1
+"""Largest turn (rad) of the tool between two waypoints of a straight-line move."""
 
 
 def arm_ik(services: RobotServices, tip: str) -> ArmIK:
@@ -66,7 +68,7 @@ def line(
     solutions."""
     a, b = start_world[:3, 3], goal_world[:3, 3]
     turn = _angle(start_world[:3, :3], goal_world[:3, :3])
-    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / 0.1))))
+    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / TURN_STEP))))
     out = []
     q = seed
     for i in range(1, n + 1):

@@ -24,12 +24,11 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.overlay import Overlay
+from bt_manip.overlay import FrameItem, Overlay
 from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
-from bt_manip.viz.overlay import FrameItem
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
 from bt_manip.viz.tree_state import FAILURE, TreeWatcher, run_result

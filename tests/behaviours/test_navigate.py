@@ -12,6 +12,7 @@ from bhelpers import place_robot, reasons, run_xml
 
 from bt_manip.bt import load_tree_string
 from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.navigation.navigator import NavigatorOptions
 from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions
 from bt_manip.sim.world import World
@@ -36,6 +37,12 @@ def test_navigate_to_coordinates_and_to_a_named_pose() -> None:
         assert abs(math.remainder(yaw - start.yaw, math.tau)) <= 0.03
         # the first leg: no shorter than the straight line from where the robot started
         assert tree.blackboard.as_dict()["len"] >= math.hypot(-1.5 - x0, -2.5 - y0) - 0.05
+        # both legs drove with the run's one navigator; the second leg's tolerances were its
+        # own and did not become the navigator's
+        assert isinstance(tree.context, RunContext)
+        nav = tree.context.robot_services("husky").navigator
+        assert nav.options.follower == NavigatorOptions().follower
+        assert nav.options.follower.xy_tolerance != 0.03
         report, _ = run_xml(world, '<Navigate goal="kitchen"/>')
         assert "goal 'kitchen' is neither a named pose" in reasons(report)["Navigate"]
         report, _ = run_xml(world, '<Navigate goal="2.6;4.6;0"/>')  # inside the counter
