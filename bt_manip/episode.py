@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_manip.bt.blackboard import Blackboard
-from bt_manip.faults import FaultInjector, FaultSpec, check_targets, inject_node_failures
+from bt_manip.faults import FaultInjector, FaultSpec, inject_node_failures
 from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 
@@ -66,8 +66,6 @@ class Episode:
                 # entries given by the user (--bb) are typed as a script would type them
                 blackboard=Blackboard.from_dict(dict(spec.blackboard), typed=False),
             )
-            nodes = self.tree.nodes()
-            check_targets(list(spec.inject), {n.name for n in nodes}, {n.NODE_ID for n in nodes})
             inject_node_failures(self.tree, self.faults)
         except BaseException:
             self.close()

@@ -223,12 +223,15 @@ class FailingStart:
 def inject_node_failures(tree: Tree, injector: FaultInjector) -> int:
     """Wrap the own tick of every node of ``tree`` that a ``NAME:failure:P`` fault targets;
     returns how many were wrapped. The wrapping is on the node instance only: the tree keeps its
-    nodes, order, names, IDs and XML."""
+    nodes, order, names, IDs and XML.
+
+    Raises InputError (see :func:`check_targets`) when a fault targets no node of the tree.
+    """
+    nodes = tree.nodes()
+    check_targets(injector.specs, {n.name for n in nodes}, {n.NODE_ID for n in nodes})
     targets = injector.targets()
-    if not targets:
-        return 0
     wrapped = 0
-    for node in tree.nodes():
+    for node in nodes:
         if node.name in targets or node.NODE_ID in targets:
             node.tick_node = FailingStart(node, node.tick_node, injector)  # type: ignore[method-assign]
             wrapped += 1

@@ -141,3 +141,17 @@ def test_halted_actions_leave_the_robot_stopped_and_holding() -> None:
         world.step(240)
         assert np.allclose(robot.arm_positions(), q, atol=0.01)  # holding where it was halted
         assert not np.allclose(q, np.radians([90, -90, 0, -90, 0, 0]), atol=0.05)
+
+
+def test_robot_behaviours_need_the_services_of_a_run() -> None:
+    from bt_manip.bt import TreeContext
+
+    with World(HOUSE, seed=0) as world:
+        xml = (
+            '<root BTCPP_format="4"><BehaviorTree ID="Main"><Navigate goal="goal"/>'
+            "</BehaviorTree></root>"
+        )
+        tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+        report = Runner(tree, world, RunOptions(max_sim_time=5)).run()
+        assert report.status == "FAILURE"
+        assert "RunContext.for_world(world)" in reasons(report)["Navigate"]
