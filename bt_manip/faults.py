@@ -135,6 +135,8 @@ class FaultEvent:
     kind: str
     target: str
     sim_time: float
+    note: str = ""
+    """What became of the fault when it could not act as drawn (for instance no crate fell)."""
 
 
 @dataclass
@@ -186,10 +188,14 @@ class FaultInjector:
         return self._world_fault("block", route)
 
     def report(self) -> list[dict[str, Any]]:
-        return [
-            {"kind": e.kind, "target": e.target, "sim_time": round(e.sim_time, 3)}
-            for e in self.events
-        ]
+        out: list[dict[str, Any]] = []
+        for e in self.events:
+            row: dict[str, Any] = {"kind": e.kind, "target": e.target,
+                                   "sim_time": round(e.sim_time, 3)}
+            if e.note:
+                row["note"] = e.note
+            out.append(row)
+        return out
 
 
 # -- node failures ------------------------------------------------------------------------------
@@ -299,6 +305,7 @@ def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) 
     )
     try:
         world.spawn(spec)
-    except ValueError:  # it would start inside a body (or the name is taken): none falls
+    except ValueError as exc:  # it would start inside a body, or the name is taken
+        injector.events[-1].note = f"no crate fell: {exc}"
         return None
     return spec.name

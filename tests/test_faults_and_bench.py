@@ -257,3 +257,40 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     assert proc.returncode == 130, err
     assert "interrupted" in err.splitlines()
     assert not (tmp_path / "out").exists()
+
+
+class _Room:
+    """A stand-in world for the ``block`` fault: records what is spawned, or refuses it."""
+
+    def __init__(self, refuse: str = "") -> None:
+        self.movable: dict[str, int] = {}
+        self.spawned: list[object] = []
+        self.refuse = refuse
+
+    def spawn(self, spec: object) -> int:
+        if self.refuse:
+            raise ValueError(self.refuse)
+        self.spawned.append(spec)
+        return 1
+
+
+def test_the_block_fault_drops_a_crate_mid_route_or_says_why_not() -> None:
+    import numpy as np
+
+    from bt_manip.faults import BLOCK_SIZE, CRATE_DROP_HEIGHT, CRATE_MASS, block_route
+
+    route = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0]])
+    room = _Room()
+    injector = FaultInjector([FaultSpec("block", 1.0)])
+    assert block_route(room, injector, route, "goal") == "dropped_crate_0"
+    (crate,) = room.spawned
+    assert crate.pose.xyz == (2.0, 0.0, BLOCK_SIZE / 2 + CRATE_DROP_HEIGHT)  # type: ignore[attr-defined]
+    assert crate.mass == CRATE_MASS  # type: ignore[attr-defined]
+    assert injector.report() == [{"kind": "block", "target": "goal", "sim_time": 0.0}]
+    # a route too short to have a point 1.5 m from both ends gets no crate, and draws nothing
+    assert block_route(room, injector, route[:3], "near") is None
+    assert len(injector.events) == 1
+    refused = FaultInjector([FaultSpec("block", 1.0)])
+    why = "'dropped_crate_0' would start 40 mm inside 'sofa'"
+    assert block_route(_Room(refuse=why), refused, route, "goal") is None
+    assert refused.report()[0]["note"] == f"no crate fell: {why}"
