@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.overlay import Overlay
+from bt_manip.overlay import FrameItem, Overlay
 from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
-from bt_manip.viz.overlay import FrameItem, item_json
+from bt_manip.viz.overlay import item_json
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, SceneObject
 from bt_manip.viz.tree_state import TreeWatcher, run_result
 
