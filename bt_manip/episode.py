@@ -12,7 +12,8 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_manip.bt.blackboard import Blackboard
-from bt_manip.faults import FaultInjector, FaultSpec, check_targets
+from bt_manip.faults import FaultInjector, FaultSpec, inject_node_failures
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 
 
@@ -37,11 +38,15 @@ class EpisodeSpec:
 class Episode:
     """Builds the world and the tree of one run; use as a context manager.
 
+    The tree's context is the run's :class:`~bt_manip.run_context.RunContext` (``context``):
+    the world's clock, the fault injector (``faults``, whose node failures are wrapped around
+    their nodes here), the overlay, and each robot's navigator and IK, built on first use.
+
     Raises :class:`~bt_manip.errors.InputError` while building when the tree or world is bad.
     """
 
     def __init__(self, spec: EpisodeSpec) -> None:
-        from bt_manip.bt import TreeContext, load_tree
+        from bt_manip.bt import load_tree
         from bt_manip.clock import MonotonicClock
 
         self.spec = spec
@@ -54,9 +59,7 @@ class Episode:
         try:
             clock = self.world.clock if self.world is not None else MonotonicClock()
             self.faults = FaultInjector(list(spec.inject), seed=spec.seed, clock=clock)
-            self.context = TreeContext(
-                clock=clock, world=self.world, services={"faults": self.faults}
-            )
+            self.context = RunContext(clock=clock, world=self.world, faults=self.faults)
             self.tree = load_tree(
                 spec.tree,
                 tree_id=spec.tree_id,
@@ -65,8 +68,7 @@ class Episode:
                 # entries given by the user (--bb) are typed as a script would type them
                 blackboard=Blackboard.from_dict(dict(spec.blackboard), typed=False),
             )
-            nodes = self.tree.nodes()
-            check_targets(list(spec.inject), {n.name for n in nodes}, {n.NODE_ID for n in nodes})
+            inject_node_failures(self.tree, self.faults)
         except BaseException:
             self.close()
             raise

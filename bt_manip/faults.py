@@ -6,9 +6,15 @@ Specifications (``--inject``, repeatable):
                     starts (a fresh execution, not every tick of a RUNNING node), without
                     running; its reason says the failure was injected.
 ``slip:P``          an object held in a gripper slips out (its grasp is released) with
-                    probability P per carry; robot behaviours that carry ask :meth:`slip`.
+                    probability P per carry; robot behaviours that carry ask :func:`plan_slip`
+                    when they start and call :func:`slip_out` when the slip is due.
 ``block:P``         with probability P per navigation, an obstacle is dropped on the planned
-                    route; the Navigate behaviour asks :meth:`block`.
+                    route; the Navigate behaviour calls :func:`block_route`.
+
+This module is the whole fault layer. Node failures are wrapped around the targeted nodes when
+the tree is loaded (:func:`inject_node_failures`), invisibly: the tree's nodes, their order,
+names, IDs, exported XML and report paths are those of the tree without faults. World faults act
+on the World (a grasp released, a crate spawned).
 
 Every draw comes from one generator seeded by the episode seed, so a run with faults is as
 repeatable as one without. What was injected is kept in :attr:`FaultInjector.events` for the
@@ -18,14 +24,35 @@ run report.
 from __future__ import annotations
 
 import difflib
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from bt_manip.errors import InputError, Problem
 
+if TYPE_CHECKING:
+    from bt_manip.bt.node import BtNode
+    from bt_manip.bt.status import NodeStatus
+    from bt_manip.bt.tree import Tree
+
 WORLD_FAULTS = ("slip", "block")
+INJECTED_REASON = "injected failure (--inject)"
+"""The reason a node gives when an injected failure stops it."""
+
+SLIP_AFTER = 0.5
+"""Sim seconds into a carrying move at which an injected slip happens."""
+BLOCK_SIZE = 0.3
+"""Side (m) of the crate an injected ``block`` fault drops on the route."""
+BLOCK_CLEARANCE = 1.5
+"""The crate falls at least this far (m) from the route's start and its goal."""
+CRATE_DROP_HEIGHT = 0.3
+"""Height (m) of the crate's underside above the floor when it appears: it falls into place."""
+CRATE_MASS = 8.0
+"""Mass (kg) of the dropped crate: heavy enough to stay where it falls."""
+CRATE_FRICTION = 0.9
+"""Friction coefficient of the dropped crate."""
 
 
 @dataclass(frozen=True)
@@ -108,6 +135,8 @@ class FaultEvent:
     kind: str
     target: str
     sim_time: float
+    note: str = ""
+    """What became of the fault when it could not act as drawn (for instance no crate fell)."""
 
 
 @dataclass
@@ -159,7 +188,124 @@ class FaultInjector:
         return self._world_fault("block", route)
 
     def report(self) -> list[dict[str, Any]]:
-        return [
-            {"kind": e.kind, "target": e.target, "sim_time": round(e.sim_time, 3)}
-            for e in self.events
-        ]
+        out: list[dict[str, Any]] = []
+        for e in self.events:
+            row: dict[str, Any] = {"kind": e.kind, "target": e.target,
+                                   "sim_time": round(e.sim_time, 3)}
+            if e.note:
+                row["note"] = e.note
+            out.append(row)
+        return out
+
+
+# -- node failures ------------------------------------------------------------------------------
+
+
+@dataclass
+class FailingStart:
+    """A node's own tick (``tick_node``) behind the draw of an injected failure.
+
+    Each time the node starts (it is IDLE and its pre-conditions let it run), the injector draws
+    for the node's name and ID; on a hit the node fails at once with :data:`INJECTED_REASON`,
+    without running, and its post-condition scripts run as for any failure.
+    """
+
+    node: BtNode
+    tick: Callable[[], NodeStatus]
+    injector: FaultInjector
+
+    def __call__(self) -> NodeStatus:
+        from bt_manip.bt.status import NodeStatus
+
+        node = self.node
+        if node.bt_status is NodeStatus.IDLE and self.injector.node_fails(
+            node.name, node.NODE_ID
+        ):
+            node.feedback_message = INJECTED_REASON
+            return NodeStatus.FAILURE
+        return self.tick()
+
+
+def inject_node_failures(tree: Tree, injector: FaultInjector) -> int:
+    """Wrap the own tick of every node of ``tree`` that a ``NAME:failure:P`` fault targets;
+    returns how many were wrapped. The wrapping is on the node instance only: the tree keeps its
+    nodes, order, names, IDs and XML.
+
+    Raises InputError (see :func:`check_targets`) when a fault targets no node of the tree.
+    """
+    nodes = tree.nodes()
+    check_targets(injector.specs, {n.name for n in nodes}, {n.NODE_ID for n in nodes})
+    targets = injector.targets()
+    wrapped = 0
+    for node in nodes:
+        if node.name in targets or node.NODE_ID in targets:
+            node.tick_node = FailingStart(node, node.tick_node, injector)  # type: ignore[method-assign]
+            wrapped += 1
+    return wrapped
+
+
+# -- world faults -------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PendingSlip:
+    """An injected slip due at sim time ``at``: ``object_name`` will slip out of the grasp."""
+
+    at: float
+    object_name: str
+
+
+def plan_slip(injector: FaultInjector, object_name: str, started_at: float) -> PendingSlip | None:
+    """Draw the ``slip`` fault for a carry of ``object_name`` that started at ``started_at``."""
+    if not injector.slip(object_name):
+        return None
+    return PendingSlip(started_at + SLIP_AFTER, object_name)
+
+
+def slip_out(world: Any, robot: Any, slip: PendingSlip) -> None:
+    """The injected slip: the attach joint goes and the fingers open."""
+    if world.attachments.is_attached(slip.object_name):
+        world.attachments.detach(slip.object_name)
+    robot.set_gripper(robot.description.gripper.max_opening)
+
+
+def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) -> str | None:
+    """The ``block`` fault for a navigation along ``polyline`` (rows x, y, ...) to ``route``.
+
+    A crate falls on the route, at the middle point of the route that is at least
+    :data:`BLOCK_CLEARANCE` from both ends (a route with no such point gets none, and nothing is
+    drawn): it tests going around an obstacle, not a goal made unreachable. Returns the crate's
+    name, or None when none fell.
+    """
+    if not injector.specs or polyline is None or len(polyline) < 2:
+        return None
+    pts = np.asarray(polyline)[:, :2]
+    far = (np.linalg.norm(pts - pts[0], axis=1) >= BLOCK_CLEARANCE) & (
+        np.linalg.norm(pts - pts[-1], axis=1) >= BLOCK_CLEARANCE
+    )
+    if not far.any() or not injector.block(route):
+        return None
+    from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
+
+    candidates = np.flatnonzero(far)
+    x, y = pts[candidates[len(candidates) // 2]]
+    n = sum(1 for name in world.movable if name.startswith("dropped_crate"))
+    spec = BodySpec(
+        name=f"dropped_crate_{n}",
+        movable=True,
+        parts=[Part("box", (BLOCK_SIZE,) * 3, colour=COLOURS["brown"])],
+        urdf=None,
+        pose=Pose3D((float(x), float(y), BLOCK_SIZE / 2 + CRATE_DROP_HEIGHT)),
+        planar=False,
+        mass=CRATE_MASS,
+        friction=CRATE_FRICTION,
+        colour=COLOURS["brown"],
+        randomize=Range2D(),
+        line=0,
+    )
+    try:
+        world.spawn(spec)
+    except ValueError as exc:  # it would start inside a body, or the name is taken
+        injector.events[-1].note = f"no crate fell: {exc}"
+        return None
+    return spec.name

@@ -20,6 +20,7 @@ from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
 from bt_manip.bt.leaves import AlwaysFailure
+from bt_manip.run_context import RunContext
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -96,7 +97,7 @@ def main() -> int:
     from bt_manip.sim.world import World
 
     with World(ROOT / "worlds" / "tb3_house.yaml", seed=args.seed) as world:
-        report = Runner(build(TreeContext(clock=world.clock, world=world)), world).run()
+        report = Runner(build(RunContext.for_world(world)), world).run()
         print(report.summary())
         return report.exit_code
 

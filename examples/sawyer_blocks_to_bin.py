@@ -19,6 +19,7 @@ from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
 from bt_manip.bt.leaves import Script, ScriptCondition
+from bt_manip.run_context import RunContext
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -100,7 +101,7 @@ def main() -> int:
     from bt_manip.sim.world import World
 
     with World(ROOT / "worlds" / "sawyer_table.yaml", seed=args.seed) as world:
-        tree = build(TreeContext(clock=world.clock, world=world))
+        tree = build(RunContext.for_world(world))
         report = Runner(tree, world).run()
         print(report.summary())
         print("blocks resting in the bin:", tree.blackboard.as_dict()["resting_in_bin"])

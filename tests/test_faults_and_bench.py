@@ -114,6 +114,51 @@ def test_injected_failures_reach_the_tree_and_the_report(tmp_path: Path) -> None
     assert main(["run", str(tree), "--quiet", "--inject", "step:failure:0"]) == 0
 
 
+def test_a_tree_with_injected_failures_looks_node_for_node_like_the_tree(tmp_path: Path) -> None:
+    from bt_manip.bt import to_xml
+    from bt_manip.episode import Episode
+    from bt_manip.viz.tree_state import TreeWatcher
+
+    tree = tmp_path / "nested.xml"
+    tree.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Main">'
+        '<BehaviorTree ID="Main"><Sequence name="mission"><Script code="fails := 0"/>'
+        '<RetryUntilSuccessful num_attempts="3">'
+        '<AlwaysSuccess name="step" _onFailure="fails += 1"/></RetryUntilSuccessful>'
+        '<Fallback><AlwaysFailure name="plan_a"/><SubTree ID="PlanB"/></Fallback>'
+        "</Sequence></BehaviorTree>"
+        '<BehaviorTree ID="PlanB"><Sequence><AlwaysSuccess name="plan_b"/>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    inject = [parse_fault("step:failure:1"), parse_fault("plan_b:failure:0.5")]
+
+    def seen(spec: EpisodeSpec) -> tuple[object, ...]:
+        with Episode(spec) as episode:
+            nodes = episode.tree.nodes()
+            shape = (
+                [(type(n), n.name, n.NODE_ID) for n in nodes],
+                TreeWatcher(episode.tree).structure(),
+                to_xml(episode.tree),
+            )
+            report = episode.run()
+            fails = episode.tree.blackboard.get("fails")
+        return shape, [(n.path, n.node) for n in report.nodes], report, fails
+
+    plain_shape, plain_paths, plain, _ = seen(EpisodeSpec(tree=str(tree)))
+    faulty_shape, faulty_paths, faulty, fails = seen(EpisodeSpec(tree=str(tree), inject=inject))
+    assert faulty_shape == plain_shape
+    assert faulty_paths == plain_paths
+    assert any(path.endswith("/plan_b") for path, _ in plain_paths)  # inside the subtree
+    assert plain.status == "SUCCESS"
+    # the failures still happen: the step fails each of its three attempts, and its
+    # _onFailure script runs as for any failure
+    assert faulty.status == "FAILURE"
+    assert [e["target"] for e in faulty.extra["injected"]] == ["step"] * 3
+    assert fails == 3
+    step = next(n for n in faulty.nodes if n.path.endswith("/step"))
+    assert step.reason == "injected failure (--inject)"
+
+
 def test_bench_runs_episodes_in_processes_and_writes_outputs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
@@ -212,3 +257,40 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     assert proc.returncode == 130, err
     assert "interrupted" in err.splitlines()
     assert not (tmp_path / "out").exists()
+
+
+class _Room:
+    """A stand-in world for the ``block`` fault: records what is spawned, or refuses it."""
+
+    def __init__(self, refuse: str = "") -> None:
+        self.movable: dict[str, int] = {}
+        self.spawned: list[object] = []
+        self.refuse = refuse
+
+    def spawn(self, spec: object) -> int:
+        if self.refuse:
+            raise ValueError(self.refuse)
+        self.spawned.append(spec)
+        return 1
+
+
+def test_the_block_fault_drops_a_crate_mid_route_or_says_why_not() -> None:
+    import numpy as np
+
+    from bt_manip.faults import BLOCK_SIZE, CRATE_DROP_HEIGHT, CRATE_MASS, block_route
+
+    route = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0]])
+    room = _Room()
+    injector = FaultInjector([FaultSpec("block", 1.0)])
+    assert block_route(room, injector, route, "goal") == "dropped_crate_0"
+    (crate,) = room.spawned
+    assert crate.pose.xyz == (2.0, 0.0, BLOCK_SIZE / 2 + CRATE_DROP_HEIGHT)  # type: ignore[attr-defined]
+    assert crate.mass == CRATE_MASS  # type: ignore[attr-defined]
+    assert injector.report() == [{"kind": "block", "target": "goal", "sim_time": 0.0}]
+    # a route too short to have a point 1.5 m from both ends gets no crate, and draws nothing
+    assert block_route(room, injector, route[:3], "near") is None
+    assert len(injector.events) == 1
+    refused = FaultInjector([FaultSpec("block", 1.0)])
+    why = "'dropped_crate_0' would start 40 mm inside 'sofa'"
+    assert block_route(_Room(refuse=why), refused, route, "goal") is None
+    assert refused.report()[0]["note"] == f"no crate fell: {why}"

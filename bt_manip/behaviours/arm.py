@@ -32,6 +32,8 @@ SETTLE_SPEED = 0.05
 """A joint counts as arrived when within tolerance and slower than this (rad/s)."""
 VIA_TOLERANCE = 0.05
 """A pass-through waypoint counts as reached within this (rad), without stopping there."""
+CORRECTION_SPEED = 0.2
+"""Every joint may correct at no less than this fraction of its allowed speed."""
 
 
 @dataclass
@@ -121,11 +123,11 @@ class JointMove(RobotAction):
 
     def _send(self, joints: list[int], travel: np.ndarray, t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
-        every joint may correct at no less than a fifth of its allowed speed, so a joint that
-        a load pushes away can come back."""
+        every joint may correct at no less than :data:`CORRECTION_SPEED` of its allowed speed, so
+        a joint that a load pushes away can come back."""
         robot = self.robot()
         vmax = np.asarray(robot.description.arm.velocity_limits, dtype=float) * self.speed
-        floor = 0.2 * vmax
+        floor = CORRECTION_SPEED * vmax
         speeds = floor.copy()
         if t > 1e-9:
             speeds[joints] = np.maximum(travel / t, floor[joints])
@@ -278,7 +280,7 @@ class Lift(JointMove):
             start = robot.link_transform(tip)
             goal = start.copy()
             goal[2, 3] += height
-            path = cartesian.line(robot, tip, start, goal, q_now)
+            path = cartesian.line(self.services(), tip, start, goal, q_now)
             return _through(path, n)
         deltas = to_radians(values, self.get_input("units"))
         if len(deltas) != n:
@@ -368,9 +370,8 @@ class MoveToPose(JointMove):
         target = cartesian.pose_matrix(np.add(position, offset), self.get_input("orientation"))
         if self.get_input("match_object_yaw") and yaw is not None:
             target = self._turned_to(robot, tip, target, yaw)
-        from bt_manip.viz.overlay import overlay_for
-
-        overlay_for(self.world).show_frame("ik_target", target)  # drawn when a viewer is on
+        self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on
+        services = self.services()
         free = bool(self.get_input("free_yaw"))
         n = len(q_now)
         approach = float(self.get_input("approach"))
@@ -383,22 +384,22 @@ class MoveToPose(JointMove):
             # leave along the tool axis first, as the tool came in
             back = here.copy()
             back[:3, 3] -= retreat * here[:3, 2]
-            path = cartesian.line(robot, tip, here, back, q_now)
+            path = cartesian.line(services, tip, here, back, q_now)
             stages += [Stage(q, list(range(n)), via=True) for q in path]
             here, q_now = back, path[-1]
         first = target.copy()
         if approach > 0:
             first[:3, 3] -= approach * target[:3, 2]
         if self.get_input("path") == "line":
-            stages += _through(cartesian.line(robot, tip, here, first, q_now, free), n)
+            stages += _through(cartesian.line(services, tip, here, first, q_now, free), n)
             q_first = stages[-1].command
         elif self.get_input("path") == "joint":
-            q_first = cartesian.solve(robot, tip, first, q_now, free)
+            q_first = cartesian.solve(services, tip, first, q_now, free)
             stages.append(Stage(q_first, list(range(n))))
         else:
             raise ActionFailed(f"path must be 'joint' or 'line', got '{self.get_input('path')}'")
         if approach > 0:
-            stages += _through(cartesian.line(robot, tip, first, target, q_first, free), n)
+            stages += _through(cartesian.line(services, tip, first, target, q_first, free), n)
         return stages
 
     @staticmethod

@@ -16,6 +16,9 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError
+from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
+from bt_manip.overlay import Overlay
+from bt_manip.run_context import RobotServices, RunContext
 
 ROBOT_PORT = PortInformation(
     data_type=str,
@@ -41,6 +44,30 @@ class WorldAccess:
             raise ActionFailed("this node needs a world (run with --world)")
         return world
 
+    @property
+    def run_context(self) -> RunContext:
+        """The run's services; a tree built in Python is given them with
+        ``RunContext.for_world(world)``."""
+        context = self.context  # type: ignore[attr-defined]
+        if not isinstance(context, RunContext):
+            _ = self.world  # without a world, that is the problem to report
+            raise ActionFailed(
+                "this node needs the services of a run: give the tree "
+                "bt_manip.run_context.RunContext.for_world(world) as its context"
+            )
+        return context
+
+    def services(self) -> RobotServices:
+        """The navigator and arm IK of the robot this node acts on."""
+        robot = self.robot()
+        return self.run_context.robot_services(self.robot_name_of(robot))
+
+    @property
+    def overlay(self) -> Overlay:
+        """What this run's viewers draw over the world (a throwaway one outside a run)."""
+        context = self.context  # type: ignore[attr-defined]
+        return context.overlay if isinstance(context, RunContext) else Overlay()
+
     def robot(self) -> Any:
         """The robot named by the ``robot`` port, or the only robot of the world."""
         robots = self.world.robots
@@ -57,7 +84,9 @@ class WorldAccess:
         return robots[name]
 
     def robot_name(self) -> str:
-        robot = self.robot()
+        return self.robot_name_of(self.robot())
+
+    def robot_name_of(self, robot: Any) -> str:
         for name, r in self.world.robots.items():
             if r is robot:
                 return name
@@ -72,8 +101,10 @@ class WorldAccess:
             )
         return movable[name]
 
-    def faults(self) -> Any:
-        return self.context.services.get("faults")  # type: ignore[attr-defined]
+    def faults(self) -> FaultInjector | None:
+        """The run's fault injector, when faults are injected."""
+        context = self.context  # type: ignore[attr-defined]
+        return context.faults if isinstance(context, RunContext) else None
 
 
 class RobotAction(WorldAccess, ActionNode):
@@ -89,13 +120,11 @@ class RobotAction(WorldAccess, ActionNode):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
     CARRIES: ClassVar[bool] = False
     """Moves what the robot holds: a ``slip`` fault may make it let go on the way."""
-    SLIP_AFTER: ClassVar[float] = 0.5
-    """Sim seconds into the move at which an injected slip happens."""
 
     def initialise(self) -> None:
         self.feedback_message = ""
         self._start_error: str | None = None
-        self._slip: tuple[float, str] | None = None
+        self._slip: PendingSlip | None = None
         self.started_at = self.now()
         try:
             self.start()
@@ -105,6 +134,7 @@ class RobotAction(WorldAccess, ActionNode):
             self._start_error = str(exc)
 
     def _draw_slip(self) -> None:
+        """Whether a ``slip`` fault makes what the robot carries slip out during this move."""
         faults = self.faults()
         if faults is None or not faults.specs:
             return
@@ -114,26 +144,17 @@ class RobotAction(WorldAccess, ActionNode):
         held = [a.object_name for a in self.world.attachments.held_by(self.robot_name())]
         held += [held_object(self.world, robot)] if not held else []
         held = [h for h in held if h]
-        if held and faults.slip(held[0]):
-            self._slip = (self.started_at + self.SLIP_AFTER, held[0])
-
-    def _apply_slip(self) -> None:
-        """The injected slip: the attach joint goes and the fingers open."""
-        assert self._slip is not None
-        _, name = self._slip
-        self._slip = None
-        if self.world.attachments.is_attached(name):
-            self.world.attachments.detach(name)
-        robot = self.robot()
-        robot.set_gripper(robot.description.gripper.max_opening)
+        if held:
+            self._slip = plan_slip(faults, held[0], self.started_at)
 
     def update(self) -> Status:
         if self._start_error is not None:
             self.feedback_message = self._start_error
             return Status.FAILURE
         try:
-            if self._slip is not None and self.now() >= self._slip[0]:
-                self._apply_slip()
+            if self._slip is not None and self.now() >= self._slip.at:
+                slip, self._slip = self._slip, None
+                slip_out(self.world, self.robot(), slip)
             return self.step()
         except (ActionFailed, PortError) as exc:
             self.feedback_message = str(exc)

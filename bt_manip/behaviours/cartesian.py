@@ -1,58 +1,34 @@
 """Cartesian targets for arm behaviours: IK on the robot's own model, straight-line paths.
 
 Each robot gets one :class:`~bt_manip.kinematics.ArmModel` and solver per tip frame, built from
-the same URDF PyBullet loaded and kept on the robot handle. Solves are deterministic (no
+the same URDF PyBullet loaded and kept for the run by its
+:class:`~bt_manip.run_context.RobotServices`. Solves are deterministic (no
 wall-clock budget, a bounded number of seeded restarts), so the same run gives the same joints.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from bt_manip.behaviours.base import ActionFailed
-from bt_manip.kinematics import ArmModel, IKOptions, IKSolver
+from bt_manip.kinematics import KinematicsError
+from bt_manip.run_context import ArmIK, RobotServices
 
 STEP = 0.02
 """Spacing (m) of the waypoints of a straight-line move."""
-
-TOLERANCE = 1e-4
-"""Position (m) and rotation (rad) tolerance of the IK targets of behaviours."""
-
-
-@dataclass
-class ArmIK:
-    """The kinematic model of a robot's arm to one tip frame, with its solvers."""
-
-    model: ArmModel
-    full: IKSolver
-    free_yaw: IKSolver
+TURN_STEP = 0.1
+"""Largest turn (rad) of the tool between two waypoints of a straight-line move."""
 
 
-def arm_ik(robot: Any, tip: str) -> ArmIK:
-    """The cached model and solvers of ``robot``'s arm from its base link to ``tip``."""
-    cache: dict[str, ArmIK] = robot.__dict__.setdefault("_arm_ik", {})
-    if tip not in cache:
-        desc = robot.description
-        try:
-            model = ArmModel.from_urdf(desc.urdf_path, desc.arm.base_link, tip)
-        except Exception as exc:  # the URDF was loaded by PyBullet already: a bad tip name
-            raise ActionFailed(f"no kinematic chain {desc.arm.base_link} -> {tip}: {exc}") from None
-        common = {
-            "position_tolerance": TOLERANCE,
-            "rotation_tolerance": TOLERANCE,
-            "time_budget": None,
-            "max_restarts": 200,
-            "posture_weight": 0.05,
-        }
-        cache[tip] = ArmIK(
-            model,
-            IKSolver(model, IKOptions(**common)),
-            IKSolver(model, IKOptions(**common, free_axis="z")),
-        )
-    return cache[tip]
+def arm_ik(services: RobotServices, tip: str) -> ArmIK:
+    """The run's model and solvers of the robot's arm from its base link to ``tip``."""
+    try:
+        return services.arm_ik(tip)
+    except KinematicsError as exc:  # PyBullet loaded the URDF already: a bad tip name
+        desc = services.robot.description
+        raise ActionFailed(f"no kinematic chain {desc.arm.base_link} -> {tip}: {exc}") from None
 
 
 def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
@@ -62,12 +38,16 @@ def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
 
 
 def solve(
-    robot: Any, tip: str, pose_world: np.ndarray, seed: np.ndarray, free_yaw: bool = False
+    services: RobotServices,
+    tip: str,
+    pose_world: np.ndarray,
+    seed: np.ndarray,
+    free_yaw: bool = False,
 ) -> np.ndarray:
     """Joint values putting ``tip`` at ``pose_world``; ActionFailed with IK's reason if none."""
-    ik = arm_ik(robot, tip)
+    ik = arm_ik(services, tip)
     solver = ik.free_yaw if free_yaw else ik.full
-    result = solver.solve(to_arm_base(robot, pose_world), q_seed=seed)
+    result = solver.solve(to_arm_base(services.robot, pose_world), q_seed=seed)
     if not result.success:
         where = ", ".join(f"{v:.3f}" for v in pose_world[:3, 3])
         raise ActionFailed(f"no arm configuration reaches ({where}): {result.reason}")
@@ -75,7 +55,7 @@ def solve(
 
 
 def line(
-    robot: Any,
+    services: RobotServices,
     tip: str,
     start_world: np.ndarray,
     goal_world: np.ndarray,
@@ -88,7 +68,7 @@ def line(
     solutions."""
     a, b = start_world[:3, 3], goal_world[:3, 3]
     turn = _angle(start_world[:3, :3], goal_world[:3, :3])
-    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / 0.1))))
+    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / TURN_STEP))))
     out = []
     q = seed
     for i in range(1, n + 1):
@@ -96,7 +76,7 @@ def line(
         pose = np.eye(4)
         pose[:3, :3] = _slerp(start_world[:3, :3], goal_world[:3, :3], s)
         pose[:3, 3] = a + (b - a) * s
-        q = solve(robot, tip, pose, q, free_yaw)
+        q = solve(services, tip, pose, q, free_yaw)
         out.append(q)
     return out
 

@@ -13,8 +13,14 @@ from bt_manip.bt.ports import POSITIVE, Accepts, Port
 
 OPENING = Accepts(low=0, also=(-1,))
 """An opening is a distance between the pads, or -1 (fully open or closed)."""
-SETTLED_SPEED = 0.002
-"""The fingers count as stopped when the opening changes by less than this per tick (m)."""
+SETTLED_SPEED = 0.04
+"""The fingers count as stopped while the opening changes slower than this (m/s)."""
+SETTLE_TIME = 0.15
+"""A gripper move ends once the fingers have stayed stopped this long (sim s)."""
+MIN_MOVE_TIME = 0.2
+"""A gripper move lasts longer than this (sim s): the fingers need time to start moving."""
+TIME_EPS = 1e-9
+"""Tolerance (s) when comparing sim-time differences."""
 
 
 def held_object(world: Any, robot: Any) -> str:
@@ -41,15 +47,23 @@ class _GripperMove(RobotAction):
         self.goal = self.target(robot)
         robot.set_gripper(self.goal)
         self.last = robot.gripper_opening()
-        self.still_ticks = 0
+        self.last_time = self.now()
+        self.still_since: float | None = None
+        """Sim time from which the fingers have been stopped (None: they are moving)."""
 
     def step(self) -> Status:
         robot = self.robot()
         opening = robot.gripper_opening()
+        now = self.now()
         moved = abs(opening - self.last)
-        self.last = opening
-        self.still_ticks = self.still_ticks + 1 if moved < SETTLED_SPEED else 0
-        if self.still_ticks >= 3 and self.elapsed() > 0.2:
+        if moved <= SETTLED_SPEED * (now - self.last_time):
+            if self.still_since is None:
+                self.still_since = self.last_time
+        else:
+            self.still_since = None
+        self.last, self.last_time = opening, now
+        settled = self.still_since is not None and now - self.still_since >= SETTLE_TIME - TIME_EPS
+        if settled and self.elapsed() > MIN_MOVE_TIME:
             return self.finished(robot, opening)
         if self.elapsed() > float(self.get_input("timeout")):
             raise ActionFailed(

@@ -19,30 +19,22 @@ from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
+from bt_manip.faults import block_route
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.grid import GridTooLarge
 from bt_manip.navigation.navigator import Navigator
-from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
-BLOCK_SIZE = 0.3
-"""Side (m) of the crate an injected ``block`` fault drops on the route."""
-BLOCK_CLEARANCE = 1.5
-"""The crate falls at least this far (m) from the route's start and its goal."""
+TIME_BUDGET_FACTOR = 1.5
+"""Without a ``timeout``, Navigate allows this many times the time the path takes at full
+speed..."""
+TIME_BUDGET_MARGIN = 30.0
+"""... plus this many sim seconds (turning on the spot, slowing down near the goal)."""
 
 
-def navigator_for(world: Any, robot: Any) -> Navigator:
-    """The robot's navigator (one per robot, kept on its handle), synced with the world: the
-    movable objects now in it and what the robot now carries."""
-    nav: Navigator | None = robot.__dict__.get("_navigator")
-    if nav is None:
-        try:
-            nav = Navigator(robot, world.obstacle_body_ids(), world.movable)
-        except GridTooLarge as exc:
-            raise ActionFailed(str(exc)) from None
-        robot.__dict__["_navigator"] = nav
+def sync_navigator(world: Any, robot_name: str, nav: Navigator) -> Navigator:
+    """``nav`` told the movable objects now in the world and what its robot now carries."""
     nav.movable = {b: n for n, b in world.movable.items()}
-    name = next((n for n, r in world.robots.items() if r is robot), "")
-    held = {a.object_body: a.object_name for a in world.attachments.held_by(name)}
+    held = {a.object_body: a.object_name for a in world.attachments.held_by(robot_name)}
     for body in [b for b in nav.attached if b not in held]:
         nav.detach(body)
     for body, label in held.items():
@@ -116,22 +108,29 @@ class Navigate(RobotAction):
         if robot.description.base.type != "skid_steer":
             raise ActionFailed(f"{robot.description.name} has no mobile base")
         goal = parse_goal(world, self.get_input("goal"))
-        nav = navigator_for(world, robot)
+        try:
+            nav = self.services().navigator
+        except GridTooLarge as exc:
+            raise ActionFailed(str(exc)) from None
+        sync_navigator(world, self.robot_name_of(robot), nav)
         follower = dataclasses.replace(
             nav.options.follower,
             xy_tolerance=float(self.get_input("xy_tolerance")),
             yaw_tolerance=float(self.get_input("yaw_tolerance")),
         )
-        nav.options = dataclasses.replace(nav.options, follower=follower)
-        plan = nav.start(robot.base_pose2d(), goal)
+        plan = nav.start(robot.base_pose2d(), goal, follower=follower)
         if not plan.ok:
             raise ActionFailed(f"no path to {self.get_input('goal')}: {plan.reason}")
         self.nav = nav
         self.set_output("path_length", float(plan.length))
         timeout = float(self.get_input("timeout"))
-        self.timeout = timeout or 1.5 * plan.length / follower.max_speed + 30.0
+        self.timeout = timeout or (
+            TIME_BUDGET_FACTOR * plan.length / follower.max_speed + TIME_BUDGET_MARGIN
+        )
         self._show(plan.polyline)
-        self._maybe_block(plan.polyline)
+        faults = self.faults()
+        if faults is not None:
+            block_route(world, faults, plan.polyline, self.get_input("goal"))
         self.touching_at_start = set(self._bumped())  # it may drive away from these
 
     def step(self) -> Status:
@@ -176,47 +175,10 @@ class Navigate(RobotAction):
         self._show(None)
 
     def _show(self, polyline: np.ndarray | None) -> None:
-        from bt_manip.viz.overlay import overlay_for
-
-        overlay = overlay_for(self.world)
         if polyline is None:
-            overlay.clear("base_plan")
+            self.overlay.clear("base_plan")
         else:
-            overlay.show_path("base_plan", np.asarray(polyline)[:, :2])
-
-    def _maybe_block(self, polyline: np.ndarray) -> None:
-        """The ``block`` fault: a crate falls on the route, at the middle point of the route
-        that is at least :data:`BLOCK_CLEARANCE` from both ends (a route with no such point
-        gets none): it tests going around an obstacle, not a goal made unreachable."""
-        faults = self.faults()
-        if faults is None or not faults.specs or polyline is None or len(polyline) < 2:
-            return
-        pts = np.asarray(polyline)[:, :2]
-        far = (np.linalg.norm(pts - pts[0], axis=1) >= BLOCK_CLEARANCE) & (
-            np.linalg.norm(pts - pts[-1], axis=1) >= BLOCK_CLEARANCE
-        )
-        if not far.any() or not faults.block(self.get_input("goal")):
-            return
-        candidates = np.flatnonzero(far)
-        x, y = pts[candidates[len(candidates) // 2]]
-        n = sum(1 for name in self.world.movable if name.startswith("dropped_crate"))
-        spec = BodySpec(
-            name=f"dropped_crate_{n}",
-            movable=True,
-            parts=[Part("box", (BLOCK_SIZE,) * 3, colour=COLOURS["brown"])],
-            urdf=None,
-            pose=Pose3D((float(x), float(y), BLOCK_SIZE / 2 + 0.3)),
-            planar=False,
-            mass=8.0,
-            friction=0.9,
-            colour=COLOURS["brown"],
-            randomize=Range2D(),
-            line=0,
-        )
-        try:
-            self.world.spawn(spec)
-        except ValueError:
-            return
+            self.overlay.show_path("base_plan", np.asarray(polyline)[:, :2])
 
 
 @registry.register

@@ -1,4 +1,8 @@
-"""What a tree's nodes can reach besides the blackboard: the clock, the world, services."""
+"""What a tree's nodes can reach besides the blackboard: the clock, the world, the timers.
+
+A run adds its services (fault injector, overlay, each robot's navigator and IK) in
+:class:`bt_manip.run_context.RunContext`, a subclass.
+"""
 
 from __future__ import annotations
 
@@ -17,12 +21,11 @@ class TreeContext:
 
     ``clock`` is what every duration (Timeout, Delay, Sleep, controller time-outs) reads: the
     world's simulation clock when a world is loaded, the monotonic clock otherwise. ``world`` is
-    the loaded world or None; ``services`` holds named helpers that robot behaviours look up.
+    the loaded world or None.
     """
 
     clock: Clock = field(default_factory=MonotonicClock)
     world: Any = None
-    services: dict[str, Any] = field(default_factory=dict)
     wake_up: bool = False
     """A node asked for the root to be ticked again (BT.CPP's wake-up signal)."""
     timers: dict[int, tuple[float, Callable[[], None] | None]] = field(default_factory=dict)

@@ -190,7 +190,7 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
             "__doc__": user_class.__doc__ or f"py_trees node {user_class.__qualname__}"})
         _OWN_CLASSES[user_class] = made_class
     made: Any = made_class.__new__(made_class)
-    made.__dict__.update(vars(node))
+    vars(made).update(vars(node))  # the object's state, as it is
     kids = [convert_node(child, builtins) for child in node.children]
     made.children = []
     for kid in kids:

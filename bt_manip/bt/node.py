@@ -11,9 +11,6 @@ Ticking follows BT.CPP (``TreeNode::executeTick``):
    ``_while`` skips it; when it is RUNNING, a false ``_while`` halts it and it is SKIPPED;
 2. otherwise the node's own logic runs (``update()`` for leaves);
 3. on SUCCESS or FAILURE, ``_onSuccess`` or ``_onFailure`` then ``_post`` run;
-
-A node that starts (it was IDLE) may instead fail at once when the tree's fault injector
-(``context.services["faults"]``, see :mod:`bt_manip.faults`) draws a failure for its name or ID.
 4. a SKIPPED node keeps its IDLE status but tells its parent it was skipped.
 
 Halting a RUNNING node calls its ``terminate(INVALID)`` exactly once, then ``_onHalted``.
@@ -138,7 +135,7 @@ class BtNode(PortsMixin):
     def __init_subclass__(cls, **kwargs: Any) -> None:
         kwargs.setdefault("register", False)  # our registry, not py_trees', names nodes
         super().__init_subclass__(**kwargs)
-        if "NODE_ID" not in cls.__dict__:
+        if "NODE_ID" not in vars(cls):
             cls.NODE_ID = cls.__name__
 
     # ------------------------------------------------------------------ construction
@@ -346,8 +343,6 @@ class BtNode(PortsMixin):
             forced = self.pre_tick(self)
             if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
                 new = forced
-        if new is None and self.bt_status is NodeStatus.IDLE and self._fault_injected():
-            new = NodeStatus.FAILURE
         if new is None:
             new = self.tick_node()
         if self._post and (new is NodeStatus.SUCCESS or new is NodeStatus.FAILURE):
@@ -380,16 +375,6 @@ class BtNode(PortsMixin):
         cycles) emits it, and ``Tree.tick()`` re-ticks the root while one is pending.
         """
         self.context.wake_up = True
-
-    def _fault_injected(self) -> bool:
-        """Whether a seeded fault (``--inject NAME:failure:P``) makes this start fail."""
-        faults = self.context.services.get("faults")
-        if faults is None or not faults.specs:
-            return False
-        if not faults.node_fails(self.name, self.NODE_ID):
-            return False
-        self.feedback_message = "injected failure (--inject)"
-        return True
 
     def halt(self) -> None:
         """Stop the node's activity and make it IDLE (BT.CPP's ``halt()``)."""

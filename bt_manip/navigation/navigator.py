@@ -124,6 +124,8 @@ class Navigator:
         self.robot = robot
         self.client = robot.client
         self.options = options
+        self._follower_options: FollowerOptions = options.follower
+        """The follower options of the navigation under way (see :meth:`start`)."""
         self.movable: dict[int, str] = (
             {b: n for n, b in movable.items()}
             if isinstance(movable, Mapping)
@@ -272,12 +274,20 @@ class Navigator:
         """A plan from ``start`` to ``goal`` for the current footprint and map."""
         return plan_path(self.costmap, self.footprint, start[:2], goal[:2], self.options.planner)
 
-    def start(self, pose: Pose2D, goal: Pose2D, align: bool = True) -> NavPlan:
+    def start(
+        self,
+        pose: Pose2D,
+        goal: Pose2D,
+        align: bool = True,
+        follower: FollowerOptions | None = None,
+    ) -> NavPlan:
         """Plan from ``pose`` to ``goal`` (x, y, yaw) and get ready to follow the path.
 
-        Returns the plan; when it is not ``ok`` there is nothing to follow and
-        :meth:`update` answers FAILED with the plan's reason.
+        ``follower`` (tolerances, speeds) holds for this navigation only; without it the
+        navigator's ``options.follower`` applies. Returns the plan; when it is not ``ok`` there
+        is nothing to follow and :meth:`update` answers FAILED with the plan's reason.
         """
+        self._follower_options = follower if follower is not None else self.options.follower
         self.refresh()
         self._goal = goal
         self._align = align
@@ -299,7 +309,7 @@ class Navigator:
         self.follower = PathFollower(
             self.plan.polyline,
             goal if align else goal[:2],
-            dataclasses.replace(self.options.follower, pivot=self.pivot),
+            dataclasses.replace(self._follower_options, pivot=self.pivot),
             path_blocked=self._path_blocked,
             replan=self._replan,
         )
@@ -346,7 +356,7 @@ class Navigator:
         self.plan = NavPlan(PlanOutcome.OK, "ok", poly, None, path_length(poly))
         self.poses = poses
         self.follower = SegmentFollower(
-            poses, goal, dataclasses.replace(self.options.follower, pivot=self.pivot)
+            poses, goal, dataclasses.replace(self._follower_options, pivot=self.pivot)
         )
         return self.plan
 

@@ -24,10 +24,11 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.overlay import FrameItem, Overlay
+from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
-from bt_manip.viz.overlay import FrameItem
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
 from bt_manip.viz.tree_state import FAILURE, TreeWatcher, run_result
@@ -71,12 +72,15 @@ class LiveViewer:
         options: server, port and update rate.
         title: shown on the page (e.g. the tree file).
         say: where the URLs are printed.
+        overlay: what to draw over the world (default: the overlay of the tree's run).
     """
 
     def __init__(self, world: Any, tree: Any, options: LiveOptions | None = None,
-                 title: str = "bt-manip", say: Callable[[str], None] = print) -> None:
+                 title: str = "bt-manip", say: Callable[[str], None] = print,
+                 overlay: Overlay | None = None) -> None:
         self.world = world
         self.tree = tree
+        self.overlay = overlay if overlay is not None else run_overlay(tree)
         self.options = options or LiveOptions()
         self.title = title
         self.say = say
@@ -240,7 +244,7 @@ class LiveViewer:
 
     def _send_overlay(self) -> None:
         link = self.link
-        overlay = getattr(self.world, "overlay", None) if self.world is not None else None
+        overlay = self.overlay
         if link is None or overlay is None or overlay.version == self._overlay_version:
             return
         from bt_manip.viz.overlay import item_json

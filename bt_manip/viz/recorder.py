@@ -27,8 +27,10 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.overlay import FrameItem, Overlay
+from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
-from bt_manip.viz.overlay import FrameItem, item_json
+from bt_manip.viz.overlay import item_json
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, SceneObject
 from bt_manip.viz.tree_state import TreeWatcher, run_result
 
@@ -97,12 +99,15 @@ class Recorder:
         world: the loaded World, or None (tree statuses only).
         tree: the tree (``root``, optional ``node_records()``).
         options: sampling rate and page title.
+        overlay: what is drawn over the world (default: the overlay of the tree's run).
     """
 
     def __init__(self, path: str | Path, world: Any, tree: Any,
-                 options: RecordOptions | None = None, info: dict[str, Any] | None = None) -> None:
+                 options: RecordOptions | None = None, info: dict[str, Any] | None = None,
+                 overlay: Overlay | None = None) -> None:
         self.path = Path(path)
         self.world = world
+        self.overlay = overlay if overlay is not None else run_overlay(tree)
         self.options = options or RecordOptions()
         self.watcher = TreeWatcher(tree)
         details = dict(info or {})
@@ -180,7 +185,7 @@ class Recorder:
         self._next_sample = t + 1.0 / self.options.sample_hz - 1e-9
 
     def _track_overlay(self, t: float) -> None:
-        overlay = getattr(self.world, "overlay", None) if self.world is not None else None
+        overlay = self.overlay
         if overlay is None or overlay.version == self._overlay_version:
             return
         self._overlay_version = overlay.version

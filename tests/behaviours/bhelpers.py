@@ -11,7 +11,8 @@ import pybullet as pb
 import pytest
 
 import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
-from bt_manip.bt import Tree, TreeContext, load_tree_string
+from bt_manip.bt import Tree, load_tree_string
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 from bt_manip.sim.world import World
 
@@ -32,7 +33,7 @@ def place_robot(world: World, name: str, x: float, y: float, yaw: float) -> None
 
 def run_xml(world: World, body: str, max_sim_time: float = 60.0) -> tuple[RunReport, Tree]:
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
-    tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+    tree = load_tree_string(xml, context=RunContext.for_world(world))
     return Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run(), tree
 
 

@@ -9,6 +9,7 @@ import pybullet as pb
 import pytest
 from bhelpers import ROOT, place_robot, reasons, run_xml, sample_every_step
 
+from bt_manip.run_context import RunContext
 from bt_manip.sim.world import World
 
 PICK = """<Sequence>
@@ -212,7 +213,7 @@ def test_spawn_model_value_from_the_blackboard_out_of_range_fails_with_the_reaso
 
 
 def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None:
-    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.bt import load_tree_string
     from bt_manip.faults import FaultInjector, FaultSpec
     from bt_manip.runner import Runner, RunOptions
 
@@ -220,7 +221,7 @@ def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None
     faults = FaultInjector([FaultSpec("slip", 1.0)], seed=0, clock=world.clock)
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{PICK}</BehaviorTree></root>'
     tree = load_tree_string(
-        xml, context=TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        xml, context=RunContext.for_world(world, faults=faults)
     )
     report = Runner(tree, world, RunOptions(max_sim_time=60)).run()
     assert report.status == "FAILURE"
@@ -232,17 +233,16 @@ def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None
 
 
 def test_move_to_pose_reaches_the_pose_and_retreats_first(table: World) -> None:
-    from bt_manip.bt import TreeContext, load_tree_string
+    from bt_manip.bt import load_tree_string
     from bt_manip.runner import Runner, RunOptions
 
     robot = table.robots["sawyer"]
-    report, _ = run_xml(table, '<MoveToPose position="0.75;0.2;0.9" approach="0.1"/>')
+    report, first = run_xml(table, '<MoveToPose position="0.75;0.2;0.9" approach="0.1"/>')
     assert report.status == "SUCCESS", report.reason
     tip = robot.link_transform("grasp_frame")
     assert np.allclose(tip[:3, 3], [0.75, 0.2, 0.9], atol=0.01)
-    from bt_manip.viz.overlay import overlay_for
-
-    target = overlay_for(table).items["ik_target"]  # what a viewer draws as a triad
+    assert isinstance(first.context, RunContext)
+    target = first.context.overlay.items["ik_target"]  # what a viewer draws as a triad
     assert np.allclose(target.matrix[:3, 3], [0.75, 0.2, 0.9])
     assert tip[2, 2] == pytest.approx(-1.0, abs=0.01)  # tool pointing down
     tips = sample_every_step(table, lambda: robot.link_transform("grasp_frame")[:3, 3].copy())
@@ -250,7 +250,7 @@ def test_move_to_pose_reaches_the_pose_and_retreats_first(table: World) -> None:
         '<root BTCPP_format="4"><BehaviorTree ID="Main">'
         '<MoveToPose position="0.75;-0.1;0.9" retreat="0.1"/></BehaviorTree></root>'
     )
-    tree = load_tree_string(xml, context=TreeContext(clock=table.clock, world=table))
+    tree = load_tree_string(xml, context=RunContext.for_world(table))
     report = Runner(tree, table, RunOptions(max_sim_time=30)).run()
     assert report.status == "SUCCESS", report.reason
     # it backed up along the tool axis (straight up) before moving across: the retreat's

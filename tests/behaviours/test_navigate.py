@@ -10,8 +10,10 @@ import pybullet as pb
 import pytest
 from bhelpers import place_robot, reasons, run_xml
 
-from bt_manip.bt import TreeContext, load_tree_string
+from bt_manip.bt import load_tree_string
 from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.navigation.navigator import NavigatorOptions
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
@@ -35,6 +37,12 @@ def test_navigate_to_coordinates_and_to_a_named_pose() -> None:
         assert abs(math.remainder(yaw - start.yaw, math.tau)) <= 0.03
         # the first leg: no shorter than the straight line from where the robot started
         assert tree.blackboard.as_dict()["len"] >= math.hypot(-1.5 - x0, -2.5 - y0) - 0.05
+        # both legs drove with the run's one navigator; the second leg's tolerances were its
+        # own and did not become the navigator's
+        assert isinstance(tree.context, RunContext)
+        nav = tree.context.robot_services("husky").navigator
+        assert nav.options.follower == NavigatorOptions().follower
+        assert nav.options.follower.xy_tolerance != 0.03
         report, _ = run_xml(world, '<Navigate goal="kitchen"/>')
         assert "goal 'kitchen' is neither a named pose" in reasons(report)["Navigate"]
         report, _ = run_xml(world, '<Navigate goal="2.6;4.6;0"/>')  # inside the counter
@@ -49,7 +57,7 @@ def test_a_crate_dropped_on_the_route_is_not_pushed_along() -> None:
             '<MoveJoints state="tuck"/><Navigate goal="goal"/></Sequence>'
             "</BehaviorTree></root>"
         )
-        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        context = RunContext.for_world(world, faults=faults)
         tree = load_tree_string(xml, context=context)
         landed: dict[str, np.ndarray] = {}
 
@@ -101,7 +109,7 @@ def test_the_bare_robot_drives_through_a_one_metre_doorway() -> None:
             '<MoveJoints state="tuck"/><Navigate goal="-4.6;2.6;3.14"/></Sequence>'
             "</BehaviorTree></root>"
         )
-        tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+        tree = load_tree_string(xml, context=RunContext.for_world(world))
         report = Runner(tree, world, RunOptions(max_sim_time=60), on_tick=[watch]).run()
         assert report.status == "SUCCESS", report.reason
         x, y, _ = robot.base_pose2d()
@@ -133,3 +141,17 @@ def test_halted_actions_leave_the_robot_stopped_and_holding() -> None:
         world.step(240)
         assert np.allclose(robot.arm_positions(), q, atol=0.01)  # holding where it was halted
         assert not np.allclose(q, np.radians([90, -90, 0, -90, 0, 0]), atol=0.05)
+
+
+def test_robot_behaviours_need_the_services_of_a_run() -> None:
+    from bt_manip.bt import TreeContext
+
+    with World(HOUSE, seed=0) as world:
+        xml = (
+            '<root BTCPP_format="4"><BehaviorTree ID="Main"><Navigate goal="goal"/>'
+            "</BehaviorTree></root>"
+        )
+        tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+        report = Runner(tree, world, RunOptions(max_sim_time=5)).run()
+        assert report.status == "FAILURE"
+        assert "RunContext.for_world(world)" in reasons(report)["Navigate"]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Iterator
+from dataclasses import dataclass, field
 from typing import ClassVar
 
 import pytest
@@ -16,6 +17,13 @@ from bt_manip.clock import ManualClock
 Ports = dict[str, PortInformation]
 
 
+@dataclass
+class LoggingContext(TreeContext):
+    """A tree context with a log of the Busy actions' lifecycles."""
+
+    log: list[tuple[str, str]] = field(default_factory=list)
+
+
 class Busy(ActionNode):
     """Test action: RUNNING until ``ticks`` ticks have passed; logs its lifecycle."""
 
@@ -23,7 +31,7 @@ class Busy(ActionNode):
         "ticks": PortInformation(int, required=False, default_value=1000)}
 
     def initialise(self) -> None:
-        self.context.services["log"].append(("init", self.name))
+        self.context.log.append(("init", self.name))  # type: ignore[attr-defined]
         self._count = 0
 
     def update(self) -> Status:
@@ -31,7 +39,7 @@ class Busy(ActionNode):
         return Status.SUCCESS if self._count >= self.get_input("ticks") else Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
-        self.context.services["log"].append((new_status.name, self.name))
+        self.context.log.append((new_status.name, self.name))  # type: ignore[attr-defined]
 
 
 @pytest.fixture
@@ -42,8 +50,7 @@ def busy() -> Iterator[list[tuple[str, str]]]:
 
 
 def make(body: str, log: list[tuple[str, str]]):  # type: ignore[no-untyped-def]
-    return load_tree_string(wrap(body), context=TreeContext(clock=ManualClock(),
-                                                            services={"log": log}))
+    return load_tree_string(wrap(body), context=LoggingContext(clock=ManualClock(), log=log))
 
 
 def test_tree_halt_terminates_running_leaves_once(busy: list[tuple[str, str]]) -> None:
@@ -82,7 +89,7 @@ def test_timeout_halts_nested_running_nodes(busy: list[tuple[str, str]]) -> None
     clock = ManualClock()
     tree = load_tree_string(
         wrap('<Timeout msec="100"><Sequence><Busy name="a"/></Sequence></Timeout>'),
-        context=TreeContext(clock=clock, services={"log": busy}))
+        context=LoggingContext(clock=clock, log=busy))
     tree.tick()
     clock.advance(0.1)
     assert tree.tick() is NodeStatus.FAILURE

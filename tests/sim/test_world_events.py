@@ -9,8 +9,9 @@ import pybullet as pb
 import pytest
 
 import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
-from bt_manip.bt import TreeContext, load_tree_string
+from bt_manip.bt import load_tree_string
 from bt_manip.faults import FaultInjector, FaultSpec
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.sim.world import World
@@ -88,7 +89,7 @@ def _grasp_panel(world: World) -> str:
         '<MoveJointsSequentially targets="70;11;78;-56;85;4" order="0;2;3;5;4;1"/>'
         '<CloseGripper/><Attach object="panel"/></Sequence></BehaviorTree></root>'
     )
-    tree = load_tree_string(xml, context=TreeContext(clock=world.clock, world=world))
+    tree = load_tree_string(xml, context=RunContext.for_world(world))
     report = Runner(tree, world, RunOptions(max_sim_time=30)).run()
     return report.status + " " + report.reason
 
@@ -122,7 +123,7 @@ def test_the_block_fault_announces_its_crate() -> None:
             '<root BTCPP_format="4"><BehaviorTree ID="M"><Navigate goal="goal"/>'
             "</BehaviorTree></root>"
         )
-        context = TreeContext(clock=world.clock, world=world, services={"faults": faults})
+        context = RunContext.for_world(world, faults=faults)
         tree = load_tree_string(xml, context=context)
         for _ in range(40):
             tree.tick()

@@ -7,7 +7,8 @@ from typing import Any
 import py_trees
 from py_trees.common import Status
 
-from bt_manip.viz.overlay import overlay_for
+from bt_manip.overlay import Overlay
+from bt_manip.run_context import RunContext
 
 HERE = __import__("pathlib").Path(__file__).resolve().parent
 ROOM = HERE / "viz_room.yaml"
@@ -16,18 +17,20 @@ ROOM = HERE / "viz_room.yaml"
 class Drive(py_trees.behaviour.Behaviour):
     """RUNNING while the base drives at (v, w) for ``duration`` s of sim; then SUCCESS.
 
-    On start it shows its planned path and a target frame on the world's overlay.
+    On start it shows its planned path and a target frame on the run's overlay.
     """
 
-    def __init__(self, name: str, world: Any, duration: float, v: float, w: float) -> None:
+    def __init__(
+        self, name: str, world: Any, overlay: Overlay, duration: float, v: float, w: float
+    ) -> None:
         super().__init__(name)
-        self.world, self.duration, self.v, self.w = world, duration, v, w
+        self.world, self.overlay, self.duration, self.v, self.w = world, overlay, duration, v, w
         self.t0 = 0.0
 
     def initialise(self) -> None:
         self.t0 = self.world.time
         x, y, _ = self.world.robots["husky"].base_pose2d()
-        overlay = overlay_for(self.world)
+        overlay = self.overlay
         overlay.show_path(f"{self.name}_plan", [(x, y), (x + 0.8, y), (x + 1.4, y + 0.4)])
         target = __import__("numpy").eye(4)
         target[:3, 3] = (x + 1.4, y + 0.4, 0.5)
@@ -61,16 +64,18 @@ class DriveTree:
     """drive (v=0.6) -> turn -> a fallback whose first child fails, then a short wait."""
 
     def __init__(self, world: Any, drive_s: float = 2.0, turn_s: float = 1.5) -> None:
+        self.context = RunContext.for_world(world)  # viewers draw its overlay
+        overlay = self.context.overlay
         self.root = py_trees.composites.Sequence(
             "mission",
             memory=True,
             children=[
-                Drive("drive", world, drive_s, 0.6, 0.0),
-                Drive("turn", world, turn_s, 0.2, 0.8),
+                Drive("drive", world, overlay, drive_s, 0.6, 0.0),
+                Drive("turn", world, overlay, turn_s, 0.2, 0.8),
                 py_trees.composites.Selector(
                     "recover",
                     memory=True,
-                    children=[Fail("plan_a"), Drive("plan_b", world, 0.5, 0.0, 0.0)],
+                    children=[Fail("plan_a"), Drive("plan_b", world, overlay, 0.5, 0.0, 0.0)],
                 ),
             ],
         )

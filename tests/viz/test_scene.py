@@ -7,9 +7,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from bt_manip.overlay import FrameItem, Overlay, PathItem
 from bt_manip.sim.compose import composed_urdf
 from bt_manip.sim.world import World
-from bt_manip.viz.overlay import FrameItem, Overlay, PathItem, item_json, overlay_for
+from bt_manip.viz.overlay import item_json
 from bt_manip.viz.scene import ROOT, build_scene, pose_matrix
 from bt_manip.viz.urdf_visuals import origin_matrix, read_visuals
 
@@ -103,6 +104,13 @@ def test_overlay_keeps_the_latest_item_per_name() -> None:
     assert max(triad["geometries"][0]["data"]["attributes"]["position"]["array"]) == 0.2
 
 
-def test_overlay_for_a_world_is_shared(room: World) -> None:
-    assert overlay_for(room) is overlay_for(room)
-    assert overlay_for(None) is not overlay_for(None)
+def test_each_run_has_its_own_overlay_and_viewers_find_it(room: World) -> None:
+    from bt_manip.bt import Tree, TreeContext
+    from bt_manip.bt.leaves import AlwaysSuccess
+    from bt_manip.run_context import RunContext, run_overlay
+
+    first, second = RunContext.for_world(room), RunContext.for_world(room)
+    first.overlay.show_path("plan", [(0, 0), (1, 0)])
+    assert "plan" not in second.overlay.items  # nothing of a run is kept on the world
+    assert run_overlay(Tree(AlwaysSuccess(), context=first)) is first.overlay
+    assert run_overlay(Tree(AlwaysSuccess(), context=TreeContext())) is None

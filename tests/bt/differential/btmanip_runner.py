@@ -11,6 +11,7 @@ import signal
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
+from dataclasses import dataclass, field
 from typing import Any
 
 from py_trees.common import Status
@@ -22,12 +23,18 @@ from bt_manip.errors import InputError
 from differential.leaf import LEAF_ID, LeafState
 from differential.spec import HALT, TICK_EXACTLY_ONCE, Case
 
-TRACE_SERVICE = "differential_trace"
+
+@dataclass
+class TracingContext(TreeContext):
+    """A tree context with the trace of the test leaves' calls."""
+
+    trace: list[str] = field(default_factory=list)
+
 _STATUS = {"SUCCESS": Status.SUCCESS, "FAILURE": Status.FAILURE, "RUNNING": Status.RUNNING}
 
 
 def _trace(node: Any) -> list[str]:
-    return node.context.services[TRACE_SERVICE]
+    return node.context.trace  # type: ignore[no-any-return]
 
 
 def _state(node: Any) -> LeafState:
@@ -135,7 +142,7 @@ def run_case(case: Case, reg: NodeRegistry | None = None,
 
 def _run(case: Case, reg: NodeRegistry | None) -> dict[str, Any]:
     trace: list[str] = []
-    context = TreeContext(clock=ManualClock(), services={TRACE_SERVICE: trace})
+    context = TracingContext(clock=ManualClock(), trace=trace)
     init = {key: value for key, _, value in case.init}
     try:
         tree = load_tree_string(case.xml(), context=context, blackboard=init,
