@@ -41,7 +41,7 @@ from bt_manip.sim.assets import resolve_uri
 from bt_manip.sim.mesh_check import mesh_problem
 
 if TYPE_CHECKING:
-    from bt_manip.sim.robot import RobotDescription
+    from bt_manip.sim.robot_description import RobotDescription
 
 COMPOSER_VERSION = 2
 """Bumped whenever the output of composition changes for the same inputs."""
@@ -102,9 +102,9 @@ def cache_dir() -> Path:
 def composed_urdf(description: RobotDescription | Recipe | Path | str) -> Path:
     """Path of the URDF that both PyBullet and Pinocchio load for this robot.
 
-    ``description`` is a :class:`~bt_manip.sim.robot.RobotDescription`, a :class:`Recipe` or a
-    URDF path. A plain URDF without meshes is returned as it is; otherwise the resolved or
-    composed file is written to :func:`cache_dir` once and its path returned.
+    ``description`` is a :class:`~bt_manip.sim.robot_description.RobotDescription`, a
+    :class:`Recipe` or a URDF path. A plain URDF without meshes is returned as it is; otherwise
+    the resolved or composed file is written to :func:`cache_dir` once and its path returned.
     """
     source = getattr(description, "urdf", description)
     if isinstance(source, Recipe):

@@ -25,14 +25,8 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from bt_manip.errors import InputError
-from bt_manip.sim.yaml_lines import (
-    LineDict,
-    LineList,
-    ProblemCollector,
-    is_number,
-    load_yaml,
-    numbers_of,
-)
+from bt_manip.sim.robot_description import find_descriptor, known_robots
+from bt_manip.sim.yaml_lines import FieldReader, LineDict, LineList, load_yaml
 
 COLOURS: dict[str, tuple[float, float, float, float]] = {
     "white": (0.95, 0.95, 0.95, 1.0),
@@ -195,59 +189,8 @@ ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize"}
 RANDOM_KEYS = {"x", "y", "yaw"}
 
 
-class _Reader(ProblemCollector):
+class _Reader(FieldReader):
     """Walks the YAML tree, converting values and collecting problems."""
-
-    # -- generic checks ---------------------------------------------------------------
-    def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
-        if isinstance(value, LineDict):
-            return value
-        self.fail(line, f"{where} must be a mapping, got {type(value).__name__}")
-        return None
-
-    def seq(self, value: Any, line: int, where: str) -> LineList | None:
-        if value is None:
-            return LineList()
-        if isinstance(value, LineList):
-            return value
-        self.fail(line, f"{where} must be a list, got {type(value).__name__}")
-        return None
-
-    def number(
-        self,
-        d: LineDict,
-        key: str,
-        where: str,
-        default: float | None = None,
-        positive: bool = False,
-        non_negative: bool = False,
-        within: tuple[float, float] | None = None,
-    ) -> float | None:
-        if key not in d:
-            if default is None:
-                self.fail(d.line, f"{where} is missing '{key}'")
-            return default
-        value = d[key]
-        if not is_number(value):
-            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
-            return default
-        if positive and value <= 0:
-            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
-            return default
-        if non_negative and value < 0:
-            self.fail(d.line_of(key), f"{where}.{key} must be >= 0, got {value}")
-            return default
-        if within is not None and not within[0] <= value <= within[1]:
-            self.fail(d.line_of(key),
-                      f"{where}.{key} must be within {within[0]:g}..{within[1]:g}, got {value}")
-            return default
-        return float(value)
-
-    def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        out = numbers_of(value, n)
-        if out is None:
-            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
-        return out
 
     def colour(
         self, d: LineDict, where: str, default: tuple[float, float, float, float]
@@ -555,29 +498,6 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
     return out
 
 
-def _find_robot(name: str, world_dir: Path) -> Path | None:
-    from bt_manip.sim.assets import REPO_ROOT
-
-    as_path = (world_dir / name) if not Path(name).is_absolute() else Path(name)
-    if name.endswith((".yaml", ".yml")) and as_path.is_file():
-        return as_path.resolve()
-    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
-        candidate = folder / f"{name}.yaml"
-        if candidate.is_file():
-            return candidate.resolve()
-    return None
-
-
-def _known_robots(world_dir: Path) -> list[str]:
-    from bt_manip.sim.assets import REPO_ROOT
-
-    names: set[str] = set()
-    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
-        if folder.is_dir():
-            names.update(p.stem for p in folder.glob("*.yaml"))
-    return sorted(names)
-
-
 def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
     out: list[RobotSpec] = []
     for i, raw in enumerate(robots):
@@ -592,14 +512,14 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
             rd.fail(
                 d.line_of("description"),
                 f"{where} ('{name}') needs 'description': a robot "
-                f"name such as {', '.join(_known_robots(base)) or 'husky_ur3'}",
+                f"name such as {', '.join(known_robots(base)) or 'husky_ur3'}",
             )
             continue
-        desc_path = _find_robot(desc, base)
+        desc_path = find_descriptor(desc, base)
         if desc_path is None:
             import difflib
 
-            known = _known_robots(base)
+            known = known_robots(base)
             close = difflib.get_close_matches(desc, known, n=1)
             hint = (
                 f"did you mean '{close[0]}'?" if close else f"known: {', '.join(known) or 'none'}"
