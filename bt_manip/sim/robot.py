@@ -20,7 +20,9 @@ import numpy as np
 import pybullet as pb
 
 from bt_manip.errors import InputError
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.compose import composed_urdf
+from bt_manip.sim.pybullet_queries import JointInfo
 from bt_manip.sim.robot_description import (
     ArmSpec,
     BaseSpec,
@@ -71,16 +73,16 @@ class Robot:
         self.description = description
         self._joints: dict[str, int] = {}
         self._links: dict[str, int] = {}
-        self._joint_info: dict[int, tuple] = {}
-        root = pb.getBodyInfo(body, physicsClientId=client)[0].decode()
-        dynamics = pb.getDynamicsInfo(body, -1, physicsClientId=client)
-        self._root_inertial = (dynamics[3], dynamics[4])
-        self._links[root] = -1
-        for j in range(pb.getNumJoints(body, physicsClientId=client)):
-            info = pb.getJointInfo(body, j, physicsClientId=client)
-            self._joints[info[1].decode()] = j
-            self._links[info[12].decode()] = j
-            self._joint_info[j] = info
+        self._joint_info: dict[int, JointInfo] = {}
+        dynamics = pbq.dynamics_info(client, body, -1)
+        self._root_inertial = (
+            dynamics.local_inertial_position, dynamics.local_inertial_orientation
+        )
+        self._links[pbq.root_link_name(client, body)] = -1
+        for info in pbq.joint_infos(client, body):
+            self._joints[info.name] = info.index
+            self._links[info.link_name] = info.index
+            self._joint_info[info.index] = info
         self.arm_joint_ids = [self.joint_index(n) for n in description.arm.joints]
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
@@ -89,11 +91,11 @@ class Robot:
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
         arm = description.arm
         self._arm_velocity = [
-            v if v is not None else float(self._joint_info[j][11])
+            v if v is not None else float(self._joint_info[j].max_velocity)
             for v, j in zip(arm.velocity_limits, self.arm_joint_ids, strict=True)
         ]
         self._arm_effort = [
-            e if e is not None else float(self._joint_info[j][10])
+            e if e is not None else float(self._joint_info[j].max_force)
             for e, j in zip(arm.efforts, self.arm_joint_ids, strict=True)
         ]
         self._gripper_target = self.gripper_opening()
@@ -146,7 +148,7 @@ class Robot:
     def _apply_friction(self) -> None:
         base = self.description.base
         for j in self.wheel_ids_left + self.wheel_ids_right:
-            axle = np.abs(np.asarray(self._joint_info[j][13], dtype=float))
+            axle = np.abs(np.asarray(self._joint_info[j].axis, dtype=float))
             anisotropic = 1.0 - (1.0 - base.wheel_axle_friction_scale) * axle
             pb.changeDynamics(
                 self.body,
@@ -218,10 +220,7 @@ class Robot:
         """PyBullet indices of the links the arm moves: the first arm joint's child link and
         everything below it (gripper included)."""
         if self._arm_links is None:
-            n = pb.getNumJoints(self.body, physicsClientId=self.client)
-            parents = {
-                j: pb.getJointInfo(self.body, j, physicsClientId=self.client)[16] for j in range(n)
-            }
+            parents = {j: info.parent_index for j, info in self._joint_info.items()}
             links = {self.joint_index(self.description.arm.joints[0])}
             grew = True
             while grew:
@@ -256,10 +255,8 @@ class Robot:
         if index == -1:
             pos, quat = self._root_pose()
             return np.array(pos), np.array(quat)
-        state = pb.getLinkState(
-            self.body, index, computeForwardKinematics=1, physicsClientId=self.client
-        )
-        return np.array(state[4]), np.array(state[5])
+        state = pbq.link_state(self.client, self.body, index)
+        return np.array(state.frame_position), np.array(state.frame_orientation)
 
     def link_transform(self, name: str) -> np.ndarray:
         """World pose of URDF link ``name`` as a 4x4 homogeneous matrix."""
@@ -272,7 +269,7 @@ class Robot:
     def _root_pose(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """URDF frame of the root link (PyBullet reports the root's centre-of-mass frame)."""
         com_pos, com_quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        inv_pos, inv_quat = pb.invertTransform(self._root_inertial[0], self._root_inertial[1])
+        inv_pos, inv_quat = pb.invertTransform(*self._root_inertial)
         return pb.multiplyTransforms(com_pos, com_quat, inv_pos, inv_quat)
 
     def base_pose2d(self) -> tuple[float, float, float]:
@@ -290,8 +287,8 @@ class Robot:
 
     # -- arm ----------------------------------------------------------------------------------
     def _positions(self, ids: Sequence[int]) -> np.ndarray:
-        states = pb.getJointStates(self.body, list(ids), physicsClientId=self.client)
-        return np.array([s[0] for s in states])
+        states = pbq.joint_states(self.client, self.body, list(ids))
+        return np.array([s.position for s in states])
 
     def arm_positions(self) -> np.ndarray:
         """Arm joint positions (rad) in descriptor order."""
@@ -299,8 +296,8 @@ class Robot:
 
     def arm_velocities(self) -> np.ndarray:
         """Arm joint velocities (rad/s) in descriptor order."""
-        states = pb.getJointStates(self.body, self.arm_joint_ids, physicsClientId=self.client)
-        return np.array([s[1] for s in states])
+        states = pbq.joint_states(self.client, self.body, self.arm_joint_ids)
+        return np.array([s.velocity for s in states])
 
     def set_arm_targets(
         self, q: Sequence[float], max_velocity: float | Sequence[float] | None = None
@@ -394,15 +391,20 @@ class Robot:
         self, other_body: int | None = None, links: Sequence[int] | None = None
     ) -> list[ContactPoint]:
         """Contacts of this robot's links (all, or ``links``) with ``other_body`` (or any body)."""
-        kwargs = {"bodyA": self.body, "physicsClientId": self.client}
-        if other_body is not None:
-            kwargs["bodyB"] = other_body
         wanted = None if links is None else set(links)
         out = []
-        for c in pb.getContactPoints(**kwargs):
-            if c[2] == self.body or (wanted is not None and c[3] not in wanted):
+        for c in pbq.contacts(self.client, self.body, other_body):
+            if c.body_b == self.body or (wanted is not None and c.link_a not in wanted):
                 continue
-            out.append(ContactPoint(self.link_name(c[3]), c[2], c[4], tuple(c[5]), float(c[9])))
+            out.append(
+                ContactPoint(
+                    self.link_name(c.link_a),
+                    c.body_b,
+                    c.link_b,
+                    tuple(c.position_on_a),
+                    float(c.normal_force),
+                )
+            )
         return out
 
     def finger_contacts(self, other_body: int | None = None) -> list[ContactPoint]:

@@ -24,6 +24,7 @@ import pybullet as pb
 
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError, Problem
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.attach import Attachments
 from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
 from bt_manip.sim.world_spec import (
@@ -305,8 +306,8 @@ class World:
 
     def _penetration(self, a: int, b: int) -> float:
         """Signed distance (m) between two bodies where they touch; negative when overlapping."""
-        pts = pb.getClosestPoints(a, b, 0.0, physicsClientId=self.client)
-        return min((p[8] for p in pts), default=0.0)
+        pts = pbq.closest_points(self.client, a, b, 0.0)
+        return min((p.distance for p in pts), default=0.0)
 
     def _overlaps(self) -> list[Problem]:
         """Movable objects and robots must not start inside anything else."""
@@ -440,8 +441,8 @@ class World:
             pos, quat = pb.getBasePositionAndOrientation(b, physicsClientId=c)
             lin, ang = pb.getBaseVelocity(b, physicsClientId=c)
             joints = [
-                pb.getJointState(b, j, physicsClientId=c)[:2]
-                for j in range(pb.getNumJoints(b, physicsClientId=c))
+                (s.position, s.velocity)
+                for s in pbq.joint_states(c, b, list(range(pbq.joint_count(c, b))))
             ]
             out[info.name] = {"pos": pos, "quat": quat, "lin": lin, "ang": ang, "joints": joints}
         return out

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import pybullet as pb
 
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.viz.scene import ROOT
 
 DISTANCE = 3.0
@@ -85,17 +85,17 @@ def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int
     for _ in range(4):  # look past up to three bodies that are not blockers
         if not todo:
             break
-        hits = pb.rayTestBatch(origin[todo].tolist(), ends[todo].tolist(), physicsClientId=c)
+        hits = pbq.ray_hits(c, origin[todo].tolist(), ends[todo].tolist())
         again = []
         for k, hit in zip(todo, hits, strict=True):
-            body = hit[0]
+            body = hit.body
             if body < 0:
                 continue
             if body in blockers:
                 out[k] = True
                 continue
             direction = ends[k] - starts[k]
-            origin[k] = np.asarray(hit[3]) + 1e-3 * direction / np.linalg.norm(direction)
+            origin[k] = np.asarray(hit.position) + 1e-3 * direction / np.linalg.norm(direction)
             again.append(k)
         todo = again
     return out
@@ -104,8 +104,7 @@ def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int
 def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box around every link of a body."""
     boxes = [
-        pb.getAABB(body, link, physicsClientId=client)
-        for link in range(-1, pb.getNumJoints(body, physicsClientId=client))
+        pbq.aabb(client, body, link) for link in range(-1, pbq.joint_count(client, body))
     ]
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.viz.urdf_visuals import Visual, read_visuals
 
 ROOT = "/meshcat/bt_manip"
@@ -97,12 +98,10 @@ class SceneBody:
         base = _matrix(pos, quat) @ body.base_offset
         out[0] = _pose_row(base)
         if body.link_ids:
-            states = pb.getLinkStates(
-                body.body_id, body.link_ids, computeForwardKinematics=1, physicsClientId=client
-            )
+            states = pbq.link_states(client, body.body_id, body.link_ids)
             inv = _inverse(base)
             for k, state in enumerate(states):
-                out[1 + k] = _pose_row(inv @ _matrix(state[4], state[5]))
+                out[1 + k] = _pose_row(inv @ _matrix(state.frame_position, state.frame_orientation))
         return out
 
 
@@ -363,12 +362,11 @@ def _urdf_of(info: Any, world: Any) -> Path | None:
 def _add_urdf_body(
     body: SceneBody, c: int, body_id: int, urdf: Path, scale: float, movable: bool
 ) -> None:
-    root_link = pb.getBodyInfo(body_id, physicsClientId=c)[0].decode()
-    links = {root_link: -1}
-    for j in range(pb.getNumJoints(body_id, physicsClientId=c)):
-        links[pb.getJointInfo(body_id, j, physicsClientId=c)[12].decode()] = j
-    dyn = pb.getDynamicsInfo(body_id, -1, physicsClientId=c)
-    base_offset = _inverse(_matrix(dyn[3], dyn[4]))
+    links = {pbq.root_link_name(c, body_id): -1}
+    for joint in pbq.joint_infos(c, body_id):
+        links[joint.link_name] = joint.index
+    dyn = pbq.dynamics_info(c, body_id, -1)
+    base_offset = _inverse(_matrix(dyn.local_inertial_position, dyn.local_inertial_orientation))
     visuals = [v for v in read_visuals(urdf) if v.link in links]
     drawn_links = sorted({links[v.link] for v in visuals if links[v.link] >= 0})
     counts: dict[str, int] = {}
@@ -393,10 +391,10 @@ def _add_primitive_body(body: SceneBody, c: int, info: Any, movable: bool) -> No
     spec = info.spec
     parts = list(getattr(spec, "parts", None) or [])
     default_rgba = tuple(getattr(spec, "colour", None) or DEFAULT_RGBA)
-    shapes = pb.getVisualShapeData(info.body_id, physicsClientId=c)
-    for k, shape in enumerate(s for s in shapes if s[1] == -1):
-        geom_type, dims = shape[2], shape[3]
-        local = _matrix(shape[5], shape[6])
+    shapes = pbq.visual_shapes(c, info.body_id)
+    for k, shape in enumerate(s for s in shapes if s.link == -1):
+        geom_type, dims = shape.geometry_type, shape.dimensions
+        local = _matrix(shape.local_position, shape.local_orientation)
         part_rgba = parts[k].colour if k < len(parts) and parts[k].colour else None
         rgba = tuple(part_rgba or default_rgba)
         if geom_type == pb.GEOM_BOX:
