@@ -8,7 +8,7 @@ import pybullet as pb
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
-from bt_manip.behaviours.gripper import held_object
+from bt_manip.behaviours.gripper import grasped_object
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, Port, count_of
 from bt_manip.sim import pybullet_queries as pbq
@@ -49,7 +49,7 @@ class IsHolding(WorldCondition):
             if robot.is_grasping(body) or self.world.attachments.is_attached(name):
                 return True, ""
             return False, f"the gripper does not hold '{name}'"
-        if held_object(self.world, robot) or self.world.attachments.held_by(self.robot_name()):
+        if grasped_object(self.world, robot) or self.world.attachments.held_by(self.robot_name()):
             return True, ""
         return False, "the gripper holds nothing"
 

@@ -17,7 +17,7 @@ SETTLED_SPEED = 0.002
 """The fingers count as stopped when the opening changes by less than this per tick (m)."""
 
 
-def held_object(world: Any, robot: Any) -> str:
+def grasped_object(world: Any, robot: Any) -> str:
     """Name of the movable object every finger touches, or ''."""
     for name, body in world.movable.items():
         if robot.is_grasping(body):
@@ -110,7 +110,7 @@ class CloseGripper(_GripperMove):
         return robot.description.gripper.min_opening if value < 0 else value
 
     def finished(self, robot: Any, opening: float) -> Status:
-        name = held_object(self.world, robot)
+        name = grasped_object(self.world, robot)
         self.set_output("holding", bool(name))
         self.set_output("object", name)
         if not name and self.get_input("require_object"):
