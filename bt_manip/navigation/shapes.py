@@ -26,10 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
+from bt_manip.geometry import Frame, compose, frame_of, inverse
 from bt_manip.sim import pybullet_queries as pbq
 
 ZBand = tuple[float, float]
-Frame = tuple[np.ndarray, np.ndarray]  # position (3,), rotation matrix (3, 3)
 
 
 @dataclass(frozen=True)
@@ -90,21 +90,6 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
             upper.pop()
         upper.append(p)
     return np.array(lower[:-1] + upper[:-1])
-
-
-def frame_of(position: tuple[float, ...], quaternion: tuple[float, ...]) -> Frame:
-    rot = np.array(pb.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
-    return np.asarray(position, dtype=float), rot
-
-
-def compose(a: Frame, b: Frame) -> Frame:
-    """Frame ``b`` (given in frame ``a``) expressed in ``a``'s parent."""
-    return a[0] + a[1] @ b[0], a[1] @ b[1]
-
-
-def inverse(a: Frame) -> Frame:
-    rt = a[1].T
-    return -rt @ a[0], rt
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:

@@ -14,9 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 import pybullet as pb
 
+from bt_manip.geometry import compose_poses, invert_pose
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.events import Attached, Detached
 
@@ -47,11 +47,6 @@ class AttachResult:
     ok: bool
     reason: str = ""
     distance: float | None = None
-
-
-def _com_pose(client: int, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
-    pos, quat = pbq.com_pose(client, body, link)
-    return np.asarray(pos), np.asarray(quat)
 
 
 class Attachments:
@@ -109,12 +104,9 @@ class Attachments:
             )
         link_name = link or robot.description.end_effector
         link_index = robot.link_index(link_name)
-        p_pos, p_quat = _com_pose(self.client, robot.body, link_index)
-        c_pos, c_quat = _com_pose(self.client, body, -1)
-        inv_pos, inv_quat = pb.invertTransform(p_pos.tolist(), p_quat.tolist())
-        rel_pos, rel_quat = pb.multiplyTransforms(
-            inv_pos, inv_quat, c_pos.tolist(), c_quat.tolist()
-        )
+        parent = pbq.com_pose(self.client, robot.body, link_index)
+        child = pbq.com_pose(self.client, body, -1)
+        rel_pos, rel_quat = compose_poses(invert_pose(parent), child)
         cid = pb.createConstraint(
             robot.body,
             link_index,

@@ -20,6 +20,7 @@ import numpy as np
 import pybullet as pb
 
 from bt_manip.errors import InputError
+from bt_manip.geometry import compose_poses, invert_pose, pose_matrix, quat_from_yaw, yaw_of
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.compose import composed_urdf
 from bt_manip.sim.pybullet_queries import JointInfo
@@ -126,7 +127,7 @@ class Robot:
             body = pb.loadURDF(
                 str(path),
                 basePosition=(x, y, z),
-                baseOrientation=pb.getQuaternionFromEuler((0.0, 0.0, yaw)),
+                baseOrientation=quat_from_yaw(yaw),
                 useFixedBase=description.base.type == "fixed",
                 flags=flags,
                 physicsClientId=client,
@@ -260,23 +261,17 @@ class Robot:
 
     def link_transform(self, name: str) -> np.ndarray:
         """World pose of URDF link ``name`` as a 4x4 homogeneous matrix."""
-        pos, quat = self.link_pose(name)
-        out = np.eye(4)
-        out[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
-        out[:3, 3] = pos
-        return out
+        return pose_matrix(*self.link_pose(name))
 
     def _root_pose(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """URDF frame of the root link (PyBullet reports the root's centre-of-mass frame)."""
         com_pos, com_quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        inv_pos, inv_quat = pb.invertTransform(*self._root_inertial)
-        return pb.multiplyTransforms(com_pos, com_quat, inv_pos, inv_quat)
+        return compose_poses((com_pos, com_quat), invert_pose(self._root_inertial))
 
     def base_pose2d(self) -> tuple[float, float, float]:
         """Planar pose (x, y, yaw) of the root link frame in the world."""
         pos, quat = self._root_pose()
-        yaw = pb.getEulerFromQuaternion(quat)[2]
-        return float(pos[0]), float(pos[1]), float(yaw)
+        return float(pos[0]), float(pos[1]), yaw_of(quat)
 
     def base_velocity(self) -> tuple[float, float, float]:
         """Forward and sideways speed (m/s, in the base heading frame) and yaw rate (rad/s)."""

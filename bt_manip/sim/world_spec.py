@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from bt_manip.errors import InputError
+from bt_manip.geometry import quat_from_euler, quat_from_yaw
 from bt_manip.sim.robot_description import find_descriptor, known_robots
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, LineList, load_yaml
 
@@ -259,13 +260,11 @@ class _Reader(FieldReader):
 
     def body_pose(self, value: Any, line: int, where: str) -> tuple[Pose3D, bool] | None:
         """``[x, y, yaw]`` (rests on the floor) or ``{xyz: [...], rpy|quat: [...]}``."""
-        import pybullet as pb
-
         if isinstance(value, list) or (isinstance(value, LineDict) and "xyz" not in value):
             p2 = self.pose2d(value, line, where)
             if p2 is None:
                 return None
-            return Pose3D((p2.x, p2.y, 0.0), tuple(pb.getQuaternionFromEuler((0, 0, p2.yaw)))), True
+            return Pose3D((p2.x, p2.y, 0.0), quat_from_yaw(p2.yaw)), True
         if isinstance(value, LineDict):
             self.unknown_keys(value, {"xyz", "rpy", "quat"}, where)
             xyz = self.vector(value["xyz"], 3, value.line_of("xyz"), f"{where}.xyz")
@@ -275,7 +274,7 @@ class _Reader(FieldReader):
             quat: tuple[float, ...] | None = (0.0, 0.0, 0.0, 1.0)
             if "rpy" in value:
                 rpy = self.vector(value["rpy"], 3, value.line_of("rpy"), f"{where}.rpy")
-                quat = tuple(pb.getQuaternionFromEuler(rpy)) if rpy else None
+                quat = quat_from_euler(rpy) if rpy else None
             elif "quat" in value:
                 quat = self.vector(value["quat"], 4, value.line_of("quat"), f"{where}.quat")
                 if quat is not None:

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.geometry import yaw_of
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.viz.scene import ROOT
 
@@ -209,7 +210,7 @@ def replay_camera(world: Any, rec: Any) -> dict[str, Any]:
     picks = sorted({0, n - 1, *np.linspace(0, n - 1, MIDDLE_FRAMES).round().astype(int)})
     weights = [END_WEIGHT if k in (0, n - 1) else 1 for k in picks]
     q = samples[0][3:7]
-    yaw = math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
-    offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], float(yaw), weights)
+    yaw = yaw_of(q)
+    offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], yaw, weights)
     target = (float(samples[0][0]), float(samples[0][1]), look_height(world, robot.body))
     return CameraView(target, offset, path).to_json()
