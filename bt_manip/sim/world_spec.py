@@ -352,12 +352,7 @@ class _Reader(FieldReader):
 
 def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
     out: list[WallSpec] = []
-    for i, raw in enumerate(walls):
-        where = f"walls[{i}]"
-        d = rd.mapping(raw, walls.line_of(i), where)
-        if d is None:
-            continue
-        rd.unknown_keys(d, WALL_KEYS, where)
+    for i, where, d in rd.entries(walls, "walls", WALL_KEYS):
         start = rd.vector(d.get("from"), 2, d.line_of("from"), f"{where}.from ([x, y])")
         end = rd.vector(d.get("to"), 2, d.line_of("to"), f"{where}.to ([x, y])")
         thickness = rd.number(d, "thickness", where, default=0.12, positive=True)
@@ -372,12 +367,7 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
             continue
         doors: list[DoorSpec] = []
         door_list = rd.seq(d.get("doors"), d.line_of("doors"), f"{where}.doors")
-        for j, rawd in enumerate(door_list or []):
-            dw = f"{where}.doors[{j}]"
-            dd = rd.mapping(rawd, door_list.line_of(j), dw)  # type: ignore[union-attr]
-            if dd is None:
-                continue
-            rd.unknown_keys(dd, DOOR_KEYS, dw)
+        for _, dw, dd in rd.entries(door_list, f"{where}.doors", DOOR_KEYS):
             at = rd.number(dd, "at", dw)
             width = rd.number(dd, "width", dw, positive=True)
             if at is None or width is None:
@@ -422,12 +412,7 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
         if not plist:
             rd.fail(d.line_of("parts"), f"{where}.parts must list at least one part")
             return None
-        for j, rawp in enumerate(plist):
-            pw = f"{where}.parts[{j}]"
-            pd = rd.mapping(rawp, plist.line_of(j), pw)
-            if pd is None:
-                continue
-            rd.unknown_keys(pd, PART_KEYS, pw)
+        for _, pw, pd in rd.entries(plist, f"{where}.parts", PART_KEYS):
             part = rd.shape(pd, pw, rd.colour(pd, pw, colour), with_offset=True)
             if part is not None:
                 parts.append(part)
@@ -499,12 +484,7 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
 
 def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
     out: list[RobotSpec] = []
-    for i, raw in enumerate(robots):
-        where = f"robots[{i}]"
-        d = rd.mapping(raw, robots.line_of(i), where)
-        if d is None:
-            continue
-        rd.unknown_keys(d, ROBOT_KEYS, where)
+    for _, where, d in rd.entries(robots, "robots", ROBOT_KEYS):
         name = rd.name(d, where)
         desc = d.get("description")
         if not isinstance(desc, str):
@@ -580,12 +560,10 @@ def parse_world(path: str | Path) -> WorldSpec:
     lists = {"furniture": spec.furniture, "objects": spec.objects, "models": spec.models}
     for key, target in lists.items():
         items = rd.seq(data.get(key), data.line_of(key), key)
-        for i, raw in enumerate(items or []):
-            d = rd.mapping(raw, items.line_of(i), f"{key}[{i}]")  # type: ignore[union-attr]
-            if d is not None:
-                body = _parse_body(rd, d, f"{key}[{i}]", key != "furniture", base)
-                if body is not None:
-                    target.append(body)
+        for _, where, d in rd.entries(items, key):
+            body = _parse_body(rd, d, where, key != "furniture", base)
+            if body is not None:
+                target.append(body)
     robots = rd.seq(data.get("robots"), data.line_of("robots"), "robots")
     spec.robots = _parse_robots(rd, robots, base) if robots else []
     if "poses" in data:

@@ -10,6 +10,7 @@ that knows the line of each item).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -221,6 +222,20 @@ class FieldReader(ProblemCollector):
             return value
         self.fail(line, f"{where} must be a list, got {type(value).__name__}")
         return None
+
+    def entries(
+        self, items: LineList | None, where: str, allowed: set[str] | None = None
+    ) -> Iterator[tuple[int, str, LineDict]]:
+        """Index, place (``where[i]``) and mapping of each item of a list that is a mapping
+        (each other item is a problem); with ``allowed``, unknown keys are problems too."""
+        for i, raw in enumerate(items or []):
+            here = f"{where}[{i}]"
+            d = self.mapping(raw, items.line_of(i), here)  # type: ignore[union-attr]
+            if d is None:
+                continue
+            if allowed is not None:
+                self.unknown_keys(d, allowed, here)
+            yield i, here, d
 
     def number(
         self,
