@@ -219,7 +219,7 @@ class World:
         else:
             body = self._make_compound(spec, pos, quat)
         if spec.movable:
-            for link in range(-1, pb.getNumJoints(body, physicsClientId=c)):
+            for link in range(-1, pbq.joint_count(c, body)):
                 pb.changeDynamics(body, link, lateralFriction=spec.friction, physicsClientId=c)
         return body
 
