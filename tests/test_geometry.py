@@ -42,3 +42,8 @@ def test_frames_and_poses_compose_like_their_matrices() -> None:
     ipos, iquat = g.invert_pose(a)
     inverted = g.inverse_matrix(g.pose_matrix(*a))
     assert g.pose_matrix(ipos, iquat) == pytest.approx(inverted, abs=1e-6)
+
+
+def test_urdf_rpy_matrix_agrees_with_the_simulator_convention() -> None:
+    rpy = (0.3, -1.1, 2.4)
+    assert g.rpy_matrix(*rpy) == pytest.approx(g.rotation_matrix(g.quat_from_euler(rpy)))
