@@ -213,12 +213,13 @@ def find_descriptor(name_or_path: str | Path, near: Path | None = None) -> Path 
 
     A name ending in ``.yaml``/``.yml`` is a path (relative to ``near`` when given); any other
     name is looked up as ``<name>.yaml`` in :func:`descriptor_folders`. Without ``near``, an
-    existing file is taken as a path whatever its suffix.
+    existing file is taken as a path whatever its suffix. Paths found for a world (``near``
+    given) are resolved; without ``near`` they are returned as named.
     """
     p = Path(name_or_path)
     if p.suffix in (".yaml", ".yml") or (near is None and p.is_file()):
-        if near is not None and not p.is_absolute():
-            p = (near / p).resolve()
+        if near is not None:
+            p = (near / p).resolve()  # an absolute p stays itself
         return p if p.is_file() else None
     for folder in descriptor_folders(near):
         candidate = folder / f"{name_or_path}.yaml"
