@@ -141,7 +141,7 @@ def _cause_json(cause: FailureCause | None) -> dict[str, str]:
     return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
 
 
-def node_records(root: py_trees.behaviour.Behaviour) -> list[NodeReport]:
+def node_reports(root: py_trees.behaviour.Behaviour) -> list[NodeReport]:
     """Every node under ``root`` with its status and feedback, paths joined by '/'."""
     out: list[NodeReport] = []
 
@@ -267,7 +267,7 @@ class Runner:
                 NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
                 for r in records()
             ]
-        return node_records(self.tree.root)
+        return node_reports(self.tree.root)
 
     def _failure_reason(self) -> str:
         """The reason of the failure that ended the run (see :mod:`bt_manip.failure_cause`):

@@ -12,7 +12,7 @@ import sys
 import time
 from typing import Any, TextIO
 
-from bt_manip.runner import NodeReport, Runner, node_records
+from bt_manip.runner import NodeReport, Runner, node_reports
 
 
 def _records(tree: Any) -> list[NodeReport]:
@@ -22,7 +22,7 @@ def _records(tree: Any) -> list[NodeReport]:
             NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
             for r in fn()
         ]
-    return node_records(tree.root)
+    return node_reports(tree.root)
 
 
 def _shown(rec: NodeReport) -> str:
