@@ -210,12 +210,7 @@ class Robot:
 
     def joint_index(self, name: str) -> int:
         """PyBullet joint index of the joint called ``name`` (KeyError names the choices)."""
-        try:
-            return self._joints[name]
-        except KeyError:
-            raise KeyError(
-                f"{self.name} has no joint '{name}'; joints: {', '.join(self._joints)}"
-            ) from None
+        return self._index(self._joints, name, "joint")
 
     def arm_link_ids(self) -> list[int]:
         """PyBullet indices of the links the arm moves: the first arm joint's child link and
@@ -235,11 +230,14 @@ class Robot:
 
     def link_index(self, name: str) -> int:
         """PyBullet link index of the URDF link ``name`` (-1 for the root link)."""
+        return self._index(self._links, name, "link")
+
+    def _index(self, table: dict[str, int], name: str, what: str) -> int:
         try:
-            return self._links[name]
+            return table[name]
         except KeyError:
             raise KeyError(
-                f"{self.name} has no link '{name}'; links: {', '.join(self._links)}"
+                f"{self.name} has no {what} '{name}'; {what}s: {', '.join(table)}"
             ) from None
 
     def link_name(self, index: int) -> str:
