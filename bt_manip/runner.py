@@ -75,7 +75,7 @@ class RunOptions:
 
 
 @dataclass
-class NodeRecord:
+class NodeReport:
     """A node's final state for the report: ``status`` now (finished nodes are IDLE again, as
     in BehaviorTree.CPP) and ``last_status``, what it last returned."""
 
@@ -98,7 +98,7 @@ class RunReport:
     tree: str = ""
     world: str = ""
     seed: int | None = None
-    nodes: list[NodeRecord] = field(default_factory=list)
+    nodes: list[NodeReport] = field(default_factory=list)
     extra: dict[str, Any] = field(default_factory=dict)
     cause: dict[str, str] = field(default_factory=dict)
     """On FAILURE, the node whose failure ended the run: ``path``, ``name``, ``node`` (its ID)
@@ -146,15 +146,15 @@ def _cause_json(cause: FailureCause | None) -> dict[str, str]:
     return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
 
 
-def node_records(root: py_trees.behaviour.Behaviour) -> list[NodeRecord]:
+def node_reports(root: py_trees.behaviour.Behaviour) -> list[NodeReport]:
     """Every node under ``root`` with its status and feedback, paths joined by '/'."""
-    out: list[NodeRecord] = []
+    out: list[NodeReport] = []
 
     def walk(node: py_trees.behaviour.Behaviour, prefix: str) -> None:
         path = f"{prefix}/{node.name}" if prefix else node.name
         node_id = getattr(node, "node_id", type(node).__name__)
         status = node.status.name
-        out.append(NodeRecord(path, node_id, status, node.feedback_message or "", status))
+        out.append(NodeReport(path, node_id, status, node.feedback_message or "", status))
         for child in node.children:
             walk(child, path)
 
@@ -269,14 +269,14 @@ class Runner:
         else:
             time.sleep(1.0 / opts.tick_hz)
 
-    def _records(self) -> list[NodeRecord]:
+    def _records(self) -> list[NodeReport]:
         records = getattr(self.tree, "node_records", None)
         if callable(records):
             return [
-                NodeRecord(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
+                NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
                 for r in records()
             ]
-        return node_records(self.tree.root)
+        return node_reports(self.tree.root)
 
     def _failure_reason(self) -> str:
         """The reason of the failure that ended the run (see :mod:`bt_manip.failure_cause`):

@@ -20,6 +20,7 @@ from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
+from bt_manip.geometry import pose_matrix, yaw_of
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
 TOLERANCE = Port(float, False, "how close each joint must get (rad)", 0.01, POSITIVE)
@@ -363,11 +364,11 @@ class MoveToPose(JointMove):
                 self.object_body(name), physicsClientId=self.world.client
             )
             position = list(pos)
-            yaw = pb.getEulerFromQuaternion(quat)[2]
+            yaw = yaw_of(quat)
         offset = self.get_input("offset")
         if len(position) != 3 or len(offset) != 3:
             raise ActionFailed("position and offset take three numbers x;y;z")
-        target = cartesian.pose_matrix(np.add(position, offset), self.get_input("orientation"))
+        target = pose_matrix(np.add(position, offset), self.get_input("orientation"))
         if self.get_input("match_object_yaw") and yaw is not None:
             target = self._turned_to(robot, tip, target, yaw)
         self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on

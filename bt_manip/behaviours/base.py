@@ -138,11 +138,11 @@ class RobotAction(WorldAccess, ActionNode):
         faults = self.faults()
         if faults is None or not faults.specs:
             return
-        from bt_manip.behaviours.gripper import held_object
+        from bt_manip.behaviours.gripper import grasped_object
 
         robot = self.robot()
         held = [a.object_name for a in self.world.attachments.held_by(self.robot_name())]
-        held += [held_object(self.world, robot)] if not held else []
+        held += [grasped_object(self.world, robot)] if not held else []
         held = [h for h in held if h]
         if held:
             self._slip = plan_slip(faults, held[0], self.started_at)

@@ -103,17 +103,3 @@ def _slerp(ra: np.ndarray, rb: np.ndarray, s: float) -> np.ndarray:
     return ra @ step
 
 
-def pose_matrix(position: np.ndarray, quat_xyzw: np.ndarray) -> np.ndarray:
-    """4x4 pose from a position and a quaternion (x, y, z, w)."""
-    x, y, z, w = np.asarray(quat_xyzw, dtype=float) / np.linalg.norm(quat_xyzw)
-    rot = np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-    out = np.eye(4)
-    out[:3, :3] = rot
-    out[:3, 3] = position
-    return out

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import Any
 
-import pybullet as pb
+from bt_manip.sim import pybullet_queries as pbq
 
 
 def arm_link_ids(robot: Any) -> frozenset[int]:
@@ -29,8 +29,8 @@ def arm_collisions(world: Any, robot: Any) -> list[str]:
     static = _static_ids(world)
     links = arm_link_ids(robot)
     found: list[str] = []
-    for pt in pb.getContactPoints(bodyA=robot.body, physicsClientId=world.client):
-        link, other = pt[3], pt[2]
+    for pt in pbq.contacts(world.client, robot.body):
+        link, other = pt.link_a, pt.body_b
         if link in links and other in static:
             found.append(f"{robot.link_name(link)} touched '{static[other]}'")
     found += carried_collisions(world, robot)

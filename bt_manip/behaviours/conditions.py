@@ -8,9 +8,10 @@ import pybullet as pb
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
-from bt_manip.behaviours.gripper import held_object
+from bt_manip.behaviours.gripper import grasped_object
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, Port, count_of
+from bt_manip.sim import pybullet_queries as pbq
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")
 
@@ -48,7 +49,7 @@ class IsHolding(WorldCondition):
             if robot.is_grasping(body) or self.world.attachments.is_attached(name):
                 return True, ""
             return False, f"the gripper does not hold '{name}'"
-        if held_object(self.world, robot) or self.world.attachments.held_by(self.robot_name()):
+        if grasped_object(self.world, robot) or self.world.attachments.held_by(self.robot_name()):
             return True, ""
         return False, "the gripper holds nothing"
 
@@ -74,7 +75,7 @@ class ObjectInRegion(WorldCondition):
         world = self.world
         inside = self.get_input("inside")
         if inside:
-            lo, hi = pb.getAABB(world.body_id(inside), physicsClientId=world.client)
+            lo, hi = pbq.aabb(world.client, world.body_id(inside))
             region = f"'{inside}'"
         else:
             lo, hi = self.get_input("min"), self.get_input("max")
@@ -100,7 +101,7 @@ class ObjectAbove(WorldCondition):
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")
         body = self.object_body(name)
-        lo, _ = pb.getAABB(body, physicsClientId=self.world.client)
+        lo, _ = pbq.aabb(self.world.client, body)
         need = float(self.get_input("height"))
         if lo[2] >= need:
             return True, ""

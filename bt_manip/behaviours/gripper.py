@@ -23,7 +23,7 @@ TIME_EPS = 1e-9
 """Tolerance (s) when comparing sim-time differences."""
 
 
-def held_object(world: Any, robot: Any) -> str:
+def grasped_object(world: Any, robot: Any) -> str:
     """Name of the movable object every finger touches, or ''."""
     for name, body in world.movable.items():
         if robot.is_grasping(body):
@@ -124,7 +124,7 @@ class CloseGripper(_GripperMove):
         return robot.description.gripper.min_opening if value < 0 else value
 
     def finished(self, robot: Any, opening: float) -> Status:
-        name = held_object(self.world, robot)
+        name = grasped_object(self.world, robot)
         self.set_output("holding", bool(name))
         self.set_output("object", name)
         if not name and self.get_input("require_object"):

@@ -23,6 +23,7 @@ from bt_manip.faults import block_route
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.grid import GridTooLarge
 from bt_manip.navigation.navigator import Navigator
+from bt_manip.sim import pybullet_queries as pbq
 
 TIME_BUDGET_FACTOR = 1.5
 """Without a ``timeout``, Navigate allows this many times the time the path takes at full
@@ -158,16 +159,14 @@ class Navigate(RobotAction):
     def _bumped(self) -> list[str]:
         """Movable objects the robot (not its fingers' load) has run into: it does not push
         things out of its way, it stops so that a retry can plan around them."""
-        import pybullet as pb
-
         world = self.world
         robot = self.robot()
         held = {a.object_body for a in world.attachments.held_by(self.robot_name())}
         movable = {b: n for n, b in world.movable.items() if b not in held}
         bumped = {
-            movable[pt[2]]
-            for pt in pb.getContactPoints(bodyA=robot.body, physicsClientId=world.client)
-            if pt[2] in movable and pt[3] not in robot.finger_link_ids
+            movable[pt.body_b]
+            for pt in pbq.contacts(world.client, robot.body)
+            if pt.body_b in movable and pt.link_a not in robot.finger_link_ids
         }
         return [f"ran into '{name}'" for name in sorted(bumped)]
 
@@ -213,17 +212,15 @@ class Reverse(RobotAction):
 
     def _contacts(self) -> set[str]:
         """Bodies other than the floor that the robot or its load touch now."""
-        import pybullet as pb
-
         world = self.world
         robot = self.robot()
         ground = world.body_id("ground")
         mine = {robot.body} | {a.object_body for a in world.attachments.held_by(self.robot_name())}
         out = set()
         for body in mine:
-            for pt in pb.getContactPoints(bodyA=body, physicsClientId=world.client):
-                if pt[2] != ground and pt[2] not in mine:
-                    out.add(world.name_of(pt[2]) or str(pt[2]))
+            for other in pbq.touching(world.client, body):
+                if other != ground and other not in mine:
+                    out.add(world.name_of(other) or str(other))
         return out
 
     def step(self) -> Status:

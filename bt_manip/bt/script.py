@@ -153,7 +153,7 @@ class Expr:
 
 
 @dataclass
-class Literal(Expr):
+class Constant(Expr):
     value: Any
     pos: int = 0
 
@@ -602,7 +602,7 @@ class _Parser:
         t = self.tok
         if t.kind in ("num", "str", "bool"):
             self.i += 1
-            return Literal(t.value, t.pos)
+            return Constant(t.value, t.pos)
         if t.kind == "name":
             self.i += 1
             return Name(t.value, t.pos)

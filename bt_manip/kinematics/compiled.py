@@ -129,7 +129,11 @@ def _build(function: ca.Function, compiler: str) -> Path | None:
     return target
 
 
-def load_runner(function: ca.Function) -> CompiledRunner | VirtualMachineRunner:
+FunctionRunner = CompiledRunner | VirtualMachineRunner
+"""Either way of evaluating a CasADi function (compiled C or CasADi's virtual machine)."""
+
+
+def load_runner(function: ca.Function) -> FunctionRunner:
     """A runner for ``function``: compiled C when possible, CasADi's VM otherwise."""
     compiler = _compiler()
     if compiler is None:

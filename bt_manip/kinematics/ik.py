@@ -38,11 +38,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from bt_manip.kinematics.arm_model import ArmModel
-from bt_manip.kinematics.compiled import CompiledRunner, VirtualMachineRunner, load_runner
+from bt_manip.kinematics.compiled import FunctionRunner, VirtualMachineRunner, load_runner
 from bt_manip.kinematics.reasons import beyond_reach, joint_limits, not_converged
 from bt_manip.kinematics.solver_graph import AXES, attempt_function
-
-Runner = CompiledRunner | VirtualMachineRunner
 
 
 @dataclass(frozen=True)
@@ -153,7 +151,7 @@ class IKSolver:
         axis = o.free_axis or "z"
         function = attempt_function(arm, o.mode, o.iterations_per_attempt, axis)
         if o.compile:
-            self._runner: Runner = load_runner(function)
+            self._runner: FunctionRunner = load_runner(function)
         else:
             self._runner = VirtualMachineRunner(function)
         self._params = np.array(

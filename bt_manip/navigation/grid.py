@@ -24,9 +24,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import pybullet as pb
 
 from bt_manip.navigation.shapes import Disc, Outline, Polygon, ZBand, body_outlines
+from bt_manip.sim import pybullet_queries as pbq
 
 DEFAULT_RESOLUTION = 0.05
 """Cell side (m)."""
@@ -278,8 +278,8 @@ def bodies_extent(
     lo = np.full(2, np.inf)
     hi = np.full(2, -np.inf)
     for b in bodies:
-        for link in range(-1, pb.getNumJoints(b, physicsClientId=client)):
-            a, c = pb.getAABB(b, link, physicsClientId=client)
+        for link in range(-1, pbq.joint_count(client, b)):
+            a, c = pbq.aabb(client, b, link)
             lo = np.minimum(lo, a[:2])
             hi = np.maximum(hi, c[:2])
     if not np.isfinite(lo).all():

@@ -34,7 +34,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-import pybullet as pb
 
 from bt_manip.navigation.controller import (
     FollowerOptions,
@@ -52,6 +51,7 @@ from bt_manip.navigation.planner import NavPlan, PlannerOptions, PlanOutcome, pl
 from bt_manip.navigation.segments import SegmentFollower
 from bt_manip.navigation.shapes import ZBand, body_outlines, planar_frame
 from bt_manip.navigation.smoothing import densify, path_length
+from bt_manip.sim import pybullet_queries as pbq
 
 
 @dataclass(frozen=True)
@@ -93,15 +93,15 @@ def lattice_clearance(grid: OccupancyGrid, d2: np.ndarray | None = None) -> np.n
 def split_links(robot: Any) -> tuple[list[int], list[int]]:
     """The robot's links the arm does not move (root included) and those it moves."""
     arm = robot.arm_link_ids()
-    n = pb.getNumJoints(robot.body, physicsClientId=robot.client)
+    n = pbq.joint_count(robot.client, robot.body)
     return [-1, *(j for j in range(n) if j not in arm)], arm
 
 
 def robot_top(robot: Any) -> float:
     """Highest point (m) of the robot's collision geometry now."""
     top = 0.0
-    for link in range(-1, pb.getNumJoints(robot.body, physicsClientId=robot.client)):
-        top = max(top, pb.getAABB(robot.body, link, physicsClientId=robot.client)[1][2])
+    for link in range(-1, pbq.joint_count(robot.client, robot.body)):
+        top = max(top, pbq.aabb(robot.client, robot.body, link).upper[2])
     return float(top)
 
 
@@ -241,12 +241,12 @@ class Navigator:
         c = self.client
         robot = self.robot
         chassis, arm = split_links(robot)
-        top = max(self.band[1], *(pb.getAABB(b, physicsClientId=c)[1][2] for b in self.attached))
-        low_top = max(pb.getAABB(robot.body, link, physicsClientId=c)[1][2] for link in chassis)
+        top = max(self.band[1], *(pbq.aabb(c, b).upper[2] for b in self.attached))
+        low_top = max(pbq.aabb(c, robot.body, link).upper[2] for link in chassis)
         low_top += 0.02
         arm_bottom = min(
-            [pb.getAABB(robot.body, link, physicsClientId=c)[0][2] for link in arm]
-            + [pb.getAABB(b, physicsClientId=c)[0][2] for b in self.attached]
+            [pbq.aabb(c, robot.body, link).lower[2] for link in arm]
+            + [pbq.aabb(c, b).lower[2] for b in self.attached]
         )
         high_band = (max(self.band[0], arm_bottom - 0.03), top + 0.05)
         frame = planar_frame(*robot.base_pose2d())

@@ -26,8 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as pb
 
+from bt_manip.geometry import Frame, compose, frame_of, inverse
+from bt_manip.sim import pybullet_queries as pbq
+
 ZBand = tuple[float, float]
-Frame = tuple[np.ndarray, np.ndarray]  # position (3,), rotation matrix (3, 3)
 
 
 @dataclass(frozen=True)
@@ -88,21 +90,6 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
             upper.pop()
         upper.append(p)
     return np.array(lower[:-1] + upper[:-1])
-
-
-def frame_of(position: tuple[float, ...], quaternion: tuple[float, ...]) -> Frame:
-    rot = np.array(pb.getMatrixFromQuaternion(quaternion)).reshape(3, 3)
-    return np.asarray(position, dtype=float), rot
-
-
-def compose(a: Frame, b: Frame) -> Frame:
-    """Frame ``b`` (given in frame ``a``) expressed in ``a``'s parent."""
-    return a[0] + a[1] @ b[0], a[1] @ b[1]
-
-
-def inverse(a: Frame) -> Frame:
-    rt = a[1].T
-    return -rt @ a[0], rt
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:
@@ -175,16 +162,11 @@ def _round_solid(
 
 def link_frame(client: int, body: int, link: int) -> Frame:
     """World frame of a link's centre of mass (the frame collision shapes are given in)."""
-    if link < 0:
-        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    else:
-        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
-        pos, quat = state[0], state[1]
-    return frame_of(pos, quat)
+    return frame_of(*pbq.com_pose(client, body, link))
 
 
 def _aabb_outline(client: int, body: int, link: int, ref: Frame, band: ZBand) -> Outline | None:
-    lo, hi = pb.getAABB(body, link, physicsClientId=client)
+    lo, hi = pbq.aabb(client, body, link)
     centre = (np.asarray(lo) + np.asarray(hi)) / 2.0
     half = (np.asarray(hi) - np.asarray(lo)) / 2.0
     return _points_outline(_box_slice(compose(ref, (centre, np.eye(3))), half, band))
@@ -216,16 +198,16 @@ def body_outlines(
     """
     ref_inv = inverse(reference) if reference is not None else (np.zeros(3), np.eye(3))
     if links is None:
-        links = list(range(-1, pb.getNumJoints(body, physicsClientId=client)))
+        links = list(range(-1, pbq.joint_count(client, body)))
     out: list[Outline] = []
     for link in links:
-        shapes = pb.getCollisionShapeData(body, link, physicsClientId=client)
+        shapes = pbq.collision_shapes(client, body, link)
         if not shapes:
             continue
         com = compose(ref_inv, link_frame(client, body, link))
         for index, shape in enumerate(shapes):
-            geom, dims = shape[2], shape[3]
-            local = frame_of(shape[5], shape[6])
+            geom, dims = shape.geometry_type, shape.dimensions
+            local = frame_of(shape.local_position, shape.local_orientation)
             frame = compose(com, local)
             outline: Outline | None
             if geom == pb.GEOM_BOX:

@@ -14,9 +14,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
 import pybullet as pb
 
+from bt_manip.geometry import compose_poses, invert_pose
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.events import Attached, Detached
 
 DEFAULT_MAX_DISTANCE = 0.01
@@ -48,15 +49,6 @@ class AttachResult:
     distance: float | None = None
 
 
-def _com_pose(client: int, body: int, link: int) -> tuple[np.ndarray, np.ndarray]:
-    if link < 0:
-        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
-    else:
-        state = pb.getLinkState(body, link, computeForwardKinematics=1, physicsClientId=client)
-        pos, quat = state[0], state[1]
-    return np.asarray(pos), np.asarray(quat)
-
-
 class Attachments:
     """The attach joints of one world."""
 
@@ -74,11 +66,8 @@ class Attachments:
         """Smallest distance (m) between the object and any finger link; <= 0 when touching."""
         best = float("inf")
         for link in robot.finger_link_ids:
-            pts = pb.getClosestPoints(
-                robot.body, body, 0.05, linkIndexA=link, physicsClientId=self.client
-            )
-            for p in pts:
-                best = min(best, p[8])
+            for p in pbq.closest_points(self.client, robot.body, body, 0.05, link):
+                best = min(best, p.distance)
         return best
 
     def attach(
@@ -115,12 +104,9 @@ class Attachments:
             )
         link_name = link or robot.description.end_effector
         link_index = robot.link_index(link_name)
-        p_pos, p_quat = _com_pose(self.client, robot.body, link_index)
-        c_pos, c_quat = _com_pose(self.client, body, -1)
-        inv_pos, inv_quat = pb.invertTransform(p_pos.tolist(), p_quat.tolist())
-        rel_pos, rel_quat = pb.multiplyTransforms(
-            inv_pos, inv_quat, c_pos.tolist(), c_quat.tolist()
-        )
+        parent = pbq.com_pose(self.client, robot.body, link_index)
+        child = pbq.com_pose(self.client, body, -1)
+        rel_pos, rel_quat = compose_poses(invert_pose(parent), child)
         cid = pb.createConstraint(
             robot.body,
             link_index,
@@ -140,9 +126,7 @@ class Attachments:
         )
         self._touched[object_name] = set()
         self._supports[object_name] = {
-            pt[2]
-            for pt in pb.getContactPoints(bodyA=body, physicsClientId=self.client)
-            if pt[2] != robot.body
+            c.body_b for c in pbq.contacts(self.client, body) if c.body_b != robot.body
         }
         world.events.announce(Attached(world.time, object_name, robot_name, link_name))
         return AttachResult(True, "", distance)
@@ -176,9 +160,7 @@ class Attachments:
             return []
         static = self._static_names()
         supports = self._supports.get(object_name, set())
-        touching = {
-            pt[2] for pt in pb.getContactPoints(bodyA=held.object_body, physicsClientId=self.client)
-        }
+        touching = {c.body_b for c in pbq.contacts(self.client, held.object_body)}
         supports &= touching  # a support left once is a support no more
         return sorted(static[b] for b in touching if b in static and b not in supports)
 

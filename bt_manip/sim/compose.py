@@ -39,9 +39,10 @@ from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import line_of_text, read_bounded
 from bt_manip.sim.assets import resolve_uri
 from bt_manip.sim.mesh_check import mesh_problem
+from bt_manip.sim.yaml_lines import FieldReader
 
 if TYPE_CHECKING:
-    from bt_manip.sim.robot import RobotDescription
+    from bt_manip.sim.robot_description import RobotDescription
 
 COMPOSER_VERSION = 2
 """Bumped whenever the output of composition changes for the same inputs."""
@@ -102,9 +103,9 @@ def cache_dir() -> Path:
 def composed_urdf(description: RobotDescription | Recipe | Path | str) -> Path:
     """Path of the URDF that both PyBullet and Pinocchio load for this robot.
 
-    ``description`` is a :class:`~bt_manip.sim.robot.RobotDescription`, a :class:`Recipe` or a
-    URDF path. A plain URDF without meshes is returned as it is; otherwise the resolved or
-    composed file is written to :func:`cache_dir` once and its path returned.
+    ``description`` is a :class:`~bt_manip.sim.robot_description.RobotDescription`, a
+    :class:`Recipe` or a URDF path. A plain URDF without meshes is returned as it is; otherwise
+    the resolved or composed file is written to :func:`cache_dir` once and its path returned.
     """
     source = getattr(description, "urdf", description)
     if isinstance(source, Recipe):
@@ -330,7 +331,7 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
 
     Raises :class:`~bt_manip.errors.InputError` naming the file, line and key of each problem.
     """
-    problems: list[Problem] = []
+    reader = FieldReader(path)
 
     def line(d: object, key: str | int | None = None) -> int | None:
         if key is not None and hasattr(d, "line_of"):
@@ -338,18 +339,13 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
         return getattr(d, "line", None)
 
     def fail(where: object, key: str | int | None, message: str) -> None:
-        problems.append(Problem(str(path), line(where, key), message))
+        reader.fail(line(where, key), message)
 
     def vec3(d: dict, key: str, where: str) -> tuple[float, float, float]:
-        value = d.get(key, [0.0, 0.0, 0.0])
-        if not (
-            isinstance(value, list)
-            and len(value) == 3
-            and all(isinstance(v, int | float) and not isinstance(v, bool) for v in value)
-        ):
-            fail(d, key, f"{where}.{key} must be a list of 3 numbers, got {value!r}")
+        if key not in d:
             return (0.0, 0.0, 0.0)
-        return (float(value[0]), float(value[1]), float(value[2]))
+        value = reader.vector(d[key], 3, line(d, key), f"{where}.{key}")  # type: ignore[arg-type]
+        return (0.0, 0.0, 0.0) if value is None else (value[0], value[1], value[2])
 
     def table(d: dict, key: str, allowed: tuple[str, ...]) -> dict[str, dict[str, float]]:
         value = d.get(key) or {}
@@ -431,6 +427,6 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
         )
     limits = table(data, "joint_limits", LIMIT_KEYS)
     contacts = table(data, "contacts", CONTACT_KEYS)
-    if problems:
-        raise InputError(problems)
+    if reader.problems:
+        raise InputError(reader.problems)
     return Recipe(name, base, path.parent, tuple(attachments), limits, contacts)

@@ -1,31 +1,39 @@
-"""Robots: their descriptors (``robots/<name>.yaml``) and a handle to drive one in PyBullet.
-
-:class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
-which URDF (or composition recipe), the base (``skid_steer`` or ``fixed``), the arm joints in
-order, the gripper, the end-effector and grasp frames, named arm states and the footprint.
+"""A robot spawned in PyBullet, driven through the names of its descriptor.
 
 :class:`Robot` wraps one spawned multibody. Every call passes the PyBullet client id it was
 spawned with; nothing here touches a global client. Joints are position controlled within the
 velocity and effort limits of the descriptor, wheels are velocity controlled. ``stop_base()``
 followed by ``hold_arm()`` leaves the robot safe (wheels braked, arm holding where it is).
+
+The descriptor itself (schema, checks, lookup) is :mod:`bt_manip.sim.robot_description`; its
+names are re-exported here.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-import defusedxml.ElementTree as SafeET
 import numpy as np
 import pybullet as pb
 
 from bt_manip.errors import InputError
-from bt_manip.sim.assets import REPO_ROOT
-from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
-from bt_manip.sim.yaml_lines import LineDict, ProblemCollector, is_number, load_yaml, numbers_of
+from bt_manip.geometry import compose_poses, invert_pose, pose_matrix, quat_from_yaw, yaw_of
+from bt_manip.sim import pybullet_queries as pbq
+from bt_manip.sim.compose import composed_urdf
+from bt_manip.sim.pybullet_queries import JointInfo
+from bt_manip.sim.robot_description import (
+    ArmSpec,
+    BaseSpec,
+    Footprint,
+    GripperSpec,
+    RobotDescription,
+    find_descriptor,
+    known_robots,
+    load_description,
+)
 
 __all__ = [
     "ArmSpec",
@@ -36,426 +44,10 @@ __all__ = [
     "Robot",
     "RobotDescription",
     "composed_urdf",
+    "find_descriptor",
     "known_robots",
     "load_description",
 ]
-
-# -- descriptors --------------------------------------------------------------------------------
-ROBOTS_DIR = REPO_ROOT / "robots"
-BASE_TYPES = ("skid_steer", "fixed")
-TOP_KEYS = {
-    "name",
-    "urdf",
-    "spawn_height",
-    "base",
-    "arm",
-    "end_effector",
-    "grasp_frame",
-    "gripper",
-    "states",
-    "footprint",
-}
-BASE_KEYS = {
-    "type",
-    "left_wheels",
-    "right_wheels",
-    "wheel_radius",
-    "track_width",
-    "max_wheel_speed",
-    "wheel_max_torque",
-    "wheel_friction",
-    "wheel_spinning_friction",
-    "wheel_rolling_friction",
-    "wheel_axle_friction_scale",
-    "pivot_offset",
-}
-ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
-GRIPPER_KEYS = {
-    "joints",
-    "finger_links",
-    "open",
-    "closed",
-    "max_force",
-    "max_speed",
-    "pad_friction",
-}
-FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
-
-
-@dataclass(frozen=True)
-class BaseSpec:
-    """The mobile base: ``skid_steer`` (wheels left/right) or ``fixed`` (welded to the world)."""
-
-    type: str = "fixed"
-    left_wheels: tuple[str, ...] = ()
-    right_wheels: tuple[str, ...] = ()
-    wheel_radius: float = 0.0
-    track_width: float = 0.0
-    """Effective track width (m) for skid-steer kinematics: yaw rate = (vr - vl) / track."""
-    max_wheel_speed: float = 0.0
-    wheel_max_torque: float = 0.0
-    wheel_friction: float = 1.0
-    wheel_spinning_friction: float = 0.0
-    wheel_rolling_friction: float = 0.0
-    wheel_axle_friction_scale: float = 1.0
-    """Friction along the wheel axle relative to ``wheel_friction`` (< 1 lets a skid-steer turn)."""
-    pivot_offset: float = 0.0
-    """Where the base turns about when it turns on the spot (m ahead of its frame, measured)."""
-
-
-@dataclass(frozen=True)
-class ArmSpec:
-    """The arm: chain root, joints in order, their speed and effort limits and lower/upper."""
-
-    base_link: str
-    joints: tuple[str, ...]
-    velocity_limits: tuple[float, ...]
-    efforts: tuple[float | None, ...]
-    lower: tuple[float, ...] = ()
-    upper: tuple[float, ...] = ()
-    position_gain: float = 0.3
-
-
-@dataclass(frozen=True)
-class GripperSpec:
-    """Parallel gripper: finger joints (each = pad distance from the centre line, m)."""
-
-    joints: tuple[str, ...]
-    finger_links: tuple[str, ...]
-    open: float
-    closed: float
-    max_force: float
-    max_speed: float = 0.1
-    pad_friction: float = 1.5
-
-    @property
-    def max_opening(self) -> float:
-        """Distance between the pads when fully open (m)."""
-        return max(self.open, self.closed) * len(self.joints)
-
-    @property
-    def min_opening(self) -> float:
-        """Distance between the pads when closed on nothing (m)."""
-        return min(self.open, self.closed) * len(self.joints)
-
-
-@dataclass(frozen=True)
-class Footprint:
-    """Outline of the base for navigation: a rectangle (length x width) or a circle (radius).
-
-    The rectangle is centred ``x_offset`` ahead of the root link frame.
-    """
-
-    length: float = 0.0
-    width: float = 0.0
-    x_offset: float = 0.0
-    radius: float = 0.0
-
-    @property
-    def is_circle(self) -> bool:
-        return self.radius > 0.0
-
-    @property
-    def circumradius(self) -> float:
-        """Radius of the smallest circle around the root frame containing the footprint."""
-        if self.is_circle:
-            return self.radius
-        return math.hypot(abs(self.x_offset) + self.length / 2.0, self.width / 2.0)
-
-
-@dataclass(frozen=True)
-class RobotDescription:
-    """A checked robot descriptor (``robots/<name>.yaml``)."""
-
-    name: str
-    path: Path
-    urdf: Path | Recipe
-    base: BaseSpec
-    arm: ArmSpec
-    gripper: GripperSpec
-    end_effector: str
-    grasp_frame: str
-    states: dict[str, tuple[float, ...]]
-    footprint: Footprint
-    spawn_height: float = 0.0
-
-    @classmethod
-    def load(cls, name_or_path: str | Path) -> RobotDescription:
-        """Read ``robots/<name>.yaml`` (or a path to a descriptor) and check it.
-
-        Raises :class:`~bt_manip.errors.InputError` naming the file, line and key of every
-        problem, including names that do not exist in the robot's URDF.
-        """
-        return load_description(name_or_path)
-
-    def state(self, name: str) -> tuple[float, ...]:
-        """Arm joint positions of the named state (``home``, ``tuck``, ...)."""
-        try:
-            return self.states[name]
-        except KeyError:
-            raise KeyError(
-                f"{self.name} has no arm state '{name}'; states: {', '.join(self.states)}"
-            ) from None
-
-    @property
-    def urdf_path(self) -> Path:
-        """The URDF PyBullet and Pinocchio load (composed and cached if needed)."""
-        return composed_urdf(self)
-
-
-def find_description(name_or_path: str | Path) -> Path:
-    """Path of a descriptor given a robot name (``robots/<name>.yaml``) or a path."""
-    p = Path(name_or_path)
-    if p.suffix in (".yaml", ".yml") or p.is_file():
-        return p
-    return ROBOTS_DIR / f"{name_or_path}.yaml"
-
-
-def known_robots() -> list[str]:
-    """Names of the robot descriptors shipped in ``robots/``."""
-    return sorted(p.stem for p in ROBOTS_DIR.glob("*.yaml"))
-
-
-class _Fields(ProblemCollector):
-    """Typed field access on a YAML mapping that records problems with file and line."""
-
-    def section(self, d: LineDict, key: str, allowed: set[str], required: bool = True) -> LineDict:
-        value = d.get(key)
-        if value is None and not required:
-            return _empty(d.line_of(key))
-        if not isinstance(value, LineDict):
-            self.fail(d.line_of(key), f"'{key}' must be a mapping")
-            return _empty(d.line_of(key))
-        self.unknown_keys(value, allowed, key)
-        return value
-
-    def text(self, d: LineDict, key: str, where: str, default: str | None = None) -> str:
-        value = d.get(key, default)
-        if not isinstance(value, str) or not value:
-            self.fail(d.line_of(key), f"{where}.{key} must be a name (text)")
-            return ""
-        return value
-
-    def number(
-        self,
-        d: LineDict,
-        key: str,
-        where: str,
-        default: float | None = None,
-        minimum: float | None = None,
-        positive: bool = False,
-    ) -> float:
-        if key not in d and default is None:
-            self.fail(d.line, f"{where} is missing '{key}'")
-            return 0.0
-        value = d.get(key, default)
-        if not is_number(value):
-            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
-            return 0.0
-        if positive and value <= 0:
-            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
-        if minimum is not None and value < minimum:
-            self.fail(d.line_of(key), f"{where}.{key} must be >= {minimum}, got {value}")
-        return float(value)
-
-    def names(self, d: LineDict, key: str, where: str, required: bool = True) -> tuple[str, ...]:
-        value = d.get(key)
-        if value is None and not required:
-            return ()
-        if (
-            not isinstance(value, list)
-            or not value
-            or not all(isinstance(v, str) and v for v in value)
-        ):
-            self.fail(d.line_of(key), f"{where}.{key} must be a non-empty list of names")
-            return ()
-        return tuple(value)
-
-    def numbers(self, value: object, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        out = numbers_of(value, n)
-        if out is None:
-            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
-        return out
-
-
-def _empty(line: int) -> LineDict:
-    out = LineDict()
-    out.line = line
-    out.key_lines = {}
-    return out
-
-
-def load_description(name_or_path: str | Path) -> RobotDescription:
-    """Read and check a robot descriptor; see :meth:`RobotDescription.load`."""
-    path = find_description(name_or_path)
-    if not path.is_file():
-        known = ", ".join(known_robots()) or "none"
-        raise InputError.single(
-            str(path), None, f"no robot descriptor '{name_or_path}'; known robots: {known}"
-        )
-    data = load_yaml(path)
-    f = _Fields(path)
-    if not isinstance(data, LineDict):
-        raise InputError.single(str(path), 1, "a robot descriptor must be a YAML mapping")
-    f.unknown_keys(data, TOP_KEYS, "the descriptor")
-    name = f.text(data, "name", "descriptor", default=path.stem)
-    urdf = _parse_urdf_source(f, data, path)
-
-    b = f.section(data, "base", BASE_KEYS)
-    base_type = b.get("type", "fixed")
-    if base_type not in BASE_TYPES:
-        f.fail(
-            b.line_of("type"),
-            f"base.type must be one of {', '.join(BASE_TYPES)}, got {base_type!r}",
-        )
-    if base_type == "skid_steer":
-        base = BaseSpec(
-            "skid_steer",
-            f.names(b, "left_wheels", "base"),
-            f.names(b, "right_wheels", "base"),
-            f.number(b, "wheel_radius", "base", positive=True),
-            f.number(b, "track_width", "base", positive=True),
-            f.number(b, "max_wheel_speed", "base", positive=True),
-            f.number(b, "wheel_max_torque", "base", positive=True),
-            f.number(b, "wheel_friction", "base", 1.0, minimum=0.0),
-            f.number(b, "wheel_spinning_friction", "base", 0.0, minimum=0.0),
-            f.number(b, "wheel_rolling_friction", "base", 0.0, minimum=0.0),
-            f.number(b, "wheel_axle_friction_scale", "base", 1.0, positive=True),
-            f.number(b, "pivot_offset", "base", 0.0),
-        )
-    else:
-        base = BaseSpec("fixed")
-
-    a = f.section(data, "arm", ARM_KEYS)
-    joints = f.names(a, "joints", "arm")
-    vel = (
-        f.numbers(
-            a.get("velocity_limits"),
-            len(joints),
-            a.line_of("velocity_limits"),
-            "arm.velocity_limits",
-        )
-        or ()
-    )
-    if any(v <= 0 for v in vel):
-        f.fail(a.line_of("velocity_limits"), "arm.velocity_limits must all be > 0")
-    efforts: tuple[float | None, ...] = (None,) * len(joints)
-    if "efforts" in a:
-        efforts = f.numbers(a["efforts"], len(joints), a.line_of("efforts"), "arm.efforts") or ()
-    arm_base = f.text(a, "base_link", "arm")
-    gain = f.number(a, "position_gain", "arm", 0.3, positive=True)
-
-    g = f.section(data, "gripper", GRIPPER_KEYS)
-    gripper = GripperSpec(
-        f.names(g, "joints", "gripper"),
-        f.names(g, "finger_links", "gripper"),
-        f.number(g, "open", "gripper"),
-        f.number(g, "closed", "gripper"),
-        f.number(g, "max_force", "gripper", positive=True),
-        f.number(g, "max_speed", "gripper", 0.1, positive=True),
-        f.number(g, "pad_friction", "gripper", 1.5, minimum=0.0),
-    )
-
-    raw_states = data.get("states")
-    s = f.section(data, "states", set(raw_states) if isinstance(raw_states, dict) else set())
-    states: dict[str, tuple[float, ...]] = {}
-    for key in ("home", "tuck"):
-        if key not in s:
-            f.fail(s.line, f"states is missing '{key}' (arm positions in rad)")
-    for key, value in s.items():
-        q = f.numbers(value, len(joints), s.line_of(key), f"states.{key}")
-        if q is not None:
-            states[key] = q
-
-    fp = f.section(data, "footprint", FOOTPRINT_KEYS)
-    if "radius" in fp:
-        footprint = Footprint(radius=f.number(fp, "radius", "footprint", positive=True))
-    else:
-        footprint = Footprint(
-            f.number(fp, "length", "footprint", positive=True),
-            f.number(fp, "width", "footprint", positive=True),
-            f.number(fp, "x_offset", "footprint", 0.0),
-        )
-    end_effector = f.text(data, "end_effector", "descriptor")
-    grasp_frame = f.text(data, "grasp_frame", "descriptor")
-    spawn_height = f.number(data, "spawn_height", "descriptor", 0.0)
-    if f.problems:
-        raise InputError(f.problems)
-
-    desc = RobotDescription(
-        name,
-        path,
-        urdf,
-        base,
-        ArmSpec(arm_base, joints, vel, efforts, position_gain=gain),
-        gripper,
-        end_effector,
-        grasp_frame,
-        states,
-        footprint,
-        spawn_height,
-    )
-    return _check_against_urdf(desc, data, f)
-
-
-def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:
-    value = data.get("urdf")
-    if isinstance(value, str):
-        urdf = (path.parent / value).resolve()
-        if not urdf.is_file():
-            f.fail(data.line_of("urdf"), f"urdf: file '{value}' not found (at {urdf})")
-        return urdf
-    if isinstance(value, LineDict):
-        try:
-            return parse_recipe(value, path, data.get("name", path.stem))
-        except InputError as exc:
-            f.problems.extend(exc.problems)
-            return path
-    f.fail(data.line_of("urdf"), "urdf must be a file path or a composition recipe (mapping)")
-    return path
-
-
-def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> RobotDescription:
-    """Check every joint and link name of ``desc`` in its URDF; fill the arm's joint limits."""
-    root = SafeET.parse(str(composed_urdf(desc))).getroot()
-    links = {el.get("name") for el in root.findall("link")}
-    joints = {el.get("name"): el for el in root.findall("joint")}
-
-    def need(names: tuple[str, ...], kind: set | dict, section: str, key: str) -> None:
-        sec = data.get(section) if section else data
-        line = sec.line_of(key) if isinstance(sec, LineDict) else None
-        for n in names:
-            if n not in kind:
-                what = "joint" if kind is joints else "link"
-                f.fail(
-                    line, f"{section + '.' if section else ''}{key}: no {what} '{n}' in the URDF"
-                )
-
-    need(desc.base.left_wheels + desc.base.right_wheels, joints, "base", "left_wheels")
-    need(desc.arm.joints, joints, "arm", "joints")
-    need((desc.arm.base_link,), links, "arm", "base_link")
-    need(desc.gripper.joints, joints, "gripper", "joints")
-    need(desc.gripper.finger_links, links, "gripper", "finger_links")
-    need((desc.end_effector,), links, "", "end_effector")
-    need((desc.grasp_frame,), links, "", "grasp_frame")
-    if f.problems:
-        raise InputError(f.problems)
-    lower, upper = [], []
-    for n in desc.arm.joints:
-        limit = joints[n].find("limit")
-        lo = float(limit.get("lower", -math.inf)) if limit is not None else -math.inf
-        hi = float(limit.get("upper", math.inf)) if limit is not None else math.inf
-        lower.append(lo)
-        upper.append(hi)
-    states = data["states"]
-    for key, q in desc.states.items():
-        bad = [desc.arm.joints[i] for i, v in enumerate(q) if not lower[i] <= v <= upper[i]]
-        if bad:
-            f.fail(states.line_of(key), f"states.{key}: outside the joint limits of {bad}")
-    if f.problems:
-        raise InputError(f.problems)
-    arm = dataclasses.replace(desc.arm, lower=tuple(lower), upper=tuple(upper))
-    return dataclasses.replace(desc, arm=arm)
 
 
 @dataclass(frozen=True)
@@ -482,16 +74,16 @@ class Robot:
         self.description = description
         self._joints: dict[str, int] = {}
         self._links: dict[str, int] = {}
-        self._joint_info: dict[int, tuple] = {}
-        root = pb.getBodyInfo(body, physicsClientId=client)[0].decode()
-        dynamics = pb.getDynamicsInfo(body, -1, physicsClientId=client)
-        self._root_inertial = (dynamics[3], dynamics[4])
-        self._links[root] = -1
-        for j in range(pb.getNumJoints(body, physicsClientId=client)):
-            info = pb.getJointInfo(body, j, physicsClientId=client)
-            self._joints[info[1].decode()] = j
-            self._links[info[12].decode()] = j
-            self._joint_info[j] = info
+        self._joint_info: dict[int, JointInfo] = {}
+        dynamics = pbq.dynamics_info(client, body, -1)
+        self._root_inertial = (
+            dynamics.local_inertial_position, dynamics.local_inertial_orientation
+        )
+        self._links[pbq.root_link_name(client, body)] = -1
+        for info in pbq.joint_infos(client, body):
+            self._joints[info.name] = info.index
+            self._links[info.link_name] = info.index
+            self._joint_info[info.index] = info
         self.arm_joint_ids = [self.joint_index(n) for n in description.arm.joints]
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
@@ -500,11 +92,11 @@ class Robot:
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
         arm = description.arm
         self._arm_velocity = [
-            v if v is not None else float(self._joint_info[j][11])
+            v if v is not None else float(self._joint_info[j].max_velocity)
             for v, j in zip(arm.velocity_limits, self.arm_joint_ids, strict=True)
         ]
         self._arm_effort = [
-            e if e is not None else float(self._joint_info[j][10])
+            e if e is not None else float(self._joint_info[j].max_force)
             for e, j in zip(arm.efforts, self.arm_joint_ids, strict=True)
         ]
         self._gripper_target = self.gripper_opening()
@@ -535,7 +127,7 @@ class Robot:
             body = pb.loadURDF(
                 str(path),
                 basePosition=(x, y, z),
-                baseOrientation=pb.getQuaternionFromEuler((0.0, 0.0, yaw)),
+                baseOrientation=quat_from_yaw(yaw),
                 useFixedBase=description.base.type == "fixed",
                 flags=flags,
                 physicsClientId=client,
@@ -557,7 +149,7 @@ class Robot:
     def _apply_friction(self) -> None:
         base = self.description.base
         for j in self.wheel_ids_left + self.wheel_ids_right:
-            axle = np.abs(np.asarray(self._joint_info[j][13], dtype=float))
+            axle = np.abs(np.asarray(self._joint_info[j].axis, dtype=float))
             anisotropic = 1.0 - (1.0 - base.wheel_axle_friction_scale) * axle
             pb.changeDynamics(
                 self.body,
@@ -618,21 +210,13 @@ class Robot:
 
     def joint_index(self, name: str) -> int:
         """PyBullet joint index of the joint called ``name`` (KeyError names the choices)."""
-        try:
-            return self._joints[name]
-        except KeyError:
-            raise KeyError(
-                f"{self.name} has no joint '{name}'; joints: {', '.join(self._joints)}"
-            ) from None
+        return self._index(self._joints, name, "joint")
 
     def arm_link_ids(self) -> list[int]:
         """PyBullet indices of the links the arm moves: the first arm joint's child link and
         everything below it (gripper included)."""
         if self._arm_links is None:
-            n = pb.getNumJoints(self.body, physicsClientId=self.client)
-            parents = {
-                j: pb.getJointInfo(self.body, j, physicsClientId=self.client)[16] for j in range(n)
-            }
+            parents = {j: info.parent_index for j, info in self._joint_info.items()}
             links = {self.joint_index(self.description.arm.joints[0])}
             grew = True
             while grew:
@@ -646,11 +230,14 @@ class Robot:
 
     def link_index(self, name: str) -> int:
         """PyBullet link index of the URDF link ``name`` (-1 for the root link)."""
+        return self._index(self._links, name, "link")
+
+    def _index(self, table: dict[str, int], name: str, what: str) -> int:
         try:
-            return self._links[name]
+            return table[name]
         except KeyError:
             raise KeyError(
-                f"{self.name} has no link '{name}'; links: {', '.join(self._links)}"
+                f"{self.name} has no {what} '{name}'; {what}s: {', '.join(table)}"
             ) from None
 
     def link_name(self, index: int) -> str:
@@ -667,30 +254,22 @@ class Robot:
         if index == -1:
             pos, quat = self._root_pose()
             return np.array(pos), np.array(quat)
-        state = pb.getLinkState(
-            self.body, index, computeForwardKinematics=1, physicsClientId=self.client
-        )
-        return np.array(state[4]), np.array(state[5])
+        state = pbq.link_state(self.client, self.body, index)
+        return np.array(state.frame_position), np.array(state.frame_orientation)
 
     def link_transform(self, name: str) -> np.ndarray:
         """World pose of URDF link ``name`` as a 4x4 homogeneous matrix."""
-        pos, quat = self.link_pose(name)
-        out = np.eye(4)
-        out[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
-        out[:3, 3] = pos
-        return out
+        return pose_matrix(*self.link_pose(name))
 
     def _root_pose(self) -> tuple[tuple[float, ...], tuple[float, ...]]:
         """URDF frame of the root link (PyBullet reports the root's centre-of-mass frame)."""
         com_pos, com_quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
-        inv_pos, inv_quat = pb.invertTransform(self._root_inertial[0], self._root_inertial[1])
-        return pb.multiplyTransforms(com_pos, com_quat, inv_pos, inv_quat)
+        return compose_poses((com_pos, com_quat), invert_pose(self._root_inertial))
 
     def base_pose2d(self) -> tuple[float, float, float]:
         """Planar pose (x, y, yaw) of the root link frame in the world."""
         pos, quat = self._root_pose()
-        yaw = pb.getEulerFromQuaternion(quat)[2]
-        return float(pos[0]), float(pos[1]), float(yaw)
+        return float(pos[0]), float(pos[1]), yaw_of(quat)
 
     def base_velocity(self) -> tuple[float, float, float]:
         """Forward and sideways speed (m/s, in the base heading frame) and yaw rate (rad/s)."""
@@ -701,8 +280,8 @@ class Robot:
 
     # -- arm ----------------------------------------------------------------------------------
     def _positions(self, ids: Sequence[int]) -> np.ndarray:
-        states = pb.getJointStates(self.body, list(ids), physicsClientId=self.client)
-        return np.array([s[0] for s in states])
+        states = pbq.joint_states(self.client, self.body, list(ids))
+        return np.array([s.position for s in states])
 
     def arm_positions(self) -> np.ndarray:
         """Arm joint positions (rad) in descriptor order."""
@@ -710,8 +289,8 @@ class Robot:
 
     def arm_velocities(self) -> np.ndarray:
         """Arm joint velocities (rad/s) in descriptor order."""
-        states = pb.getJointStates(self.body, self.arm_joint_ids, physicsClientId=self.client)
-        return np.array([s[1] for s in states])
+        states = pbq.joint_states(self.client, self.body, self.arm_joint_ids)
+        return np.array([s.velocity for s in states])
 
     def set_arm_targets(
         self, q: Sequence[float], max_velocity: float | Sequence[float] | None = None
@@ -805,15 +384,20 @@ class Robot:
         self, other_body: int | None = None, links: Sequence[int] | None = None
     ) -> list[ContactPoint]:
         """Contacts of this robot's links (all, or ``links``) with ``other_body`` (or any body)."""
-        kwargs = {"bodyA": self.body, "physicsClientId": self.client}
-        if other_body is not None:
-            kwargs["bodyB"] = other_body
         wanted = None if links is None else set(links)
         out = []
-        for c in pb.getContactPoints(**kwargs):
-            if c[2] == self.body or (wanted is not None and c[3] not in wanted):
+        for c in pbq.contacts(self.client, self.body, other_body):
+            if c.body_b == self.body or (wanted is not None and c.link_a not in wanted):
                 continue
-            out.append(ContactPoint(self.link_name(c[3]), c[2], c[4], tuple(c[5]), float(c[9])))
+            out.append(
+                ContactPoint(
+                    self.link_name(c.link_a),
+                    c.body_b,
+                    c.link_b,
+                    tuple(c.position_on_a),
+                    float(c.normal_force),
+                )
+            )
         return out
 
     def finger_contacts(self, other_body: int | None = None) -> list[ContactPoint]:

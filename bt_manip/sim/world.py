@@ -24,6 +24,8 @@ import pybullet as pb
 
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError, Problem
+from bt_manip.geometry import euler_from_quat, quat_from_euler, quat_from_yaw, rotation_matrix
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.attach import Attachments
 from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
 from bt_manip.sim.world_spec import (
@@ -181,7 +183,7 @@ class World:
             pos = door.at + door.width / 2
         if length > pos + 1e-6:
             stretches.append((pos, length))
-        quat = pb.getQuaternionFromEuler((0, 0, yaw))
+        quat = quat_from_yaw(yaw)
         halves = [[(b - a) / 2, wall.thickness / 2, wall.height / 2] for a, b in stretches]
         # frames are relative to the wall's start point, along the wall's axis
         frames = [[(a + b) / 2, 0.0, wall.height / 2] for a, b in stretches]
@@ -217,7 +219,7 @@ class World:
         else:
             body = self._make_compound(spec, pos, quat)
         if spec.movable:
-            for link in range(-1, pb.getNumJoints(body, physicsClientId=c)):
+            for link in range(-1, pbq.joint_count(c, body)):
                 pb.changeDynamics(body, link, lateralFriction=spec.friction, physicsClientId=c)
         return body
 
@@ -225,10 +227,10 @@ class World:
         self, spec: BodySpec, offset: tuple[float, float, float]
     ) -> tuple[list[float], list[float]]:
         x, y, z = spec.pose.xyz
-        yaw0 = pb.getEulerFromQuaternion(spec.pose.quat)
+        yaw0 = euler_from_quat(spec.pose.quat)
         quat = list(spec.pose.quat)
         if offset[2] != 0.0:
-            quat = list(pb.getQuaternionFromEuler((yaw0[0], yaw0[1], yaw0[2] + offset[2])))
+            quat = list(quat_from_euler((yaw0[0], yaw0[1], yaw0[2] + offset[2])))
         if spec.planar and spec.parts:
             z = -min(p.bottom() for p in spec.parts) * spec.scale
         return [x + offset[0], y + offset[1], z], quat
@@ -265,7 +267,7 @@ class World:
             halves = [_half(p) for p in parts]
             lengths = [p.size[2] for p in parts]
             frames = [list(np.subtract(p.xyz, com)) for p in parts]
-            orns = [list(pb.getQuaternionFromEuler(p.rpy)) for p in parts]
+            orns = [list(quat_from_euler(p.rpy)) for p in parts]
             shapes = {
                 "radii": radii,
                 "halfExtents": halves,
@@ -279,7 +281,7 @@ class World:
                 types, visualFramePositions=frames, visualFrameOrientations=orns, **shapes
             )
         # the body frame sits at the centre of mass; shift the spawn point to match
-        rot = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
+        rot = rotation_matrix(quat)
         base = np.asarray(pos) + rot @ com
         body = pb.createMultiBody(spec.mass, col, vis, list(base), quat, physicsClientId=c)
         pb.changeVisualShape(body, -1, rgbaColor=spec.colour, physicsClientId=c)
@@ -305,8 +307,8 @@ class World:
 
     def _penetration(self, a: int, b: int) -> float:
         """Signed distance (m) between two bodies where they touch; negative when overlapping."""
-        pts = pb.getClosestPoints(a, b, 0.0, physicsClientId=self.client)
-        return min((p[8] for p in pts), default=0.0)
+        pts = pbq.closest_points(self.client, a, b, 0.0)
+        return min((p.distance for p in pts), default=0.0)
 
     def _overlaps(self) -> list[Problem]:
         """Movable objects and robots must not start inside anything else."""
@@ -440,8 +442,8 @@ class World:
             pos, quat = pb.getBasePositionAndOrientation(b, physicsClientId=c)
             lin, ang = pb.getBaseVelocity(b, physicsClientId=c)
             joints = [
-                pb.getJointState(b, j, physicsClientId=c)[:2]
-                for j in range(pb.getNumJoints(b, physicsClientId=c))
+                (s.position, s.velocity)
+                for s in pbq.joint_states(c, b, list(range(pbq.joint_count(c, b))))
             ]
             out[info.name] = {"pos": pos, "quat": quat, "lin": lin, "ang": ang, "joints": joints}
         return out

@@ -25,14 +25,9 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 from bt_manip.errors import InputError
-from bt_manip.sim.yaml_lines import (
-    LineDict,
-    LineList,
-    ProblemCollector,
-    is_number,
-    load_yaml,
-    numbers_of,
-)
+from bt_manip.geometry import quat_from_euler, quat_from_yaw
+from bt_manip.sim.robot_description import find_descriptor, known_robots
+from bt_manip.sim.yaml_lines import FieldReader, LineDict, LineList, load_yaml
 
 COLOURS: dict[str, tuple[float, float, float, float]] = {
     "white": (0.95, 0.95, 0.95, 1.0),
@@ -195,59 +190,8 @@ ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize"}
 RANDOM_KEYS = {"x", "y", "yaw"}
 
 
-class _Reader(ProblemCollector):
+class _Reader(FieldReader):
     """Walks the YAML tree, converting values and collecting problems."""
-
-    # -- generic checks ---------------------------------------------------------------
-    def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
-        if isinstance(value, LineDict):
-            return value
-        self.fail(line, f"{where} must be a mapping, got {type(value).__name__}")
-        return None
-
-    def seq(self, value: Any, line: int, where: str) -> LineList | None:
-        if value is None:
-            return LineList()
-        if isinstance(value, LineList):
-            return value
-        self.fail(line, f"{where} must be a list, got {type(value).__name__}")
-        return None
-
-    def number(
-        self,
-        d: LineDict,
-        key: str,
-        where: str,
-        default: float | None = None,
-        positive: bool = False,
-        non_negative: bool = False,
-        within: tuple[float, float] | None = None,
-    ) -> float | None:
-        if key not in d:
-            if default is None:
-                self.fail(d.line, f"{where} is missing '{key}'")
-            return default
-        value = d[key]
-        if not is_number(value):
-            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
-            return default
-        if positive and value <= 0:
-            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
-            return default
-        if non_negative and value < 0:
-            self.fail(d.line_of(key), f"{where}.{key} must be >= 0, got {value}")
-            return default
-        if within is not None and not within[0] <= value <= within[1]:
-            self.fail(d.line_of(key),
-                      f"{where}.{key} must be within {within[0]:g}..{within[1]:g}, got {value}")
-            return default
-        return float(value)
-
-    def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
-        out = numbers_of(value, n)
-        if out is None:
-            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
-        return out
 
     def colour(
         self, d: LineDict, where: str, default: tuple[float, float, float, float]
@@ -316,13 +260,11 @@ class _Reader(ProblemCollector):
 
     def body_pose(self, value: Any, line: int, where: str) -> tuple[Pose3D, bool] | None:
         """``[x, y, yaw]`` (rests on the floor) or ``{xyz: [...], rpy|quat: [...]}``."""
-        import pybullet as pb
-
         if isinstance(value, list) or (isinstance(value, LineDict) and "xyz" not in value):
             p2 = self.pose2d(value, line, where)
             if p2 is None:
                 return None
-            return Pose3D((p2.x, p2.y, 0.0), tuple(pb.getQuaternionFromEuler((0, 0, p2.yaw)))), True
+            return Pose3D((p2.x, p2.y, 0.0), quat_from_yaw(p2.yaw)), True
         if isinstance(value, LineDict):
             self.unknown_keys(value, {"xyz", "rpy", "quat"}, where)
             xyz = self.vector(value["xyz"], 3, value.line_of("xyz"), f"{where}.xyz")
@@ -332,7 +274,7 @@ class _Reader(ProblemCollector):
             quat: tuple[float, ...] | None = (0.0, 0.0, 0.0, 1.0)
             if "rpy" in value:
                 rpy = self.vector(value["rpy"], 3, value.line_of("rpy"), f"{where}.rpy")
-                quat = tuple(pb.getQuaternionFromEuler(rpy)) if rpy else None
+                quat = quat_from_euler(rpy) if rpy else None
             elif "quat" in value:
                 quat = self.vector(value["quat"], 4, value.line_of("quat"), f"{where}.quat")
                 if quat is not None:
@@ -410,12 +352,7 @@ class _Reader(ProblemCollector):
 
 def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
     out: list[WallSpec] = []
-    for i, raw in enumerate(walls):
-        where = f"walls[{i}]"
-        d = rd.mapping(raw, walls.line_of(i), where)
-        if d is None:
-            continue
-        rd.unknown_keys(d, WALL_KEYS, where)
+    for i, where, d in rd.entries(walls, "walls", WALL_KEYS):
         start = rd.vector(d.get("from"), 2, d.line_of("from"), f"{where}.from ([x, y])")
         end = rd.vector(d.get("to"), 2, d.line_of("to"), f"{where}.to ([x, y])")
         thickness = rd.number(d, "thickness", where, default=0.12, positive=True)
@@ -430,12 +367,7 @@ def _parse_walls(rd: _Reader, walls: LineList) -> list[WallSpec]:
             continue
         doors: list[DoorSpec] = []
         door_list = rd.seq(d.get("doors"), d.line_of("doors"), f"{where}.doors")
-        for j, rawd in enumerate(door_list or []):
-            dw = f"{where}.doors[{j}]"
-            dd = rd.mapping(rawd, door_list.line_of(j), dw)  # type: ignore[union-attr]
-            if dd is None:
-                continue
-            rd.unknown_keys(dd, DOOR_KEYS, dw)
+        for _, dw, dd in rd.entries(door_list, f"{where}.doors", DOOR_KEYS):
             at = rd.number(dd, "at", dw)
             width = rd.number(dd, "width", dw, positive=True)
             if at is None or width is None:
@@ -480,12 +412,7 @@ def _parse_body(rd: _Reader, d: LineDict, where: str, movable: bool, base: Path)
         if not plist:
             rd.fail(d.line_of("parts"), f"{where}.parts must list at least one part")
             return None
-        for j, rawp in enumerate(plist):
-            pw = f"{where}.parts[{j}]"
-            pd = rd.mapping(rawp, plist.line_of(j), pw)
-            if pd is None:
-                continue
-            rd.unknown_keys(pd, PART_KEYS, pw)
+        for _, pw, pd in rd.entries(plist, f"{where}.parts", PART_KEYS):
             part = rd.shape(pd, pw, rd.colour(pd, pw, colour), with_offset=True)
             if part is not None:
                 parts.append(part)
@@ -555,51 +482,23 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
     return out
 
 
-def _find_robot(name: str, world_dir: Path) -> Path | None:
-    from bt_manip.sim.assets import REPO_ROOT
-
-    as_path = (world_dir / name) if not Path(name).is_absolute() else Path(name)
-    if name.endswith((".yaml", ".yml")) and as_path.is_file():
-        return as_path.resolve()
-    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
-        candidate = folder / f"{name}.yaml"
-        if candidate.is_file():
-            return candidate.resolve()
-    return None
-
-
-def _known_robots(world_dir: Path) -> list[str]:
-    from bt_manip.sim.assets import REPO_ROOT
-
-    names: set[str] = set()
-    for folder in (world_dir / "robots", world_dir.parent / "robots", REPO_ROOT / "robots"):
-        if folder.is_dir():
-            names.update(p.stem for p in folder.glob("*.yaml"))
-    return sorted(names)
-
-
 def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
     out: list[RobotSpec] = []
-    for i, raw in enumerate(robots):
-        where = f"robots[{i}]"
-        d = rd.mapping(raw, robots.line_of(i), where)
-        if d is None:
-            continue
-        rd.unknown_keys(d, ROBOT_KEYS, where)
+    for _, where, d in rd.entries(robots, "robots", ROBOT_KEYS):
         name = rd.name(d, where)
         desc = d.get("description")
         if not isinstance(desc, str):
             rd.fail(
                 d.line_of("description"),
                 f"{where} ('{name}') needs 'description': a robot "
-                f"name such as {', '.join(_known_robots(base)) or 'husky_ur3'}",
+                f"name such as {', '.join(known_robots(base)) or 'husky_ur3'}",
             )
             continue
-        desc_path = _find_robot(desc, base)
+        desc_path = find_descriptor(desc, base)
         if desc_path is None:
             import difflib
 
-            known = _known_robots(base)
+            known = known_robots(base)
             close = difflib.get_close_matches(desc, known, n=1)
             hint = (
                 f"did you mean '{close[0]}'?" if close else f"known: {', '.join(known) or 'none'}"
@@ -661,12 +560,10 @@ def parse_world(path: str | Path) -> WorldSpec:
     lists = {"furniture": spec.furniture, "objects": spec.objects, "models": spec.models}
     for key, target in lists.items():
         items = rd.seq(data.get(key), data.line_of(key), key)
-        for i, raw in enumerate(items or []):
-            d = rd.mapping(raw, items.line_of(i), f"{key}[{i}]")  # type: ignore[union-attr]
-            if d is not None:
-                body = _parse_body(rd, d, f"{key}[{i}]", key != "furniture", base)
-                if body is not None:
-                    target.append(body)
+        for _, where, d in rd.entries(items, key):
+            body = _parse_body(rd, d, where, key != "furniture", base)
+            if body is not None:
+                target.append(body)
     robots = rd.seq(data.get("robots"), data.line_of("robots"), "robots")
     spec.robots = _parse_robots(rd, robots, base) if robots else []
     if "poses" in data:

@@ -10,6 +10,7 @@ that knows the line of each item).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -197,3 +198,109 @@ class ProblemCollector:
                     else f"; allowed: {', '.join(sorted(allowed))}"
                 )
                 self.fail(d.line_of(key), f"unknown key '{key}' in {where}{hint}")
+
+
+class FieldReader(ProblemCollector):
+    """Typed readers of the fields of YAML input files (worlds, robot descriptors).
+
+    Each reader converts one value and records a problem with the file and line when the value
+    does not fit; the caller keeps going so that one run reports every problem of a file.
+    """
+
+    def mapping(self, value: Any, line: int, where: str) -> LineDict | None:
+        """``value`` if it is a mapping, else None (and a problem)."""
+        if isinstance(value, LineDict):
+            return value
+        self.fail(line, f"{where} must be a mapping, got {type(value).__name__}")
+        return None
+
+    def seq(self, value: Any, line: int, where: str) -> LineList | None:
+        """``value`` if it is a list (absent = empty), else None (and a problem)."""
+        if value is None:
+            return LineList()
+        if isinstance(value, LineList):
+            return value
+        self.fail(line, f"{where} must be a list, got {type(value).__name__}")
+        return None
+
+    def entries(
+        self, items: LineList | None, where: str, allowed: set[str] | None = None
+    ) -> Iterator[tuple[int, str, LineDict]]:
+        """Index, place (``where[i]``) and mapping of each item of a list that is a mapping
+        (each other item is a problem); with ``allowed``, unknown keys are problems too."""
+        for i, raw in enumerate(items or []):
+            here = f"{where}[{i}]"
+            d = self.mapping(raw, items.line_of(i), here)  # type: ignore[union-attr]
+            if d is None:
+                continue
+            if allowed is not None:
+                self.unknown_keys(d, allowed, here)
+            yield i, here, d
+
+    def number(
+        self,
+        d: LineDict,
+        key: str,
+        where: str,
+        default: float | None = None,
+        positive: bool = False,
+        non_negative: bool = False,
+        minimum: float | None = None,
+        within: tuple[float, float] | None = None,
+    ) -> float | None:
+        """``d[key]`` as a finite float; ``default`` when absent (required when None).
+
+        A value out of its bounds (``positive``: > 0, ``non_negative``: >= 0, ``minimum``,
+        ``within``: inclusive range) is a problem and gives ``default``.
+        """
+        if key not in d:
+            if default is None:
+                self.fail(d.line, f"{where} is missing '{key}'")
+            return default
+        value = d[key]
+        if not is_number(value):
+            self.fail(d.line_of(key), f"{where}.{key} must be a number, got {value!r}")
+            return default
+        if positive and value <= 0:
+            self.fail(d.line_of(key), f"{where}.{key} must be > 0, got {value}")
+            return default
+        if non_negative and value < 0:
+            self.fail(d.line_of(key), f"{where}.{key} must be >= 0, got {value}")
+            return default
+        if minimum is not None and value < minimum:
+            self.fail(d.line_of(key), f"{where}.{key} must be >= {minimum}, got {value}")
+            return default
+        if within is not None and not within[0] <= value <= within[1]:
+            self.fail(d.line_of(key),
+                      f"{where}.{key} must be within {within[0]:g}..{within[1]:g}, got {value}")
+            return default
+        return float(value)
+
+    def vector(self, value: Any, n: int, line: int, where: str) -> tuple[float, ...] | None:
+        """``value`` as ``n`` floats if it is a list of ``n`` finite numbers, else None."""
+        out = numbers_of(value, n)
+        if out is None:
+            self.fail(line, f"{where} must be a list of {n} numbers, got {value!r}")
+        return out
+
+    def text(self, d: LineDict, key: str, where: str, default: str | None = None) -> str:
+        """``d[key]`` as a non-empty text ("" and a problem otherwise)."""
+        value = d.get(key, default)
+        if not isinstance(value, str) or not value:
+            self.fail(d.line_of(key), f"{where}.{key} must be a name (text)")
+            return ""
+        return value
+
+    def names(self, d: LineDict, key: str, where: str, required: bool = True) -> tuple[str, ...]:
+        """``d[key]`` as a non-empty list of names (``()`` when absent and not ``required``)."""
+        value = d.get(key)
+        if value is None and not required:
+            return ()
+        if (
+            not isinstance(value, list)
+            or not value
+            or not all(isinstance(v, str) and v for v in value)
+        ):
+            self.fail(d.line_of(key), f"{where}.{key} must be a non-empty list of names")
+            return ()
+        return tuple(value)

@@ -18,8 +18,9 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-import pybullet as pb
 
+from bt_manip.geometry import yaw_of
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.viz.scene import ROOT
 
 DISTANCE = 3.0
@@ -85,17 +86,17 @@ def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int
     for _ in range(4):  # look past up to three bodies that are not blockers
         if not todo:
             break
-        hits = pb.rayTestBatch(origin[todo].tolist(), ends[todo].tolist(), physicsClientId=c)
+        hits = pbq.ray_hits(c, origin[todo].tolist(), ends[todo].tolist())
         again = []
         for k, hit in zip(todo, hits, strict=True):
-            body = hit[0]
+            body = hit.body
             if body < 0:
                 continue
             if body in blockers:
                 out[k] = True
                 continue
             direction = ends[k] - starts[k]
-            origin[k] = np.asarray(hit[3]) + 1e-3 * direction / np.linalg.norm(direction)
+            origin[k] = np.asarray(hit.position) + 1e-3 * direction / np.linalg.norm(direction)
             again.append(k)
         todo = again
     return out
@@ -104,8 +105,7 @@ def _blocked(world: Any, starts: np.ndarray, ends: np.ndarray, blockers: set[int
 def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box around every link of a body."""
     boxes = [
-        pb.getAABB(body, link, physicsClientId=client)
-        for link in range(-1, pb.getNumJoints(body, physicsClientId=client))
+        pbq.aabb(client, body, link) for link in range(-1, pbq.joint_count(client, body))
     ]
     return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
 
@@ -210,7 +210,7 @@ def replay_camera(world: Any, rec: Any) -> dict[str, Any]:
     picks = sorted({0, n - 1, *np.linspace(0, n - 1, MIDDLE_FRAMES).round().astype(int)})
     weights = [END_WEIGHT if k in (0, n - 1) else 1 for k in picks]
     q = samples[0][3:7]
-    yaw = math.atan2(2 * (q[3] * q[2] + q[0] * q[1]), 1 - 2 * (q[1] ** 2 + q[2] ** 2))
-    offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], float(yaw), weights)
+    yaw = yaw_of(q)
+    offset = clear_offset(world, robot.body, [samples[k][:2] for k in picks], yaw, weights)
     target = (float(samples[0][0]), float(samples[0][1]), look_height(world, robot.body))
     return CameraView(target, offset, path).to_json()

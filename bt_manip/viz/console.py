@@ -12,20 +12,20 @@ import sys
 import time
 from typing import Any, TextIO
 
-from bt_manip.runner import NodeRecord, Runner, node_records
+from bt_manip.runner import NodeReport, Runner, node_reports
 
 
-def _records(tree: Any) -> list[NodeRecord]:
+def _records(tree: Any) -> list[NodeReport]:
     fn = getattr(tree, "node_records", None)
     if callable(fn):
         return [
-            NodeRecord(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
+            NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
             for r in fn()
         ]
-    return node_records(tree.root)
+    return node_reports(tree.root)
 
 
-def _shown(rec: NodeRecord) -> str:
+def _shown(rec: NodeReport) -> str:
     """RUNNING while running; once finished, what the node returned (not IDLE)."""
     if rec.status == "IDLE" and rec.last_status:
         return rec.last_status

@@ -29,7 +29,7 @@ from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
-from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, pose_matrix
+from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, row_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
 from bt_manip.viz.tree_state import FAILURE, TreeWatcher, run_result
 
@@ -239,7 +239,7 @@ class LiveViewer:
                     continue
                 self._sent[path] = row
                 commands.append({"type": "set_transform", "path": path,
-                                 "matrix": column_major(pose_matrix(row))})
+                                 "matrix": column_major(row_matrix(row))})
         link.send_many(commands)
 
     def _send_overlay(self) -> None:

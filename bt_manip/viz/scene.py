@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 import pybullet as pb
 
+from bt_manip.geometry import inverse_matrix, matrix_row, pose_matrix, row_matrix
+from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.viz.urdf_visuals import Visual, read_visuals
 
 ROOT = "/meshcat/bt_manip"
@@ -94,15 +96,14 @@ class SceneBody:
         if body is None:
             return out
         pos, quat = pb.getBasePositionAndOrientation(body.body_id, physicsClientId=client)
-        base = _matrix(pos, quat) @ body.base_offset
-        out[0] = _pose_row(base)
+        base = pose_matrix(pos, quat) @ body.base_offset
+        out[0] = matrix_row(base)
         if body.link_ids:
-            states = pb.getLinkStates(
-                body.body_id, body.link_ids, computeForwardKinematics=1, physicsClientId=client
-            )
-            inv = _inverse(base)
+            states = pbq.link_states(client, body.body_id, body.link_ids)
+            inv = inverse_matrix(base)
             for k, state in enumerate(states):
-                out[1 + k] = _pose_row(inv @ _matrix(state[4], state[5]))
+                link = pose_matrix(state.frame_position, state.frame_orientation)
+                out[1 + k] = matrix_row(inv @ link)
         return out
 
 
@@ -194,50 +195,6 @@ def lowered(obj: SceneObject, mesh_data: dict[Path, bytes]) -> dict[str, Any]:
     else:
         json["geometries"] = [{**json["geometries"][0], "data": content}]
     return json
-
-
-def _matrix(pos: Any, quat: Any) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = np.array(pb.getMatrixFromQuaternion(quat)).reshape(3, 3)
-    out[:3, 3] = pos
-    return out
-
-
-def _inverse(t: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = t[:3, :3].T
-    out[:3, 3] = -t[:3, :3].T @ t[:3, 3]
-    return out
-
-
-def quat_from_matrix(r: np.ndarray) -> np.ndarray:
-    """Unit quaternion (x, y, z, w) of a rotation matrix, w >= 0."""
-    m = r
-    trace = m[0, 0] + m[1, 1] + m[2, 2]
-    if trace > 0:
-        s = 2.0 * np.sqrt(trace + 1.0)
-        q = [(m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s, s / 4]
-    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-        q = [s / 4, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s, (m[2, 1] - m[1, 2]) / s]
-    elif m[1, 1] > m[2, 2]:
-        s = 2.0 * np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-        q = [(m[0, 1] + m[1, 0]) / s, s / 4, (m[1, 2] + m[2, 1]) / s, (m[0, 2] - m[2, 0]) / s]
-    else:
-        s = 2.0 * np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-        q = [(m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, s / 4, (m[1, 0] - m[0, 1]) / s]
-    quat = np.array(q)
-    quat /= np.linalg.norm(quat)
-    return -quat if quat[3] < 0 else quat
-
-
-def _pose_row(t: np.ndarray) -> np.ndarray:
-    return np.concatenate([t[:3, 3], quat_from_matrix(t[:3, :3])])
-
-
-def pose_matrix(row: np.ndarray) -> np.ndarray:
-    """The 4x4 transform of a pose row (x, y, z, qx, qy, qz, qw)."""
-    return _matrix(row[:3], row[3:7])
 
 
 def colour_int(rgba: tuple[float, ...]) -> int:
@@ -363,12 +320,12 @@ def _urdf_of(info: Any, world: Any) -> Path | None:
 def _add_urdf_body(
     body: SceneBody, c: int, body_id: int, urdf: Path, scale: float, movable: bool
 ) -> None:
-    root_link = pb.getBodyInfo(body_id, physicsClientId=c)[0].decode()
-    links = {root_link: -1}
-    for j in range(pb.getNumJoints(body_id, physicsClientId=c)):
-        links[pb.getJointInfo(body_id, j, physicsClientId=c)[12].decode()] = j
-    dyn = pb.getDynamicsInfo(body_id, -1, physicsClientId=c)
-    base_offset = _inverse(_matrix(dyn[3], dyn[4]))
+    links = {pbq.root_link_name(c, body_id): -1}
+    for joint in pbq.joint_infos(c, body_id):
+        links[joint.link_name] = joint.index
+    dyn = pbq.dynamics_info(c, body_id, -1)
+    inertial = pose_matrix(dyn.local_inertial_position, dyn.local_inertial_orientation)
+    base_offset = inverse_matrix(inertial)
     visuals = [v for v in read_visuals(urdf) if v.link in links]
     drawn_links = sorted({links[v.link] for v in visuals if links[v.link] >= 0})
     counts: dict[str, int] = {}
@@ -384,7 +341,7 @@ def _add_urdf_body(
     if not movable:
         # fixed bodies: read once, then place statically
         rows = body.read_poses(c)
-        body.static = [(p, pose_matrix(r)) for p, r in zip(body.tracks, rows, strict=True)]
+        body.static = [(p, row_matrix(r)) for p, r in zip(body.tracks, rows, strict=True)]
         body.tracks = []
         body.frames = None
 
@@ -393,10 +350,10 @@ def _add_primitive_body(body: SceneBody, c: int, info: Any, movable: bool) -> No
     spec = info.spec
     parts = list(getattr(spec, "parts", None) or [])
     default_rgba = tuple(getattr(spec, "colour", None) or DEFAULT_RGBA)
-    shapes = pb.getVisualShapeData(info.body_id, physicsClientId=c)
-    for k, shape in enumerate(s for s in shapes if s[1] == -1):
-        geom_type, dims = shape[2], shape[3]
-        local = _matrix(shape[5], shape[6])
+    shapes = pbq.visual_shapes(c, info.body_id)
+    for k, shape in enumerate(s for s in shapes if s.link == -1):
+        geom_type, dims = shape.geometry_type, shape.dimensions
+        local = pose_matrix(shape.local_position, shape.local_orientation)
         part_rgba = parts[k].colour if k < len(parts) and parts[k].colour else None
         rgba = tuple(part_rgba or default_rgba)
         if geom_type == pb.GEOM_BOX:
@@ -417,4 +374,4 @@ def _add_primitive_body(body: SceneBody, c: int, info: Any, movable: bool) -> No
         body.tracks = [body.path]
     else:
         pos, quat = pb.getBasePositionAndOrientation(info.body_id, physicsClientId=c)
-        body.static = [(body.path, _matrix(pos, quat))]
+        body.static = [(body.path, pose_matrix(pos, quat))]

@@ -14,6 +14,7 @@ from pathlib import Path
 import defusedxml.ElementTree as SafeET
 import numpy as np
 
+from bt_manip.geometry import rpy_matrix
 from bt_manip.sim.assets import resolve_uri
 
 Rgba = tuple[float, float, float, float]
@@ -44,20 +45,6 @@ def _floats(text: str | None, n: int, default: float) -> tuple[float, ...]:
     if len(values) == 1 and n > 1:
         values = values * n
     return tuple(values[:n])
-
-
-def rpy_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
-    """Rotation matrix of URDF fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll))."""
-    cr, sr = np.cos(roll), np.sin(roll)
-    cp, sp = np.cos(pitch), np.sin(pitch)
-    cy, sy = np.cos(yaw), np.sin(yaw)
-    return np.array(
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
-    )
 
 
 def origin_matrix(xyz: tuple[float, ...], rpy: tuple[float, ...]) -> np.ndarray:

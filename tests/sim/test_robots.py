@@ -414,3 +414,16 @@ def _euler_xyz(rotation: np.ndarray) -> tuple[float, float, float]:
     roll = math.atan2(rotation[2, 1], rotation[2, 2])
     yaw = math.atan2(rotation[1, 0], rotation[0, 0])
     return roll, pitch, yaw
+
+
+def test_a_recipe_offset_must_be_finite(tmp_path: Path) -> None:
+    text = (REPO_ROOT / "robots" / "husky_ur3.yaml").read_text()
+    text = text.replace("xyz: [0.38, 0.0, 0.2243]", "xyz: [.inf, 0.0, 0.2243]")
+    text = text.replace("parts/", str(REPO_ROOT / "robots/parts") + "/")
+    path = tmp_path / "husky.yaml"
+    path.write_text(text)
+    with pytest.raises(InputError) as caught:
+        RobotDescription.load(path)
+    wanted = "xyz must be a list of 3 numbers"
+    problem = next(p for p in caught.value.problems if wanted in p.message)
+    assert problem.line == 10

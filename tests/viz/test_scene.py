@@ -11,7 +11,7 @@ from bt_manip.overlay import FrameItem, Overlay, PathItem
 from bt_manip.sim.compose import composed_urdf
 from bt_manip.sim.world import World
 from bt_manip.viz.overlay import item_json
-from bt_manip.viz.scene import ROOT, build_scene, pose_matrix
+from bt_manip.viz.scene import ROOT, build_scene, row_matrix
 from bt_manip.viz.urdf_visuals import origin_matrix, read_visuals
 
 REPO = Path(__file__).resolve().parents[2]
@@ -45,12 +45,12 @@ def test_link_frames_match_pybullet(room: World) -> None:
     room.step(120)
     scene = build_scene(room)
     poses = scene.read_poses()
-    base = pose_matrix(poses[scene.tracks.index(f"{ROOT}/husky")])
+    base = row_matrix(poses[scene.tracks.index(f"{ROOT}/husky")])
     checked = 0
     for k, path in enumerate(scene.tracks):
         parts = path.split("/")
         if len(parts) == 5 and parts[3] == "husky":
-            world_pose = base @ pose_matrix(poses[k])
+            world_pose = base @ row_matrix(poses[k])
             assert world_pose == pytest.approx(robot.link_transform(parts[4]), abs=1e-6), path
             checked += 1
     assert checked >= 15  # wheels, plate, arm links, gripper

@@ -1,0 +1,446 @@
+"""Robot descriptors (``robots/<name>.yaml``): where they are found and what they say.
+
+:class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
+which URDF (or composition recipe), the base (``skid_steer`` or ``fixed``), the arm joints in
+order, the gripper, the end-effector and grasp frames, named arm states and the footprint.
+Every name in it is checked against the robot's URDF. This module is pure data: nothing here
+touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import defusedxml.ElementTree as SafeET
+
+from bt_manip.errors import InputError
+from bt_manip.sim.assets import REPO_ROOT
+from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
+from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
+
+__all__ = [
+    "ROBOTS_DIR",
+    "ArmSpec",
+    "BaseSpec",
+    "Footprint",
+    "GripperSpec",
+    "RobotDescription",
+    "descriptor_folders",
+    "find_descriptor",
+    "known_robots",
+    "load_description",
+]
+
+# -- descriptors --------------------------------------------------------------------------------
+ROBOTS_DIR = REPO_ROOT / "robots"
+BASE_TYPES = ("skid_steer", "fixed")
+TOP_KEYS = {
+    "name",
+    "urdf",
+    "spawn_height",
+    "base",
+    "arm",
+    "end_effector",
+    "grasp_frame",
+    "gripper",
+    "states",
+    "footprint",
+}
+BASE_KEYS = {
+    "type",
+    "left_wheels",
+    "right_wheels",
+    "wheel_radius",
+    "track_width",
+    "max_wheel_speed",
+    "wheel_max_torque",
+    "wheel_friction",
+    "wheel_spinning_friction",
+    "wheel_rolling_friction",
+    "wheel_axle_friction_scale",
+    "pivot_offset",
+}
+ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
+GRIPPER_KEYS = {
+    "joints",
+    "finger_links",
+    "open",
+    "closed",
+    "max_force",
+    "max_speed",
+    "pad_friction",
+}
+FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
+
+
+@dataclass(frozen=True)
+class BaseSpec:
+    """The mobile base: ``skid_steer`` (wheels left/right) or ``fixed`` (welded to the world)."""
+
+    type: str = "fixed"
+    left_wheels: tuple[str, ...] = ()
+    right_wheels: tuple[str, ...] = ()
+    wheel_radius: float = 0.0
+    track_width: float = 0.0
+    """Effective track width (m) for skid-steer kinematics: yaw rate = (vr - vl) / track."""
+    max_wheel_speed: float = 0.0
+    wheel_max_torque: float = 0.0
+    wheel_friction: float = 1.0
+    wheel_spinning_friction: float = 0.0
+    wheel_rolling_friction: float = 0.0
+    wheel_axle_friction_scale: float = 1.0
+    """Friction along the wheel axle relative to ``wheel_friction`` (< 1 lets a skid-steer turn)."""
+    pivot_offset: float = 0.0
+    """Where the base turns about when it turns on the spot (m ahead of its frame, measured)."""
+
+
+@dataclass(frozen=True)
+class ArmSpec:
+    """The arm: chain root, joints in order, their speed and effort limits and lower/upper."""
+
+    base_link: str
+    joints: tuple[str, ...]
+    velocity_limits: tuple[float, ...]
+    efforts: tuple[float | None, ...]
+    lower: tuple[float, ...] = ()
+    upper: tuple[float, ...] = ()
+    position_gain: float = 0.3
+
+
+@dataclass(frozen=True)
+class GripperSpec:
+    """Parallel gripper: finger joints (each = pad distance from the centre line, m)."""
+
+    joints: tuple[str, ...]
+    finger_links: tuple[str, ...]
+    open: float
+    closed: float
+    max_force: float
+    max_speed: float = 0.1
+    pad_friction: float = 1.5
+
+    @property
+    def max_opening(self) -> float:
+        """Distance between the pads when fully open (m)."""
+        return max(self.open, self.closed) * len(self.joints)
+
+    @property
+    def min_opening(self) -> float:
+        """Distance between the pads when closed on nothing (m)."""
+        return min(self.open, self.closed) * len(self.joints)
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """Outline of the base for navigation: a rectangle (length x width) or a circle (radius).
+
+    The rectangle is centred ``x_offset`` ahead of the root link frame.
+    """
+
+    length: float = 0.0
+    width: float = 0.0
+    x_offset: float = 0.0
+    radius: float = 0.0
+
+    @property
+    def is_circle(self) -> bool:
+        return self.radius > 0.0
+
+    @property
+    def circumradius(self) -> float:
+        """Radius of the smallest circle around the root frame containing the footprint."""
+        if self.is_circle:
+            return self.radius
+        return math.hypot(abs(self.x_offset) + self.length / 2.0, self.width / 2.0)
+
+
+@dataclass(frozen=True)
+class RobotDescription:
+    """A checked robot descriptor (``robots/<name>.yaml``)."""
+
+    name: str
+    path: Path
+    urdf: Path | Recipe
+    base: BaseSpec
+    arm: ArmSpec
+    gripper: GripperSpec
+    end_effector: str
+    grasp_frame: str
+    states: dict[str, tuple[float, ...]]
+    footprint: Footprint
+    spawn_height: float = 0.0
+
+    @classmethod
+    def load(cls, name_or_path: str | Path) -> RobotDescription:
+        """Read ``robots/<name>.yaml`` (or a path to a descriptor) and check it.
+
+        Raises :class:`~bt_manip.errors.InputError` naming the file, line and key of every
+        problem, including names that do not exist in the robot's URDF.
+        """
+        return load_description(name_or_path)
+
+    def state(self, name: str) -> tuple[float, ...]:
+        """Arm joint positions of the named state (``home``, ``tuck``, ...)."""
+        try:
+            return self.states[name]
+        except KeyError:
+            raise KeyError(
+                f"{self.name} has no arm state '{name}'; states: {', '.join(self.states)}"
+            ) from None
+
+    @property
+    def urdf_path(self) -> Path:
+        """The URDF PyBullet and Pinocchio load (composed and cached if needed)."""
+        return composed_urdf(self)
+
+
+def descriptor_folders(near: Path | None = None) -> list[Path]:
+    """Folders searched for a descriptor named without a path, first match wins.
+
+    With ``near`` (the folder of a world file): its ``robots/`` folder, the ``robots/`` folder
+    beside it, then the shipped ``robots/``; without: the shipped ``robots/`` only.
+    """
+    if near is None:
+        return [ROBOTS_DIR]
+    return [near / "robots", near.parent / "robots", ROBOTS_DIR]
+
+
+def find_descriptor(name_or_path: str | Path, near: Path | None = None) -> Path | None:
+    """The descriptor file a robot name or a descriptor path refers to, or None if none exists.
+
+    A name ending in ``.yaml``/``.yml`` is a path (relative to ``near`` when given); any other
+    name is looked up as ``<name>.yaml`` in :func:`descriptor_folders`. Without ``near``, an
+    existing file is taken as a path whatever its suffix. Paths found for a world (``near``
+    given) are resolved; without ``near`` they are returned as named.
+    """
+    p = Path(name_or_path)
+    if p.suffix in (".yaml", ".yml") or (near is None and p.is_file()):
+        if near is not None:
+            p = (near / p).resolve()  # an absolute p stays itself
+        return p if p.is_file() else None
+    for folder in descriptor_folders(near):
+        candidate = folder / f"{name_or_path}.yaml"
+        if candidate.is_file():
+            return candidate.resolve() if near is not None else candidate
+    return None
+
+
+def known_robots(near: Path | None = None) -> list[str]:
+    """Names of the robot descriptors found in :func:`descriptor_folders`."""
+    names: set[str] = set()
+    for folder in descriptor_folders(near):
+        if folder.is_dir():
+            names.update(p.stem for p in folder.glob("*.yaml"))
+    return sorted(names)
+
+
+class _Fields(FieldReader):
+    """The field readers of YAML input, plus the sections of a descriptor."""
+
+    def section(self, d: LineDict, key: str, allowed: set[str], required: bool = True) -> LineDict:
+        value = d.get(key)
+        if value is None and not required:
+            return _empty(d.line_of(key))
+        if not isinstance(value, LineDict):
+            self.fail(d.line_of(key), f"'{key}' must be a mapping")
+            return _empty(d.line_of(key))
+        self.unknown_keys(value, allowed, key)
+        return value
+
+    def real(
+        self,
+        d: LineDict,
+        key: str,
+        where: str,
+        default: float | None = None,
+        minimum: float | None = None,
+        positive: bool = False,
+    ) -> float:
+        """Like :meth:`number`, 0.0 when the value is refused (the problem is recorded)."""
+        value = self.number(d, key, where, default, positive=positive, minimum=minimum)
+        return 0.0 if value is None else value
+
+
+def _empty(line: int) -> LineDict:
+    out = LineDict()
+    out.line = line
+    out.key_lines = {}
+    return out
+
+
+def load_description(name_or_path: str | Path) -> RobotDescription:
+    """Read and check a robot descriptor; see :meth:`RobotDescription.load`."""
+    path = find_descriptor(name_or_path)
+    if path is None:
+        p = Path(name_or_path)
+        missing = p if p.suffix in (".yaml", ".yml") else ROBOTS_DIR / f"{name_or_path}.yaml"
+        known = ", ".join(known_robots()) or "none"
+        raise InputError.single(
+            str(missing), None, f"no robot descriptor '{name_or_path}'; known robots: {known}"
+        )
+    data = load_yaml(path)
+    f = _Fields(path)
+    if not isinstance(data, LineDict):
+        raise InputError.single(str(path), 1, "a robot descriptor must be a YAML mapping")
+    f.unknown_keys(data, TOP_KEYS, "the descriptor")
+    name = f.text(data, "name", "descriptor", default=path.stem)
+    urdf = _parse_urdf_source(f, data, path)
+
+    b = f.section(data, "base", BASE_KEYS)
+    base_type = b.get("type", "fixed")
+    if base_type not in BASE_TYPES:
+        f.fail(
+            b.line_of("type"),
+            f"base.type must be one of {', '.join(BASE_TYPES)}, got {base_type!r}",
+        )
+    if base_type == "skid_steer":
+        base = BaseSpec(
+            "skid_steer",
+            f.names(b, "left_wheels", "base"),
+            f.names(b, "right_wheels", "base"),
+            f.real(b, "wheel_radius", "base", positive=True),
+            f.real(b, "track_width", "base", positive=True),
+            f.real(b, "max_wheel_speed", "base", positive=True),
+            f.real(b, "wheel_max_torque", "base", positive=True),
+            f.real(b, "wheel_friction", "base", 1.0, minimum=0.0),
+            f.real(b, "wheel_spinning_friction", "base", 0.0, minimum=0.0),
+            f.real(b, "wheel_rolling_friction", "base", 0.0, minimum=0.0),
+            f.real(b, "wheel_axle_friction_scale", "base", 1.0, positive=True),
+            f.real(b, "pivot_offset", "base", 0.0),
+        )
+    else:
+        base = BaseSpec("fixed")
+
+    a = f.section(data, "arm", ARM_KEYS)
+    joints = f.names(a, "joints", "arm")
+    vel = (
+        f.vector(
+            a.get("velocity_limits"),
+            len(joints),
+            a.line_of("velocity_limits"),
+            "arm.velocity_limits",
+        )
+        or ()
+    )
+    if any(v <= 0 for v in vel):
+        f.fail(a.line_of("velocity_limits"), "arm.velocity_limits must all be > 0")
+    efforts: tuple[float | None, ...] = (None,) * len(joints)
+    if "efforts" in a:
+        efforts = f.vector(a["efforts"], len(joints), a.line_of("efforts"), "arm.efforts") or ()
+    arm_base = f.text(a, "base_link", "arm")
+    gain = f.real(a, "position_gain", "arm", 0.3, positive=True)
+
+    g = f.section(data, "gripper", GRIPPER_KEYS)
+    gripper = GripperSpec(
+        f.names(g, "joints", "gripper"),
+        f.names(g, "finger_links", "gripper"),
+        f.real(g, "open", "gripper"),
+        f.real(g, "closed", "gripper"),
+        f.real(g, "max_force", "gripper", positive=True),
+        f.real(g, "max_speed", "gripper", 0.1, positive=True),
+        f.real(g, "pad_friction", "gripper", 1.5, minimum=0.0),
+    )
+
+    raw_states = data.get("states")
+    s = f.section(data, "states", set(raw_states) if isinstance(raw_states, dict) else set())
+    states: dict[str, tuple[float, ...]] = {}
+    for key in ("home", "tuck"):
+        if key not in s:
+            f.fail(s.line, f"states is missing '{key}' (arm positions in rad)")
+    for key, value in s.items():
+        q = f.vector(value, len(joints), s.line_of(key), f"states.{key}")
+        if q is not None:
+            states[key] = q
+
+    fp = f.section(data, "footprint", FOOTPRINT_KEYS)
+    if "radius" in fp:
+        footprint = Footprint(radius=f.real(fp, "radius", "footprint", positive=True))
+    else:
+        footprint = Footprint(
+            f.real(fp, "length", "footprint", positive=True),
+            f.real(fp, "width", "footprint", positive=True),
+            f.real(fp, "x_offset", "footprint", 0.0),
+        )
+    end_effector = f.text(data, "end_effector", "descriptor")
+    grasp_frame = f.text(data, "grasp_frame", "descriptor")
+    spawn_height = f.real(data, "spawn_height", "descriptor", 0.0)
+    if f.problems:
+        raise InputError(f.problems)
+
+    desc = RobotDescription(
+        name,
+        path,
+        urdf,
+        base,
+        ArmSpec(arm_base, joints, vel, efforts, position_gain=gain),
+        gripper,
+        end_effector,
+        grasp_frame,
+        states,
+        footprint,
+        spawn_height,
+    )
+    return _check_against_urdf(desc, data, f)
+
+
+def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:
+    value = data.get("urdf")
+    if isinstance(value, str):
+        urdf = (path.parent / value).resolve()
+        if not urdf.is_file():
+            f.fail(data.line_of("urdf"), f"urdf: file '{value}' not found (at {urdf})")
+        return urdf
+    if isinstance(value, LineDict):
+        try:
+            return parse_recipe(value, path, data.get("name", path.stem))
+        except InputError as exc:
+            f.problems.extend(exc.problems)
+            return path
+    f.fail(data.line_of("urdf"), "urdf must be a file path or a composition recipe (mapping)")
+    return path
+
+
+def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> RobotDescription:
+    """Check every joint and link name of ``desc`` in its URDF; fill the arm's joint limits."""
+    root = SafeET.parse(str(composed_urdf(desc))).getroot()
+    links = {el.get("name") for el in root.findall("link")}
+    joints = {el.get("name"): el for el in root.findall("joint")}
+
+    def need(names: tuple[str, ...], kind: set | dict, section: str, key: str) -> None:
+        sec = data.get(section) if section else data
+        line = sec.line_of(key) if isinstance(sec, LineDict) else None
+        for n in names:
+            if n not in kind:
+                what = "joint" if kind is joints else "link"
+                f.fail(
+                    line, f"{section + '.' if section else ''}{key}: no {what} '{n}' in the URDF"
+                )
+
+    need(desc.base.left_wheels + desc.base.right_wheels, joints, "base", "left_wheels")
+    need(desc.arm.joints, joints, "arm", "joints")
+    need((desc.arm.base_link,), links, "arm", "base_link")
+    need(desc.gripper.joints, joints, "gripper", "joints")
+    need(desc.gripper.finger_links, links, "gripper", "finger_links")
+    need((desc.end_effector,), links, "", "end_effector")
+    need((desc.grasp_frame,), links, "", "grasp_frame")
+    if f.problems:
+        raise InputError(f.problems)
+    lower, upper = [], []
+    for n in desc.arm.joints:
+        limit = joints[n].find("limit")
+        lo = float(limit.get("lower", -math.inf)) if limit is not None else -math.inf
+        hi = float(limit.get("upper", math.inf)) if limit is not None else math.inf
+        lower.append(lo)
+        upper.append(hi)
+    states = data["states"]
+    for key, q in desc.states.items():
+        bad = [desc.arm.joints[i] for i, v in enumerate(q) if not lower[i] <= v <= upper[i]]
+        if bad:
+            f.fail(states.line_of(key), f"states.{key}: outside the joint limits of {bad}")
+    if f.problems:
+        raise InputError(f.problems)
+    arm = dataclasses.replace(desc.arm, lower=tuple(lower), upper=tuple(upper))
+    return dataclasses.replace(desc, arm=arm)
