@@ -1,0 +1,19 @@
+"""Nav2's behaviour-tree nodes, so Nav2's own trees run on bt-manip's robots without ROS.
+
+Importing this package registers the nodes (Nav2's IDs, ports and semantics):
+
+- controls: PipelineSequence, RecoveryNode, RoundRobin (:mod:`.controls`);
+- decorators: RateController (:mod:`.decorators`);
+- conditions: GoalUpdated, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
+  WouldAControllerRecoveryHelp (:mod:`.conditions`);
+- actions: ComputePathToPose, FollowPath, ClearEntireCostmap, Spin, BackUp, DriveOnHeading,
+  Wait (:mod:`.actions`).
+
+The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
+paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
+(:mod:`.errors`). Planning and following are bt-manip's navigation of the robot's base.
+"""
+
+from bt_manip.nav2 import actions, conditions, controls, decorators
+
+__all__ = ["actions", "conditions", "controls", "decorators"]
