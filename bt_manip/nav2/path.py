@@ -41,7 +41,8 @@ class Nav2Path:
         """The (n, 2) points ``ahead`` metres in front of each pose (the base's turning point
         when ``ahead`` is its pivot offset)."""
         p = self.poses
-        return np.column_stack([p[:, 0] + ahead * np.cos(p[:, 2]), p[:, 1] + ahead * np.sin(p[:, 2])])
+        x = p[:, 0] + ahead * np.cos(p[:, 2])
+        return np.column_stack([x, p[:, 1] + ahead * np.sin(p[:, 2])])
 
     def __len__(self) -> int:
         return len(self.poses)
