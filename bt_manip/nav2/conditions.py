@@ -72,6 +72,7 @@ class WouldAControllerRecoveryHelp(AreErrorCodesPresent):
 @registry.register
 class GoalUpdated(ConditionNode):
     """Whether the goal (``goal``, or ``goals`` for the through-poses trees) has changed.
+    Without the ports, the blackboard entries ``goal`` and ``goals`` are read.
 
     When the node is not active (IDLE: the first tick, or after a parent reset it) it records
     the goals and returns FAILURE. Otherwise it compares the goals now with the recorded ones:
@@ -79,16 +80,26 @@ class GoalUpdated(ConditionNode):
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "goal": PortInformation(object, False, "Destination", "{goal}"),
-        "goals": PortInformation(object, False, "Destinations", "{goals}"),
+        "goal": PortInformation(object, False, "Destination (default: the entry 'goal')"),
+        "goals": PortInformation(object, False, "Destinations (default: the entry 'goals')"),
     }
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name, **attributes)
         self.recorded: tuple[Any, Any] = (None, None)
 
+    def _read(self, port: str) -> Any:
+        """The port's value, or the blackboard entry of the same name when the port is not
+        given (Nav2's ``getInputOrBlackboard``); None when neither has one."""
+        if port in self.bindings:
+            return self.get_input(port, None)
+        try:
+            return self.blackboard.get(port)
+        except KeyError:
+            return None
+
     def _now(self) -> tuple[Any, Any]:
-        return (_plain(self.get_input("goal", None)), _plain(self.get_input("goals", None)))
+        return (_plain(self._read("goal")), _plain(self._read("goals")))
 
     def tick_node(self) -> NodeStatus:
         active = self.bt_status not in (NodeStatus.IDLE, NodeStatus.SKIPPED)

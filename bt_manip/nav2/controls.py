@@ -192,4 +192,5 @@ class RoundRobin(_Nav2Control):
 
     def halt(self) -> None:
         self.current = 0
+        self.failed = 0
         super().halt()
