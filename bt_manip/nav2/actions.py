@@ -24,6 +24,7 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.bt.node import PortError
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.bt.registry import registry
 from bt_manip.nav2.blocking import maybe_block
@@ -45,6 +46,17 @@ PLAN_ERRORS = {
     PlanOutcome.FOOTPRINT: PlannerError.NO_VALID_PATH,
     PlanOutcome.NO_PATH: PlannerError.NO_VALID_PATH,
 }
+
+
+def plan_error(outcome: PlanOutcome, reason: str) -> PlannerError:
+    """Nav2's planner result code for a failed plan: a start or goal too close to obstacles
+    for the footprint is occupied, as in Nav2's costmap."""
+    if outcome is PlanOutcome.FOOTPRINT:
+        if reason.startswith("goal"):
+            return PlannerError.GOAL_OCCUPIED
+        if reason.startswith("start"):
+            return PlannerError.START_OCCUPIED
+    return PLAN_ERRORS.get(outcome, PlannerError.UNKNOWN)
 
 
 def _error_ports(doc: str) -> dict[str, PortInformation]:
@@ -169,8 +181,14 @@ class ComputePathToPose(Nav2Action):
         end = (goal[0] + p * math.cos(goal[2]), goal[1] + p * math.sin(goal[2]))
         plan = nav.plan_to((*ahead, start[2]), (*end, goal[2]))
         if not plan.ok or plan.polyline is None:
-            code = PLAN_ERRORS.get(plan.outcome, PlannerError.UNKNOWN)
-            self.fail(code, f"no path to {goal[0]:.3f};{goal[1]:.3f}: {plan.reason}")
+            # the reason in the base frame's terms when its start or goal is the trouble
+            base = nav.plan_to(start, goal)
+            failed = plan if base.ok else base
+            code = plan_error(failed.outcome, failed.reason) if not base.ok else (
+                PlannerError.NO_VALID_PATH
+            )
+            self.fail(code, f"no path to {goal[0]:.3f};{goal[1]:.3f}: {failed.reason}")
+        assert plan.polyline is not None
         path = path_from_points(plan.polyline, goal, p)
         path = dataclasses.replace(path, planner_id=str(self.get_input("planner_id", "") or ""))
         self.set_output("path", path)
@@ -209,7 +227,10 @@ class FollowPath(Nav2Action):
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("The follow path")
 
     def _path(self) -> Nav2Path:
-        path = self.get_input("path", None)
+        try:
+            path = self.get_input("path", None)
+        except PortError as exc:
+            self.fail(ControllerError.INVALID_PATH, str(exc))
         if not isinstance(path, Nav2Path) or len(path) == 0:
             self.fail(ControllerError.INVALID_PATH, f"no path to follow (got {path!r})")
         return path

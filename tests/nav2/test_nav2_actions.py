@@ -1,0 +1,130 @@
+"""Nav2's action nodes on the Husky in a small room: planning, following, behaviours, clearing."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
+from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.bt import Tree, TreeContext, load_tree_string
+from bt_manip.nav2.path import Nav2Path
+from bt_manip.runner import Runner, RunOptions, RunReport
+from bt_manip.sim.world import World
+
+ROOM = Path(__file__).resolve().parent / "room.yaml"
+
+
+@pytest.fixture
+def room() -> Iterator[World]:
+    with World(ROOM, seed=0) as world:
+        yield world
+
+
+def run(world: World, body: str, bb: dict[str, Any] | None = None,
+        max_sim_time: float = 60.0) -> tuple[RunReport, dict[str, Any]]:
+    xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
+    tree: Tree = load_tree_string(
+        xml, context=TreeContext(clock=world.clock, world=world), blackboard=dict(bb or {})
+    )
+    report = Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run()
+    entries = {key: tree.blackboard.get(key) for key in tree.blackboard.as_dict()}
+    return report, entries
+
+
+def yaw_gap(a: float, b: float) -> float:
+    return abs(math.remainder(a - b, math.tau))
+
+
+def test_compute_path_then_follow_path_reaches_the_goal(room: World) -> None:
+    x0, y0, _ = room.robots["husky"].base_pose2d()
+    report, bb = run(
+        room,
+        '<Sequence><ComputePathToPose goal="{goal}" path="{path}" error_code_id="{pe}"/>'
+        '<FollowPath path="{path}" error_code_id="{fe}" error_msg="{fm}"/></Sequence>',
+        {"goal": "1.8;0.5;1.0"},
+    )
+    assert report.status == "SUCCESS", report.reason
+    x, y, yaw = room.robots["husky"].base_pose2d()
+    assert math.hypot(x - 1.8, y - 0.5) <= 0.25
+    assert yaw_gap(yaw, 1.0) <= 0.25
+    path = bb["path"]
+    assert isinstance(path, Nav2Path)
+    assert path.goal == pytest.approx((1.8, 0.5, 1.0))
+    assert math.hypot(path.poses[0, 0] - x0, path.poses[0, 1] - y0) <= 0.3
+    assert path.length >= math.hypot(1.8 - x0, 0.5 - y0) - 0.05
+    assert (bb["pe"], bb["fe"], bb["fm"]) == (0, 0, "")
+
+
+def test_compute_path_failures_carry_nav2_result_codes(room: World) -> None:
+    body = '<ComputePathToPose goal="{goal}" path="{path}" error_code_id="{code}" ' \
+           'error_msg="{msg}"/>'
+    report, bb = run(room, body, {"goal": "inside_wall"})
+    assert report.status == "FAILURE"
+    assert bb["code"] == 206  # GOAL_OCCUPIED
+    assert "inside an obstacle" in bb["msg"]
+    assert "path" not in bb
+    report, bb = run(room, body, {"goal": "40;0;0"})
+    assert (report.status, bb["code"]) == ("FAILURE", 204)  # GOAL_OUTSIDE_MAP
+
+
+def test_follow_path_without_a_path_is_an_invalid_path(room: World) -> None:
+    report, bb = run(room, '<FollowPath path="{path}" error_code_id="{code}"/>',
+                     {"path": "not a path"})
+    assert report.status == "FAILURE"
+    assert bb["code"] == 103  # INVALID_PATH
+
+
+@pytest.mark.parametrize("dist", [1.57, -1.0])
+def test_spin_turns_the_base_by_spin_dist(room: World, dist: float) -> None:
+    x0, y0, yaw0 = room.robots["husky"].base_pose2d()
+    report, bb = run(room, f'<Spin spin_dist="{dist}" error_code_id="{{code}}"/>')
+    assert report.status == "SUCCESS", report.reason
+    x, y, yaw = room.robots["husky"].base_pose2d()
+    assert yaw_gap(yaw, yaw0 + dist) <= 0.15
+    assert math.hypot(x - x0, y - y0) <= 0.3  # on the spot (a skid-steer pivots ahead)
+    assert bb["code"] == 0
+
+
+def test_back_up_reverses_by_backup_dist(room: World) -> None:
+    x0, y0, _ = room.robots["husky"].base_pose2d()
+    report, _ = run(room, '<BackUp backup_dist="0.3" backup_speed="0.1"/>')
+    assert report.status == "SUCCESS", report.reason
+    x, y, _ = room.robots["husky"].base_pose2d()
+    assert 0.3 <= math.hypot(x - x0, y - y0) <= 0.4
+    assert x < x0  # backwards: the robot faces +x
+
+
+def test_back_up_into_a_wall_stops_with_collision_ahead(room: World) -> None:
+    x0, _, _ = room.robots["husky"].base_pose2d()
+    report, bb = run(room, '<BackUp backup_dist="2.0" backup_speed="0.2" '
+                           'error_code_id="{code}" error_msg="{msg}"/>')
+    assert report.status == "FAILURE"
+    assert bb["code"] == 703  # COLLISION_AHEAD
+    assert "wall_west" in bb["msg"]
+    x, _, _ = room.robots["husky"].base_pose2d()
+    assert x0 - 1.0 < x < x0 - 0.3  # it went back until the wall, not through it
+
+
+def test_wait_waits_wait_duration_of_sim_time(room: World) -> None:
+    before = room.clock.now()
+    report, _ = run(room, '<Wait wait_duration="2"/>')
+    assert report.status == "SUCCESS"
+    assert 2.0 <= room.clock.now() - before <= 2.2
+
+
+def test_clear_entire_costmap_forgets_what_the_map_marked(room: World) -> None:
+    report, _ = run(room, '<ComputePathToPose goal="east" path="{path}"/>')
+    assert report.status == "SUCCESS", report.reason
+    nav = navigator_for(room, room.robots["husky"])
+    crate = room.movable["crate"]
+    assert crate in nav.costmap.grid.sources  # the crate is marked
+    report, _ = run(room, '<ClearEntireCostmap service_name="local_costmap/clear"/>')
+    assert report.status == "SUCCESS"
+    assert not nav.costmap.grid.sources
+    assert not np.any(nav.costmap.grid.occupied & ~nav.static.occupied)
