@@ -1,0 +1,110 @@
+"""Nav2's default tree, navigate_to_pose_w_replanning_and_recovery.xml, end to end on the Husky:
+to the house's goal, and through its recovery branch when the goal is walled in by crates."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
+from bt_manip.bt import Tree, TreeContext, load_tree
+from bt_manip.bt.status import NodeStatus
+from bt_manip.sim.world import World
+from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
+
+ROOT = Path(__file__).resolve().parents[2]
+SAMPLES = ROOT.parent / "shared" / "samples" / "nav2"
+DEFAULT_TREE = SAMPLES / "navigate_to_pose_w_replanning_and_recovery.xml"
+RECOVERIES = ("ClearingActions", "Spin", "Wait", "BackUp")
+
+pytestmark = pytest.mark.skipif(
+    not DEFAULT_TREE.is_file(), reason="Nav2's sample trees are not in ../shared/samples/nav2"
+)
+
+
+def load(world: World, goal: str) -> Tree:
+    return load_tree(
+        str(DEFAULT_TREE), context=TreeContext(clock=world.clock, world=world),
+        blackboard={"goal": goal},
+    )
+
+
+def run(world: World, tree: Tree, max_ticks: int = 2400,
+        on_tick: Callable[[list[str]], None] | None = None) -> tuple[NodeStatus, list[str]]:
+    """Tick at 20 Hz (12 physics steps a tick) until the root finishes; the recoveries of the
+    RoundRobin in the order they started."""
+    started: list[str] = []
+    status = NodeStatus.RUNNING
+    for _ in range(max_ticks):
+        status = tree.tick()
+        names = [n.name for n in tree.visited_nodes()]
+        for name in names:
+            if name in RECOVERIES and (not started or started[-1] != name):
+                started.append(name)
+        if on_tick is not None:
+            on_tick(started)
+        if status is not NodeStatus.RUNNING:
+            break
+        world.step(12)
+    return status, started
+
+
+def test_default_tree_reaches_the_house_goal() -> None:
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=3) as world:
+        status, recoveries = run(world, load(world, "2.616;-0.715;0.848"))
+        assert status is NodeStatus.SUCCESS
+        assert recoveries == []
+        x, y, yaw = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - 2.616, y + 0.715) <= 0.25
+        assert abs(math.remainder(yaw - 0.848, math.tau)) <= 0.25
+
+
+def crate_ring(world: World, centre: tuple[float, float], radius: float, n: int) -> list[str]:
+    """``n`` crates in a ring round ``centre``: too close together for the Husky to pass."""
+    names = []
+    for k in range(n):
+        a = 2 * math.pi * k / n
+        name = f"ring_{k}"
+        world.spawn(BodySpec(
+            name=name, movable=True,
+            parts=[Part("box", (0.3, 0.3, 0.3), colour=COLOURS["brown"])],
+            urdf=None,
+            pose=Pose3D((centre[0] + radius * math.cos(a), centre[1] + radius * math.sin(a), 0.15)),
+            planar=False, mass=8.0, friction=0.9, colour=COLOURS["brown"],
+            randomize=Range2D(), line=0,
+        ))
+        names.append(name)
+    world.step(48)
+    return names
+
+
+def test_recoveries_take_turns_until_the_retries_are_spent() -> None:
+    with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
+        crate_ring(world, (1.6, 0.5), 0.85, 12)
+        tree = load(world, "1.6;0.5;0.0")
+        status, recoveries = run(world, tree)
+        assert status is NodeStatus.FAILURE
+        # six retries of the navigation, one recovery before each, in RoundRobin order
+        assert recoveries == ["ClearingActions", "Spin", "Wait", "BackUp", "ClearingActions",
+                              "Spin"]
+        assert tree.blackboard.get("compute_path_error_code") == 208  # NO_VALID_PATH
+
+
+def test_the_goal_is_reached_once_a_recovery_gave_the_world_time_to_change() -> None:
+    with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
+        ring = crate_ring(world, (1.6, 0.5), 0.85, 12)
+        tree = load(world, "1.6;0.5;0.0")
+
+        def open_the_ring(started: list[str]) -> None:
+            if started[-1:] == ["Wait"] and "ring_6" in world.movable:
+                for name in ring[5:8]:  # the crates on the robot's side
+                    world.remove(name)
+
+        status, recoveries = run(world, tree, on_tick=open_the_ring)
+        assert status is NodeStatus.SUCCESS
+        assert recoveries == ["ClearingActions", "Spin", "Wait"]
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - 1.6, y - 0.5) <= 0.25
