@@ -108,3 +108,22 @@ def test_the_goal_is_reached_once_a_recovery_gave_the_world_time_to_change() -> 
         assert recoveries == ["ClearingActions", "Spin", "Wait"]
         x, y, _ = world.robots["husky"].base_pose2d()
         assert math.hypot(x - 1.6, y - 0.5) <= 0.25
+
+
+def test_validate_and_the_groot_model_know_nav2s_nodes(
+    capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    from bt_manip import cli
+
+    assert cli.main(["validate", str(DEFAULT_TREE)]) == 0
+    assert ": OK" in capsys.readouterr().out
+    assert cli.main(["nodes", "--groot"]) == 0
+    model = capsys.readouterr().out
+    for node_id in ("PipelineSequence", "RecoveryNode", "RoundRobin", "RateController",
+                    "ComputePathToPose", "FollowPath", "ClearEntireCostmap", "Spin", "Wait",
+                    "BackUp", "GoalUpdated", "WouldAPlannerRecoveryHelp",
+                    "WouldAControllerRecoveryHelp"):
+        assert f'ID="{node_id}"' in model
+    path = tmp_path / "nav2_model.xml"
+    path.write_text(model)
+    assert cli.main(["validate", str(DEFAULT_TREE), "--models", str(path)]) == 0
