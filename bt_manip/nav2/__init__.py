@@ -3,9 +3,10 @@
 Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 
 - controls: PipelineSequence, RecoveryNode, RoundRobin (:mod:`.controls`);
-- decorators: RateController (:mod:`.decorators`);
+- decorators: RateController, DistanceController, SingleTrigger (:mod:`.decorators`);
 - conditions: GoalUpdated, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
-  WouldAControllerRecoveryHelp (:mod:`.conditions`);
+  WouldAControllerRecoveryHelp (:mod:`.conditions`); GoalReached, DistanceTraveled,
+  TimeExpired, IsPathValid (:mod:`.progress`);
 - actions: ComputePathToPose, FollowPath, ClearEntireCostmap, Spin, BackUp, DriveOnHeading,
   Wait (:mod:`.actions`).
 
@@ -14,6 +15,6 @@ paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
 (:mod:`.errors`). Planning and following are bt-manip's navigation of the robot's base.
 """
 
-from bt_manip.nav2 import actions, conditions, controls, decorators
+from bt_manip.nav2 import actions, conditions, controls, decorators, progress
 
-__all__ = ["actions", "conditions", "controls", "decorators"]
+__all__ = ["actions", "conditions", "controls", "decorators", "progress"]

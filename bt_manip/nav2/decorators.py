@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
+from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldAccess
 from bt_manip.bt.node import BtNode, DecoratorNode
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
@@ -58,3 +60,76 @@ class RateController(DecoratorNode):
                 self.started = now
             return status
         return RUNNING
+
+
+@registry.register
+class DistanceController(WorldAccess, DecoratorNode):
+    """Ticks its child each time the robot has travelled ``distance`` metres (straight-line,
+    from where it was when the child last succeeded).
+
+    When it starts (from IDLE) the child is ticked at once. Later ticks tick the child while
+    it is RUNNING or once the robot is ``distance`` from that point; otherwise it returns
+    RUNNING without ticking it. Child SUCCESS: SUCCESS (the distance is measured from here
+    now); child RUNNING: RUNNING; child FAILURE: FAILURE.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "robot": ROBOT_PORT,
+        "distance": Port(float, False, "Distance", 1.0, POSITIVE),
+        "global_frame": PortInformation(str, False, "Global frame", "map"),
+        "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.start = (0.0, 0.0)
+        self.first_time = True
+
+    def tick_node(self) -> NodeStatus:
+        try:
+            x, y, _ = self.robot().base_pose2d()
+        except ActionFailed as exc:
+            self.feedback_message = str(exc)
+            return FAILURE
+        if self.bt_status is IDLE:
+            self.start = (x, y)
+            self.first_time = True
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+        travelled = math.hypot(x - self.start[0], y - self.start[1])
+        due = travelled >= float(self.get_input("distance"))
+        if self.first_time or self.child.bt_status is RUNNING or due:
+            self.first_time = False
+            status = self.child.execute_tick()
+            if status is SUCCESS:
+                self.start = (x, y)
+            return status
+        return RUNNING
+
+
+@registry.register
+class SingleTrigger(DecoratorNode):
+    """Ticks its child through one run only, until the node is reset.
+
+    From IDLE the child may run: child RUNNING gives RUNNING, SUCCESS or FAILURE is returned
+    once. Ticked again without a reset in between, it returns FAILURE without ticking the
+    child.
+    """
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.first_time = True
+
+    def tick_node(self) -> NodeStatus:
+        if self.bt_status is IDLE:
+            self.first_time = True
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+        if self.first_time:
+            status = self.child.execute_tick()
+            if status is not RUNNING:
+                self.first_time = False
+            return status
+        return FAILURE

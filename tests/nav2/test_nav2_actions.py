@@ -128,3 +128,62 @@ def test_clear_entire_costmap_forgets_what_the_map_marked(room: World) -> None:
     assert report.status == "SUCCESS"
     assert not nav.costmap.grid.sources
     assert not np.any(nav.costmap.grid.occupied & ~nav.static.occupied)
+
+
+def place(world: World, x: float, y: float, yaw: float = 0.0) -> None:
+    import pybullet as pb
+
+    robot = world.robots["husky"]
+    z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
+    pb.resetBasePositionAndOrientation(robot.body, [x, y, z],
+                                       pb.getQuaternionFromEuler([0, 0, yaw]),
+                                       physicsClientId=world.client)
+    world.step(24)
+
+
+def load(world: World, body: str, bb: dict[str, Any] | None = None) -> Tree:
+    xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
+    return load_tree_string(
+        xml, context=TreeContext(clock=world.clock, world=world), blackboard=dict(bb or {})
+    )
+
+
+def test_goal_reached_within_a_quarter_metre(room: World) -> None:
+    x, y, _ = room.robots["husky"].base_pose2d()
+    near = load(room, '<GoalReached goal="{goal}"/>', {"goal": f"{x + 0.2};{y};3.0"})
+    far = load(room, '<GoalReached goal="{goal}"/>', {"goal": f"{x + 0.4};{y};0.0"})
+    assert near.tick().value == "SUCCESS"
+    assert far.tick().value == "FAILURE"
+
+
+def test_distance_traveled_and_distance_controller_follow_the_robot(room: World) -> None:
+    cond = load(room, '<DistanceTraveled distance="0.5"/>').root
+    tree = load(room, '<PipelineSequence><DistanceController distance="0.5">'
+                      '<Script code="n += 1"/></DistanceController>'
+                      '<Wait wait_duration="100"/></PipelineSequence>', {"n": 0})
+    seen = []
+    for x in (-1.8, -1.6, -1.2, -1.0, -0.6):
+        place(room, x, 0.0)
+        assert tree.tick().value == "RUNNING"
+        seen.append((cond.execute_tick().value, tree.blackboard.get("n")))
+    # DistanceController: its child at once, then each 0.5 m from where it last succeeded
+    assert [n for _, n in seen] == [1, 1, 2, 2, 3]
+    # DistanceTraveled: records at -1.8, succeeds at -1.2 (0.6 m), then at -0.6 (0.6 m)
+    assert [s for s, _ in seen] == ["FAILURE", "FAILURE", "SUCCESS", "FAILURE", "SUCCESS"]
+
+
+def test_is_path_valid_until_an_object_lands_on_the_path(room: World) -> None:
+    import pybullet as pb
+
+    tree = load(room, '<Sequence><ComputePathToPose goal="east" path="{path}"/>'
+                      '<IsPathValid path="{path}"/></Sequence>')
+    assert tree.tick().value == "SUCCESS"
+    path = tree.blackboard.get("path")
+    mid = path.poses[len(path) // 2]
+    crate = room.movable["crate"]
+    pb.resetBasePositionAndOrientation(crate, [mid[0], mid[1], 0.15], [0, 0, 0, 1],
+                                       physicsClientId=room.client)
+    room.step(24)
+    check = load(room, '<IsPathValid path="{path}"/>', {"path": path})
+    assert check.tick().value == "FAILURE"
+    assert "obstacle lies on the path" in check.root.feedback_message

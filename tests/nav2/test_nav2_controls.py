@@ -202,3 +202,30 @@ def test_goal_updated_reports_a_new_goal_once() -> None:
     tree.blackboard.set("goal", "5;2;0")
     node.reset_status()  # a parent reset it: it records the goal again
     assert node.execute_tick().value == "FAILURE"
+
+
+def test_single_trigger_runs_its_child_once_until_reset() -> None:
+    tree, _ = make(f"<SingleTrigger>{kid('once')}</SingleTrigger>", {"once": "RS"})
+    node = tree.root  # ticked without a parent resetting it in between
+    LOG.clear()
+    assert node.execute_tick().value == "RUNNING"
+    assert node.execute_tick().value == "SUCCESS"
+    assert node.execute_tick().value == "FAILURE"  # not again
+    assert LOG == [("tick", "once"), ("tick", "once")]
+    node.reset_status()
+    assert node.execute_tick().value == "SUCCESS"  # reset: once more
+
+
+def test_time_expired_succeeds_once_per_period() -> None:
+    clock = ManualClock()
+    tree = load_tree_string(
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><TimeExpired seconds="1"/></BehaviorTree>'
+        "</root>",
+        context=TreeContext(clock=clock),
+    )
+    node = tree.root
+    seen = []
+    for dt in (0.0, 0.5, 0.6, 0.1, 0.95):
+        clock.advance(dt)
+        seen.append(node.execute_tick().value)
+    assert seen == ["FAILURE", "FAILURE", "SUCCESS", "FAILURE", "SUCCESS"]
