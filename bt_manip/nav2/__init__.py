@@ -3,18 +3,20 @@
 Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 
 - controls: PipelineSequence, RecoveryNode, RoundRobin (:mod:`.controls`);
-- decorators: RateController, DistanceController, SingleTrigger (:mod:`.decorators`);
-- conditions: GoalUpdated, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
+- decorators: RateController, DistanceController, SingleTrigger, GoalUpdatedController
+  (:mod:`.decorators`);
+- conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
   WouldAControllerRecoveryHelp (:mod:`.conditions`); GoalReached, DistanceTraveled,
   TimeExpired, IsPathValid (:mod:`.progress`);
 - actions: ComputePathToPose, FollowPath, ClearEntireCostmap, Spin, BackUp, DriveOnHeading,
-  Wait (:mod:`.actions`).
+  Wait (:mod:`.actions`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
+  SmootherSelector (:mod:`.selectors`).
 
 The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
 paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
 (:mod:`.errors`). Planning and following are bt-manip's navigation of the robot's base.
 """
 
-from bt_manip.nav2 import actions, conditions, controls, decorators, progress
+from bt_manip.nav2 import actions, conditions, controls, decorators, progress, selectors
 
-__all__ = ["actions", "conditions", "controls", "decorators", "progress"]
+__all__ = ["actions", "conditions", "controls", "decorators", "progress", "selectors"]

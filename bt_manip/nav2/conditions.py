@@ -69,8 +69,33 @@ class WouldAControllerRecoveryHelp(AreErrorCodesPresent):
         return frozenset(int(c) for c in CONTROLLER_RECOVERABLE)
 
 
+GOAL_PORTS: dict[str, PortInformation] = {
+    "goal": PortInformation(object, False, "Destination (default: the entry 'goal')"),
+    "goals": PortInformation(object, False, "Destinations (default: the entry 'goals')"),
+}
+
+
+class GoalsReader:
+    """Mixin: the goals now, from the ports ``goal`` and ``goals`` or, when a port is not
+    given, from the blackboard entries of the same names (Nav2's ``getInputOrBlackboard``)."""
+
+    bindings: dict[str, Any]
+    blackboard: Any
+
+    def _read(self, port: str) -> Any:
+        if port in self.bindings:
+            return self.get_input(port, None)  # type: ignore[attr-defined]
+        try:
+            return self.blackboard.get(port)
+        except KeyError:
+            return None
+
+    def current_goals(self) -> tuple[Any, Any]:
+        return (_plain(self._read("goal")), _plain(self._read("goals")))
+
+
 @registry.register
-class GoalUpdated(ConditionNode):
+class GoalUpdated(GoalsReader, ConditionNode):
     """Whether the goal (``goal``, or ``goals`` for the through-poses trees) has changed.
     Without the ports, the blackboard entries ``goal`` and ``goals`` are read.
 
@@ -79,35 +104,20 @@ class GoalUpdated(ConditionNode):
     SUCCESS (and records them) when they differ, FAILURE when they are the same.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "goal": PortInformation(object, False, "Destination (default: the entry 'goal')"),
-        "goals": PortInformation(object, False, "Destinations (default: the entry 'goals')"),
-    }
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name, **attributes)
         self.recorded: tuple[Any, Any] = (None, None)
 
-    def _read(self, port: str) -> Any:
-        """The port's value, or the blackboard entry of the same name when the port is not
-        given (Nav2's ``getInputOrBlackboard``); None when neither has one."""
-        if port in self.bindings:
-            return self.get_input(port, None)
-        try:
-            return self.blackboard.get(port)
-        except KeyError:
-            return None
-
-    def _now(self) -> tuple[Any, Any]:
-        return (_plain(self._read("goal")), _plain(self._read("goals")))
-
     def tick_node(self) -> NodeStatus:
-        active = self.bt_status not in (NodeStatus.IDLE, NodeStatus.SKIPPED)
-        self._was_active = active
+        self._was_active = self.bt_status not in (NodeStatus.IDLE, NodeStatus.SKIPPED)
         return super().tick_node()
 
+    _was_active = False
+
     def update(self) -> Status:
-        now = self._now()
+        now = self.current_goals()
         if not self._was_active:
             self.recorded = now
             return Status.FAILURE
@@ -116,7 +126,25 @@ class GoalUpdated(ConditionNode):
             return Status.SUCCESS
         return Status.FAILURE
 
-    _was_active = False
+
+@registry.register
+class GlobalUpdatedGoal(GoalUpdated):
+    """Like GoalUpdated, but it records the goals only on its very first tick, not each time
+    it is reset: SUCCESS whenever the goals differ from those it saw last, FAILURE otherwise
+    (and on its first tick)."""
+
+    first_time = True
+
+    def update(self) -> Status:
+        now = self.current_goals()
+        if self.first_time:
+            self.first_time = False
+            self.recorded = now
+            return Status.FAILURE
+        if now != self.recorded:
+            self.recorded = now
+            return Status.SUCCESS
+        return Status.FAILURE
 
 
 def _plain(value: Any) -> Any:

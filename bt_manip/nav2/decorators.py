@@ -12,6 +12,7 @@ from bt_manip.bt.node import BtNode, DecoratorNode
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
+from bt_manip.nav2.conditions import GOAL_PORTS, GoalsReader
 
 IDLE = NodeStatus.IDLE
 RUNNING = NodeStatus.RUNNING
@@ -133,3 +134,37 @@ class SingleTrigger(DecoratorNode):
                 self.first_time = False
             return status
         return FAILURE
+
+
+@registry.register
+class GoalUpdatedController(GoalsReader, DecoratorNode):
+    """Ticks its child when the goal (``goal`` / ``goals``, or those blackboard entries) has
+    changed, and while the child is RUNNING.
+
+    From IDLE it records the goals and ticks the child. Later ticks tick the child only if it
+    is RUNNING or the goals differ from the recorded ones (which are then recorded); it returns
+    the child's status when ticked, RUNNING otherwise.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.recorded: tuple[Any, Any] = (None, None)
+        self.updated = True
+
+    def tick_node(self) -> NodeStatus:
+        if self.bt_status in (IDLE, NodeStatus.SKIPPED):
+            self.recorded = self.current_goals()
+            self.updated = True
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+        now = self.current_goals()
+        if now != self.recorded:
+            self.recorded = now
+            self.updated = True
+        if self.child.bt_status is RUNNING or self.updated:
+            self.updated = False
+            return self.child.execute_tick()
+        return RUNNING
