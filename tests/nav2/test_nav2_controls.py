@@ -229,3 +229,42 @@ def test_time_expired_succeeds_once_per_period() -> None:
         clock.advance(dt)
         seen.append(node.execute_tick().value)
     assert seen == ["FAILURE", "FAILURE", "SUCCESS", "FAILURE", "SUCCESS"]
+
+
+def test_goal_updated_controller_ticks_its_child_when_the_goal_changes() -> None:
+    tree, _ = make(
+        f"<PipelineSequence><GoalUpdatedController>{kid('plan')}</GoalUpdatedController>"
+        f"{kid('drive')}</PipelineSequence>",
+        {"plan": "S", "drive": "R"},
+    )
+    tree.blackboard.set("goal", "1;0;0")
+    planned = []
+    for goal in ("1;0;0", "1;0;0", "2;0;0", "2;0;0"):
+        tree.blackboard.set("goal", goal)
+        _, log = tick(tree)
+        planned.append(("tick", "plan") in log)
+    assert planned == [True, False, True, False]
+
+
+def test_global_updated_goal_is_not_reset_with_its_parent() -> None:
+    tree = load_tree_string(
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><GlobalUpdatedGoal/></BehaviorTree></root>',
+        blackboard={"goal": "1;2;0"},
+    )
+    seen = []
+    for goal in ("1;2;0", "1;2;0", "4;2;0", "4;2;0"):
+        tree.blackboard.set("goal", goal)
+        seen.append(tree.tick().value)  # the root is reset after each tick
+    assert seen == ["FAILURE", "FAILURE", "SUCCESS", "FAILURE"]
+
+
+def test_selectors_select_the_default() -> None:
+    tree = load_tree_string(
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence>'
+        '<PlannerSelector selected_planner="{p}" default_planner="GridBased"/>'
+        '<ControllerSelector selected_controller="{c}" default_controller="FollowPath"/>'
+        '<GoalCheckerSelector selected_goal_checker="{g}" default_goal_checker="general"/>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    assert tree.tick().value == "SUCCESS"
+    assert [tree.blackboard.get(k) for k in "pcg"] == ["GridBased", "FollowPath", "general"]

@@ -7,6 +7,7 @@ import math
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
@@ -127,3 +128,49 @@ def test_validate_and_the_groot_model_know_nav2s_nodes(
     path = tmp_path / "nav2_model.xml"
     path.write_text(model)
     assert cli.main(["validate", str(DEFAULT_TREE), "--models", str(path)]) == 0
+
+
+REPLAN_IF_INVALID = """
+<root BTCPP_format="4">
+  <BehaviorTree ID="ReplanWhenBlocked">
+    <PipelineSequence>
+      <PlannerSelector selected_planner="{planner}" default_planner="GridBased"/>
+      <RateController hz="2.0">
+        <Fallback>
+          <ReactiveSequence>
+            <Inverter><GlobalUpdatedGoal/></Inverter>
+            <IsPathValid path="{path}"/>
+          </ReactiveSequence>
+          <ComputePathToPose goal="{goal}" path="{path}" planner_id="{planner}"/>
+        </Fallback>
+      </RateController>
+      <FollowPath path="{path}" error_code_id="{follow_code}"/>
+    </PipelineSequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def test_a_path_made_invalid_is_planned_again_and_followed_round_the_obstacle() -> None:
+    import pybullet as pb
+
+    with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
+        tree = load_tree(
+            "replan.xml", text=REPLAN_IF_INVALID,
+            context=TreeContext(clock=world.clock, world=world), blackboard={"goal": "east"},
+        )
+        assert tree.tick() is NodeStatus.RUNNING
+        first = tree.blackboard.get("path")
+        ahead = first.poses[int(np.argmin(np.abs(first.poses[:, 0] - 0.0)))]
+        crate = world.movable["crate"]
+        pb.resetBasePositionAndOrientation(crate, [ahead[0], ahead[1], 0.15], [0, 0, 0, 1],
+                                           physicsClientId=world.client)
+        world.step(12)
+        status, _ = run(world, tree)
+        assert status is NodeStatus.SUCCESS
+        assert tree.blackboard.get("path") is not first  # planned again
+        moved, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)
+        assert math.hypot(moved[0] - ahead[0], moved[1] - ahead[1]) <= 0.02  # not pushed
+        east = world.poses["east"]
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - east.x, y - east.y) <= 0.25
