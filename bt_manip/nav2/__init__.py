@@ -8,8 +8,9 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 - conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
   WouldAControllerRecoveryHelp (:mod:`.conditions`); GoalReached, DistanceTraveled,
   TimeExpired, IsPathValid (:mod:`.progress`);
-- actions: ComputePathToPose, FollowPath, ClearEntireCostmap, Spin, BackUp, DriveOnHeading,
-  Wait (:mod:`.actions`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
+- actions: ComputePathToPose, FollowPath, Spin, BackUp, DriveOnHeading, Wait
+  (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
+  (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
   SmootherSelector (:mod:`.selectors`).
 
 The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
@@ -17,6 +18,16 @@ paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
 (:mod:`.errors`). Planning and following are bt-manip's navigation of the robot's base.
 """
 
-from bt_manip.nav2 import actions, conditions, controls, decorators, progress, selectors
+from bt_manip.nav2 import (
+    actions,
+    clearing,
+    conditions,
+    controls,
+    decorators,
+    progress,
+    selectors,
+)
 
-__all__ = ["actions", "conditions", "controls", "decorators", "progress", "selectors"]
+__all__ = [
+    "actions", "clearing", "conditions", "controls", "decorators", "progress", "selectors"
+]

@@ -4,8 +4,6 @@
   Navigator`), written to the blackboard as a :class:`~bt_manip.nav2.path.Nav2Path`.
 - FollowPath: the base's path follower on that path; a new path on the blackboard is taken
   over on the fly, as Nav2's controller server does when the tree replans.
-- ClearEntireCostmap: forgets what the robot's map has marked (the movable objects are drawn
-  again, where they are now, at the next plan).
 - Spin, BackUp, Wait: Nav2's behaviours on the base, with their result codes.
 
 Every node writes Nav2's numeric result code to ``error_code_id`` and its text to
@@ -270,31 +268,6 @@ class FollowPath(Nav2Action):
             self.fail(ControllerError.FAILED_TO_MAKE_PROGRESS, status.reason)
         robot.set_base_twist(*status.cmd)
         return Status.RUNNING
-
-
-@registry.register
-class ClearEntireCostmap(Nav2Action):
-    """Clears the robot's costmap: what it has marked is forgotten, and the next plan draws the
-    movable objects again where they are now. bt-manip keeps one map per robot, so the local
-    and global costmaps (``service_name``) are the same one. SUCCESS at once (FAILURE only
-    without a world or a mobile base)."""
-
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        **RobotAction.INPUT_PORTS,
-        "service_name": PortInformation(str, False, "Service name", ""),
-        "server_timeout": PortInformation(float, False, "Server timeout (ms)", 50.0),
-    }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
-
-    def _set_result(self, code: int, message: str) -> None:
-        pass
-
-    def begin(self) -> None:
-        nav = navigator_for(self.world, self.base())
-        nav.costmap = nav.costmap.with_grid(nav.static)
-
-    def step(self) -> Status:
-        return Status.SUCCESS
 
 
 class _BaseBehavior(Nav2Action):

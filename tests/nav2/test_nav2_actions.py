@@ -187,3 +187,16 @@ def test_is_path_valid_until_an_object_lands_on_the_path(room: World) -> None:
     check = load(room, '<IsPathValid path="{path}"/>', {"path": path})
     assert check.tick().value == "FAILURE"
     assert "obstacle lies on the path" in check.root.feedback_message
+
+
+@pytest.mark.parametrize(("node", "kept"), [("ClearCostmapAroundRobot", True),
+                                            ("ClearCostmapExceptRegion", False)])
+def test_clearing_round_the_robot_or_except_there(room: World, node: str, kept: bool) -> None:
+    report, _ = run(room, '<ComputePathToPose goal="east" path="{path}"/>')
+    assert report.status == "SUCCESS", report.reason
+    nav = navigator_for(room, room.robots["husky"])
+    crate = room.movable["crate"]  # about 4 m from the robot
+    report, _ = run(room, f'<{node} reset_distance="1.5"/>')
+    assert report.status == "SUCCESS"
+    assert (crate in nav.costmap.grid.sources) is kept
+    assert nav.costmap.grid.occupied.sum() > nav.static.occupied.sum() or not kept
