@@ -11,7 +11,8 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 - actions: ComputePathToPose, FollowPath, Spin, BackUp, DriveOnHeading, Wait
   (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
-  SmootherSelector (:mod:`.selectors`).
+  SmootherSelector (:mod:`.selectors`); ComputePathThroughPoses, RemovePassedGoals
+  (:mod:`.through_poses`).
 
 The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
 paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
@@ -26,8 +27,10 @@ from bt_manip.nav2 import (
     decorators,
     progress,
     selectors,
+    through_poses,
 )
 
 __all__ = [
-    "actions", "clearing", "conditions", "controls", "decorators", "progress", "selectors"
+    "actions", "clearing", "conditions", "controls", "decorators", "progress", "selectors",
+    "through_poses",
 ]

@@ -174,3 +174,53 @@ def test_a_path_made_invalid_is_planned_again_and_followed_round_the_obstacle() 
         east = world.poses["east"]
         x, y, _ = world.robots["husky"].base_pose2d()
         assert math.hypot(x - east.x, y - east.y) <= 0.25
+
+
+THROUGH_POSES = """
+<root BTCPP_format="4">
+  <BehaviorTree ID="ThroughPoses">
+    <PipelineSequence>
+      <RateController hz="1.0">
+        <Sequence>
+          <RemovePassedGoals input_goals="{goals}" output_goals="{goals}" radius="0.5"/>
+          <ComputePathThroughPoses goals="{goals}" path="{path}" error_code_id="{code}"/>
+        </Sequence>
+      </RateController>
+      <FollowPath path="{path}"/>
+    </PipelineSequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def test_through_poses_passes_each_goal_and_ends_on_the_last() -> None:
+    with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
+        tree = load_tree(
+            "through.xml", text=THROUGH_POSES,
+            context=TreeContext(clock=world.clock, world=world),
+            blackboard={"goals": "-0.2;1.2;0|1.8;0.5;0"},
+        )
+        closest = [math.inf]
+
+        def watch(_: list[str]) -> None:
+            x, y, _ = world.robots["husky"].base_pose2d()
+            closest[0] = min(closest[0], math.hypot(x + 0.2, y - 1.2))
+
+        status, _ = run(world, tree, on_tick=watch)
+        assert status is NodeStatus.SUCCESS
+        assert closest[0] <= 0.5  # it went by the first goal
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - 1.8, y - 0.5) <= 0.25
+        assert tree.blackboard.get("goals") == [(1.8, 0.5, 0.0)]  # the first one was passed
+        assert tree.blackboard.get("code") == 0
+
+
+def test_through_poses_without_goals_gives_no_viapoints() -> None:
+    with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
+        tree = load_tree(
+            "through.xml", text=THROUGH_POSES,
+            context=TreeContext(clock=world.clock, world=world), blackboard={"goals": ""},
+        )
+        status, _ = run(world, tree)
+        assert status is NodeStatus.FAILURE
+        assert tree.blackboard.get("code") == 309  # NO_VIAPOINTS_GIVEN
