@@ -3,7 +3,8 @@
 Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 
 - controls: PipelineSequence, RecoveryNode, RoundRobin (:mod:`.controls`);
-- decorators: RateController, DistanceController, SingleTrigger, GoalUpdatedController
+- decorators: RateController, DistanceController, SpeedController, SingleTrigger,
+  GoalUpdatedController
   (:mod:`.decorators`);
 - conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
   WouldAControllerRecoveryHelp (:mod:`.conditions`); GoalReached, DistanceTraveled,

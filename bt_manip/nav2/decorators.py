@@ -168,3 +168,73 @@ class GoalUpdatedController(GoalsReader, DecoratorNode):
             self.updated = False
             return self.child.execute_tick()
         return RUNNING
+
+
+@registry.register
+class SpeedController(GoalsReader, WorldAccess, DecoratorNode):
+    """Ticks its child at a rate that grows with the robot's speed: ``min_rate`` at
+    ``min_speed`` and below, ``max_rate`` above ``max_speed``, in proportion between.
+
+    From IDLE, and whenever the goal (``goal`` / ``goals``, or those blackboard entries)
+    changes, the child is ticked at once. Otherwise the child is ticked while it is RUNNING or
+    once the period (1 / rate, the rate taken from the speed when the child was last ticked)
+    has passed; it returns the child's status when ticked, RUNNING otherwise. The speed is the
+    base's speed now (Nav2 smooths odometry over ``filter_duration``).
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "robot": ROBOT_PORT,
+        **GOAL_PORTS,
+        "min_rate": Port(float, False, "Minimum rate (Hz)", 0.1, POSITIVE),
+        "max_rate": Port(float, False, "Maximum rate (Hz)", 1.0, POSITIVE),
+        "min_speed": Port(float, False, "Minimum speed (m/s)", 0.0),
+        "max_speed": Port(float, False, "Maximum speed (m/s)", 0.5),
+        "filter_duration": Port(float, False, "Duration (s) for velocity smoothing filter",
+                                0.3),
+    }
+
+    def __init__(self, name: str | None = None, child: BtNode | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, child, **attributes)
+        self.recorded: tuple[Any, Any] = (None, None)
+        self.period = 1.0
+        self.started = 0.0
+        self.first_tick = True
+
+    def _restart(self, now: float) -> None:
+        self.period = 1.0 / float(self.get_input("max_rate"))
+        self.started = now
+        self.first_tick = True
+
+    def _update_period(self) -> None:
+        vx, vy, _ = self.robot().base_velocity()
+        speed = math.hypot(vx, vy)
+        lo_rate, hi_rate = float(self.get_input("min_rate")), float(self.get_input("max_rate"))
+        lo, hi = float(self.get_input("min_speed")), float(self.get_input("max_speed"))
+        if speed < lo or speed > hi or hi <= lo:
+            self.period = 1.0 / (lo_rate if speed < lo else hi_rate)
+            return
+        self.period = 1.0 / (lo_rate + (hi_rate - lo_rate) * (speed - lo) / (hi - lo))
+
+    def tick_node(self) -> NodeStatus:
+        now = self.now()
+        if self.bt_status in (IDLE, NodeStatus.SKIPPED):
+            self.recorded = self.current_goals()
+            self._restart(now)
+        goals = self.current_goals()
+        if goals != self.recorded:
+            self.recorded = goals
+            self._restart(now)
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+        due = now - self.started >= self.period - 1e-9
+        if self.first_tick or self.child.bt_status is RUNNING or due:
+            self.first_tick = False
+            try:
+                self._update_period()
+            except ActionFailed as exc:
+                self.feedback_message = str(exc)
+                return FAILURE
+            self.started = now
+            return self.child.execute_tick()
+        return RUNNING

@@ -200,3 +200,23 @@ def test_clearing_round_the_robot_or_except_there(room: World, node: str, kept: 
     assert report.status == "SUCCESS"
     assert (crate in nav.costmap.grid.sources) is kept
     assert nav.costmap.grid.occupied.sum() > nav.static.occupied.sum() or not kept
+
+
+def test_speed_controller_ticks_slowly_while_the_robot_stands_and_at_once_on_a_new_goal(
+    room: World,
+) -> None:
+    tree = load(room, '<PipelineSequence><SpeedController min_rate="0.2" max_rate="2.0">'
+                      '<Script code="n += 1"/></SpeedController>'
+                      '<Wait wait_duration="100"/></PipelineSequence>', {"n": 0, "goal": "a"})
+    counts = []
+    for k in range(120):  # 6 s of sim time at 20 Hz
+        if k == 110:
+            tree.blackboard.set("goal", "b")
+        tree.tick()
+        room.step(12)
+        counts.append(tree.blackboard.get("n"))
+    # standing still: 0.2 Hz, so once at the start and once 5 s later; a new goal: at once
+    assert counts[0] == 1
+    assert counts[90] == 1
+    assert counts[105] == 2
+    assert counts[110] == 3
