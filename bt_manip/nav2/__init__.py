@@ -4,11 +4,10 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 
 - controls: PipelineSequence, RecoveryNode, RoundRobin (:mod:`.controls`);
 - decorators: RateController, DistanceController, SpeedController, SingleTrigger,
-  GoalUpdatedController
-  (:mod:`.decorators`);
+  GoalUpdatedController (:mod:`.decorators`);
 - conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
-  WouldAControllerRecoveryHelp (:mod:`.conditions`); GoalReached, DistanceTraveled,
-  TimeExpired, IsPathValid (:mod:`.progress`);
+  WouldAControllerRecoveryHelp, WouldASmootherRecoveryHelp (:mod:`.conditions`);
+  GoalReached, DistanceTraveled, TimeExpired, IsPathValid (:mod:`.progress`);
 - actions: ComputePathToPose, FollowPath, Spin, BackUp, DriveOnHeading, Wait
   (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,

@@ -10,7 +10,11 @@ from py_trees.ports import PortInformation
 from bt_manip.bt.node import ConditionNode
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
-from bt_manip.nav2.errors import CONTROLLER_RECOVERABLE, PLANNER_RECOVERABLE
+from bt_manip.nav2.errors import (
+    CONTROLLER_RECOVERABLE,
+    PLANNER_RECOVERABLE,
+    SMOOTHER_RECOVERABLE,
+)
 
 
 def _codes(text: Any) -> frozenset[int]:
@@ -67,6 +71,20 @@ class WouldAControllerRecoveryHelp(AreErrorCodesPresent):
 
     def codes(self) -> frozenset[int]:
         return frozenset(int(c) for c in CONTROLLER_RECOVERABLE)
+
+
+@registry.register
+class WouldASmootherRecoveryHelp(AreErrorCodesPresent):
+    """SUCCESS when ``error_code`` is a smoother failure that a recovery may cure (500 UNKNOWN,
+    502 TIMEOUT, 503 SMOOTHED_PATH_IN_COLLISION, 504 FAILED_TO_SMOOTH_PATH), FAILURE
+    otherwise."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "error_code": PortInformation(int, False, "The active error code to compare against", 0),
+    }
+
+    def codes(self) -> frozenset[int]:
+        return frozenset(int(c) for c in SMOOTHER_RECOVERABLE)
 
 
 GOAL_PORTS: dict[str, PortInformation] = {

@@ -43,6 +43,18 @@ class BehaviorError(enum.IntEnum):
     COLLISION_AHEAD = 703
 
 
+class SmootherError(enum.IntEnum):
+    """SmoothPath result codes."""
+
+    NONE = 0
+    UNKNOWN = 500
+    INVALID_SMOOTHER = 501
+    TIMEOUT = 502
+    SMOOTHED_PATH_IN_COLLISION = 503
+    FAILED_TO_SMOOTH_PATH = 504
+    INVALID_PATH = 505
+
+
 PLANNER_RECOVERABLE = frozenset(
     {PlannerError.UNKNOWN, PlannerError.NO_VALID_PATH, PlannerError.TIMEOUT}
 )
@@ -57,3 +69,13 @@ CONTROLLER_RECOVERABLE = frozenset(
     }
 )
 """Controller failures that a recovery may cure (WouldAControllerRecoveryHelp)."""
+
+SMOOTHER_RECOVERABLE = frozenset(
+    {
+        SmootherError.UNKNOWN,
+        SmootherError.TIMEOUT,
+        SmootherError.SMOOTHED_PATH_IN_COLLISION,
+        SmootherError.FAILED_TO_SMOOTH_PATH,
+    }
+)
+"""Smoother failures that a recovery may cure (WouldASmootherRecoveryHelp)."""

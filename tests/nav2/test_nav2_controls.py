@@ -171,14 +171,16 @@ def test_error_code_conditions() -> None:
         '<Sequence><WouldAPlannerRecoveryHelp error_code="{plan}"/>'
         '<WouldAControllerRecoveryHelp error_code="{follow}"/>'
         '<AreErrorCodesPresent error_code="{other}" error_codes_to_check="701,703"/>'
+        '<WouldASmootherRecoveryHelp error_code="{smooth}"/>'
         "</Sequence>"
     )
     cases: list[tuple[dict[str, Any], str]] = [
-        ({"plan": 208, "follow": 105, "other": 703}, "SUCCESS"),
-        ({"plan": 200, "follow": 106, "other": 701}, "SUCCESS"),
-        ({"plan": 206, "follow": 105, "other": 703}, "FAILURE"),  # goal occupied: no help
-        ({"plan": 207, "follow": 103, "other": 703}, "FAILURE"),  # invalid path: no help
-        ({"plan": 207, "follow": 104, "other": 700}, "FAILURE"),
+        ({"plan": 208, "follow": 105, "other": 703, "smooth": 504}, "SUCCESS"),
+        ({"plan": 200, "follow": 106, "other": 701, "smooth": 503}, "SUCCESS"),
+        ({"plan": 206, "follow": 105, "other": 703, "smooth": 500}, "FAILURE"),  # goal occupied
+        ({"plan": 207, "follow": 103, "other": 703, "smooth": 502}, "FAILURE"),  # invalid path
+        ({"plan": 207, "follow": 104, "other": 700, "smooth": 502}, "FAILURE"),
+        ({"plan": 207, "follow": 104, "other": 701, "smooth": 505}, "FAILURE"),  # invalid path
     ]
     for values, expected in cases:
         tree = load_tree_string(
