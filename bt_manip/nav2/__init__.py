@@ -12,7 +12,8 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
   (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
   SmootherSelector (:mod:`.selectors`); ComputePathThroughPoses, RemovePassedGoals
-  (:mod:`.through_poses`).
+  (:mod:`.through_poses`); TruncatePath, PathLongerOnApproach (a decorator) and
+  InitialPoseReceived (:mod:`.path_nodes`).
 
 The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
 paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
@@ -25,12 +26,13 @@ from bt_manip.nav2 import (
     conditions,
     controls,
     decorators,
+    path_nodes,
     progress,
     selectors,
     through_poses,
 )
 
 __all__ = [
-    "actions", "clearing", "conditions", "controls", "decorators", "progress", "selectors",
-    "through_poses",
+    "actions", "clearing", "conditions", "controls", "decorators", "path_nodes", "progress",
+    "selectors", "through_poses",
 ]

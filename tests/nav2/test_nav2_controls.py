@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from typing import Any, ClassVar
 
+import numpy as np
 import pytest
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -12,6 +13,7 @@ from py_trees.ports import PortInformation
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import ActionNode, Tree, TreeContext, load_tree_string, registry
 from bt_manip.clock import ManualClock
+from bt_manip.nav2.path import Nav2Path
 
 SCRIPTS: dict[str, list[str]] = {}
 """Per scripted child: the statuses it returns, one per tick (the last one repeats)."""
@@ -270,3 +272,48 @@ def test_selectors_select_the_default() -> None:
     )
     assert tree.tick().value == "SUCCESS"
     assert [tree.blackboard.get(k) for k in "pcg"] == ["GridBased", "FollowPath", "general"]
+
+
+def straight(length: float, n: int = 11) -> Nav2Path:
+    xs = np.linspace(0.0, length, n)
+    return Nav2Path(np.column_stack([xs, np.zeros(n), np.zeros(n)]), length=length)
+
+
+def test_truncate_path_stops_short_of_the_goal_facing_it() -> None:
+    tree = load_tree_string(
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><TruncatePath input_path="{path}" '
+        'output_path="{short}" distance="0.45"/></BehaviorTree></root>',
+        blackboard={"path": straight(2.0)},
+    )
+    assert tree.tick().value == "SUCCESS"
+    short = tree.blackboard.get("short")
+    assert short.goal == pytest.approx((1.4, 0.0, 0.0))  # 0.6 m before the end: >= 0.45
+    assert short.length == pytest.approx(1.4)
+
+
+def test_path_longer_on_approach_ticks_its_child_for_a_much_longer_path_near_the_goal() -> None:
+    tree, _ = make(
+        f"<PipelineSequence><PathLongerOnApproach path=\"{{path}}\" prox_len=\"3\" "
+        f"length_factor=\"2\">{kid('wait')}</PathLongerOnApproach>{kid('drive')}"
+        "</PipelineSequence>",
+        {"wait": "RS", "drive": "R"},
+    )
+    ran = []
+    for path in (straight(2.5), straight(2.0), straight(5.0), straight(5.0)):
+        tree.blackboard.set("path", path)
+        _, log = tick(tree)
+        ran.append(("tick", "wait") in log)
+    # first tick: only records; shorter path: no; 5 m after 2 m within 3 m of the goal: the
+    # child runs (RUNNING), then finishes (SUCCESS)
+    assert ran == [False, False, True, True]
+    tree.blackboard.set("path", straight(4.5))  # not near the goal any more (5 m before)
+    _, log = tick(tree)
+    assert ("tick", "wait") not in log
+
+
+def test_initial_pose_received_reads_the_blackboard() -> None:
+    body = '<root BTCPP_format="4"><BehaviorTree ID="M"><InitialPoseReceived/></BehaviorTree>' \
+           "</root>"
+    assert load_tree_string(body, blackboard={"initial_pose_received": True}).tick().value == \
+        "SUCCESS"
+    assert load_tree_string(body).tick().value == "FAILURE"
