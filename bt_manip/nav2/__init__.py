@@ -7,7 +7,7 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
   GoalUpdatedController (:mod:`.decorators`);
 - conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
   WouldAControllerRecoveryHelp, WouldASmootherRecoveryHelp (:mod:`.conditions`);
-  GoalReached, DistanceTraveled, TimeExpired, IsPathValid (:mod:`.progress`);
+  GoalReached, DistanceTraveled, TimeExpired, IsPathValid, IsStuck (:mod:`.progress`);
 - actions: ComputePathToPose, FollowPath, Spin, BackUp, DriveOnHeading, Wait
   (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,

@@ -1,5 +1,6 @@
-"""Nav2's conditions on the robot's progress: GoalReached, DistanceTraveled, TimeExpired and
-IsPathValid. They read the robot's pose in the world and the tree's clock."""
+"""Nav2's conditions on the robot's progress: GoalReached, DistanceTraveled, TimeExpired,
+IsPathValid and IsStuck. They read the robot's pose and speed in the world and the tree's
+clock."""
 
 from __future__ import annotations
 
@@ -161,3 +162,30 @@ class IsPathValid(WorldCondition):
             k = int(np.argmax(blocked))
             return False, f"an obstacle lies on the path at ({ahead[k, 0]:.2f}, {ahead[k, 1]:.2f})"
         return True, ""
+
+
+BRAKE_ACCEL_LIMIT = -10.0
+"""Nav2's IsStuck threshold: a forward deceleration (m/s^2) beyond it means the robot hit
+something."""
+
+
+@registry.register
+class IsStuck(WorldCondition):
+    """SUCCESS when the base's forward speed fell faster than 10 m/s^2 since the last tick
+    (it ran into something), FAILURE otherwise (and on the first tick, which has nothing to
+    compare with)."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
+
+    previous: tuple[float, float] | None = None
+
+    def check(self) -> tuple[bool, str]:
+        speed = self.robot().base_velocity()[0]
+        now = self.now()
+        before, self.previous = self.previous, (now, speed)
+        if before is None or now <= before[0]:
+            return False, "robot is free"
+        accel = (speed - before[1]) / (now - before[0])
+        if accel < BRAKE_ACCEL_LIMIT:
+            return True, ""
+        return False, "robot is free"

@@ -220,3 +220,20 @@ def test_speed_controller_ticks_slowly_while_the_robot_stands_and_at_once_on_a_n
     assert counts[90] == 1
     assert counts[105] == 2
     assert counts[110] == 3
+
+
+def test_is_stuck_on_a_sudden_stop(room: World) -> None:
+    import pybullet as pb
+
+    robot = room.robots["husky"]
+    cond = load(room, "<IsStuck/>")
+    pb.resetBaseVelocity(robot.body, [1.0, 0, 0], [0, 0, 0], physicsClientId=room.client)
+    assert cond.tick().value == "FAILURE"  # nothing to compare with yet
+    room.step(1)
+    pb.resetBaseVelocity(robot.body, [0.9, 0, 0], [0, 0, 0], physicsClientId=room.client)
+    room.step(11)
+    pb.resetBaseVelocity(robot.body, [0.9, 0, 0], [0, 0, 0], physicsClientId=room.client)
+    assert cond.tick().value == "FAILURE"  # slowing down gently
+    room.step(12)
+    pb.resetBaseVelocity(robot.body, [0.0, 0, 0], [0, 0, 0], physicsClientId=room.client)
+    assert cond.tick().value == "SUCCESS"  # 0.9 m/s to rest within a tick: it hit something
