@@ -57,7 +57,8 @@ def plan_error(outcome: PlanOutcome, reason: str) -> PlannerError:
     return PLAN_ERRORS.get(outcome, PlannerError.UNKNOWN)
 
 
-def _error_ports(doc: str) -> dict[str, PortInformation]:
+def error_ports(doc: str) -> dict[str, PortInformation]:
+    """Nav2's ``error_code_id`` and ``error_msg`` output ports."""
     return {
         "error_code_id": PortInformation(int, False, f"{doc} error code"),
         "error_msg": PortInformation(str, False, f"{doc} error message"),
@@ -73,10 +74,17 @@ class Nav2Failed(ActionFailed):
 
 
 class Nav2Action(RobotAction):
-    """A Nav2 action: reports Nav2's result code and message on its ports. As Nav2's action
-    nodes, it starts again when ticked after it finished (it is not stateful)."""
+    """A Nav2 action: reports Nav2's result code and message on its ports (0 and "" while it
+    runs and on SUCCESS; on FAILURE the code given to :meth:`fail`, else ``UNKNOWN``). As
+    Nav2's action nodes, it starts again when ticked after it finished (it is not stateful).
+
+    Subclasses implement :meth:`begin` (instead of ``start``) and ``step``.
+    """
 
     STATEFUL = False
+    UNKNOWN: ClassVar[int] = 0
+    """The result code of a failure that gave none (Nav2's UNKNOWN of the server)."""
+    _code: int = 0
 
     def initialise(self) -> None:
         self._set_result(0, "")
@@ -92,9 +100,6 @@ class Nav2Action(RobotAction):
         elif status == Status.SUCCESS:
             self._set_result(0, "")
         return status
-
-    UNKNOWN: ClassVar[int] = 0
-    _code: int = 0
 
     def fail(self, code: int, reason: str) -> None:
         """End the action with FAILURE, result ``code`` and ``reason``."""
@@ -159,7 +164,7 @@ class ComputePathToPose(Nav2Action):
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathToPose node"),
-        **_error_ports("The compute path to pose"),
+        **error_ports("The compute path to pose"),
     }
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
@@ -222,7 +227,7 @@ class FollowPath(Nav2Action):
             str, False, "Mapped name of the progress checker", ""
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("The follow path")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("The follow path")
 
     def _path(self) -> Nav2Path:
         try:
@@ -336,7 +341,7 @@ class Spin(_BaseBehavior):
         **BEHAVIOR_PORTS,
         "spin_dist": Port(float, False, "Spin distance (rad)", 1.57),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("Spin")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Spin")
 
     def begin(self) -> None:
         super().begin()
@@ -387,7 +392,7 @@ class BackUp(_Drive):
         "backup_dist": Port(float, False, "Distance to backup (m)", 0.15, POSITIVE),
         "backup_speed": Port(float, False, "Speed at which to backup (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("Back up")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Back up")
 
     def begin(self) -> None:
         super().begin()
@@ -406,7 +411,7 @@ class DriveOnHeading(_Drive):
         "dist_to_travel": Port(float, False, "Distance to travel (m)", 0.15),
         "speed": Port(float, False, "Speed at which to travel (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("Drive on heading")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Drive on heading")
 
     def begin(self) -> None:
         super().begin()
@@ -420,7 +425,7 @@ class Wait(Nav2Action):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "wait_duration": Port(float, False, "Wait time (s)", 1.0, NON_NEGATIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _error_ports("Wait")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Wait")
     UNKNOWN = BehaviorError.UNKNOWN
 
     def begin(self) -> None:

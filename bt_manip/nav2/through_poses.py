@@ -21,7 +21,7 @@ from bt_manip.behaviours.navigate import navigator_for
 from bt_manip.bt.node import PortError, SyncActionNode
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
-from bt_manip.nav2.actions import Nav2Action, _error_ports, plan_error
+from bt_manip.nav2.actions import Nav2Action, error_ports, plan_error
 from bt_manip.nav2.blocking import maybe_block
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
 
@@ -72,7 +72,7 @@ class ComputePathThroughPoses(Nav2Action):
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
-        **_error_ports("The compute path through poses"),
+        **error_ports("The compute path through poses"),
     }
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
