@@ -8,6 +8,7 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
 - conditions: GoalUpdated, GlobalUpdatedGoal, AreErrorCodesPresent, WouldAPlannerRecoveryHelp,
   WouldAControllerRecoveryHelp, WouldASmootherRecoveryHelp (:mod:`.conditions`);
   GoalReached, DistanceTraveled, TimeExpired, IsPathValid, IsStuck (:mod:`.progress`);
+  TransformAvailable (:mod:`.frames`);
 - actions: ComputePathToPose, FollowPath, Spin, BackUp, DriveOnHeading, Wait
   (:mod:`.actions`); ClearEntireCostmap, ClearCostmapAroundRobot, ClearCostmapExceptRegion
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
@@ -26,6 +27,7 @@ from bt_manip.nav2 import (
     conditions,
     controls,
     decorators,
+    frames,
     path_nodes,
     progress,
     selectors,
@@ -33,6 +35,6 @@ from bt_manip.nav2 import (
 )
 
 __all__ = [
-    "actions", "clearing", "conditions", "controls", "decorators", "path_nodes", "progress",
-    "selectors", "through_poses",
+    "actions", "clearing", "conditions", "controls", "decorators", "frames", "path_nodes",
+    "progress", "selectors", "through_poses",
 ]

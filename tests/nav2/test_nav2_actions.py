@@ -237,3 +237,11 @@ def test_is_stuck_on_a_sudden_stop(room: World) -> None:
     room.step(12)
     pb.resetBaseVelocity(robot.body, [0.0, 0, 0], [0, 0, 0], physicsClientId=room.client)
     assert cond.tick().value == "SUCCESS"  # 0.9 m/s to rest within a tick: it hit something
+
+
+def test_transform_available_for_the_world_the_base_and_links(room: World) -> None:
+    ok = load(room, '<TransformAvailable parent="map" child="base_link"/>')
+    assert ok.tick().value == "SUCCESS"
+    missing = load(room, '<TransformAvailable parent="map" child="laser_frame"/>')
+    assert missing.tick().value == "FAILURE"
+    assert "laser_frame" in missing.root.feedback_message
