@@ -127,7 +127,8 @@ class Episode:
 def _load_behaviours(imports: Sequence[str] = ()) -> None:
     """Register the robot behaviours and the user's modules' nodes with the node registry
     (importing them does it); InputError naming ``--import`` when a user's module fails."""
-    import bt_manip.behaviours  # noqa: F401
+    import bt_manip.behaviours
+    import bt_manip.nav2  # noqa: F401
     from bt_manip.errors import InputError
     from bt_manip.plugins import import_modules
 

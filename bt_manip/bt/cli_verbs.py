@@ -19,7 +19,7 @@ from bt_manip.errors import InputError, Problem
 from bt_manip.outputs import check_output_file, write_text
 from bt_manip.plugins import add_import_flag, import_modules
 
-PLUGIN_PACKAGES = ("bt_manip.behaviours",)
+PLUGIN_PACKAGES = ("bt_manip.behaviours", "bt_manip.nav2")
 
 
 def load_plugins(extra: Iterable[str] = ()) -> list[Problem]:

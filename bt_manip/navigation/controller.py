@@ -172,6 +172,16 @@ class PathFollower:
         n = float(np.hypot(*d))
         self._end_dir = (float(d[0] / n), float(d[1] / n)) if n > 1e-9 else (1.0, 0.0)
 
+    def follow(self, path: np.ndarray, goal: tuple[float, ...]) -> None:
+        """Take over a new ``path`` (and ``goal``) from where the base is, keeping its speed:
+        the tree replanned while the base drives."""
+        self.goal_xy = (float(goal[0]), float(goal[1]))
+        self.goal_yaw = float(goal[2]) if len(goal) > 2 else None
+        self._set_path(np.asarray(path, dtype=float))
+        self._best_time = self._last_time
+        if self._phase in ("approach", "align") and self.remaining() > self.options.xy_tolerance:
+            self._phase = "drive"
+
     @property
     def path_end(self) -> tuple[float, float]:
         return float(self.path[-1, 0]), float(self.path[-1, 1])

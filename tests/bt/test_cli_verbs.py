@@ -74,12 +74,11 @@ def test_validate_ok_and_all_problems(capsys: pytest.CaptureFixture[str]) -> Non
 
 def test_validate_nav2_with_models(capsys: pytest.CaptureFixture[str]) -> None:
     tree = SAMPLES / "nav2/navigate_to_pose_w_replanning_and_recovery.xml"
+    # bt-manip's own Nav2 nodes (bt_manip.nav2) declare what Nav2's older model lacks
     code = run_verb(["validate", str(tree), "--models", str(SAMPLES / "nav2/nav2_tree_nodes.xml")])
-    assert code == 2
+    assert code == 0
     lines = capsys.readouterr().err.strip().splitlines()
-    errors = [line for line in lines if ": warning:" not in line]
-    assert [int(line.split(":")[1]) for line in errors] == [12, 14, 20, 22, 29, 30, 33]
-    assert len(lines) == len(errors) + 1
+    assert [line for line in lines if ": warning:" not in line] == []
 
 
 def test_show_text_and_dot(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,0 +1,118 @@
+"""Nav2's costmap clearing: ClearEntireCostmap, ClearCostmapAroundRobot and
+ClearCostmapExceptRegion.
+
+The robot's map is its static grid (walls, furniture) with the movable objects drawn in where
+they were last seen. Clearing forgets the drawn objects (all of them, those within a square
+round the robot, or those outside it); the next plan draws them again where they are now.
+bt-manip keeps one map per robot, so the local and global costmaps a tree names
+(``service_name``) are the same map. Each node answers SUCCESS at once (FAILURE only without a
+world or a mobile base).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import RobotAction
+from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.bt.ports import POSITIVE, Port
+from bt_manip.bt.registry import registry
+from bt_manip.nav2.actions import Nav2Action
+from bt_manip.navigation.grid import OccupancyGrid
+from bt_manip.navigation.navigator import Navigator
+
+SERVICE_PORTS: dict[str, PortInformation] = {
+    **RobotAction.INPUT_PORTS,
+    "service_name": PortInformation(str, False, "Service name", ""),
+    "server_timeout": PortInformation(float, False, "Server timeout (ms)", 50.0),
+}
+
+
+def clear_map(nav: Navigator, keep: np.ndarray | None = None) -> None:
+    """Forget the objects drawn on ``nav``'s map, except in the cells where ``keep`` (a bool
+    grid) is True."""
+    grid = nav.costmap.grid
+    if keep is None or not grid.sources:
+        nav.costmap = nav.costmap.with_grid(nav.static)
+        return
+    flat_keep = keep.reshape(-1)
+    occupied = nav.static.occupied.copy()
+    flat = occupied.reshape(-1)
+    sources = {}
+    for body, idx in grid.sources.items():
+        kept = idx[flat_keep[idx]]
+        if kept.size:
+            flat[kept] = True
+            sources[body] = kept
+    s = nav.static
+    nav.costmap = nav.costmap.with_grid(OccupancyGrid(s.origin, s.resolution, occupied, s.band,
+                                                      sources))
+
+
+def square_round(nav: Navigator, x: float, y: float, half: float) -> np.ndarray:
+    """The cells of ``nav``'s map within the square of half side ``half`` centred on (x, y)."""
+    grid = nav.static
+    rows, cols = grid.shape
+    xs = grid.origin[0] + (np.arange(cols) + 0.5) * grid.resolution
+    ys = grid.origin[1] + (np.arange(rows) + 0.5) * grid.resolution
+    return (np.abs(ys - y)[:, None] <= half) & (np.abs(xs - x)[None, :] <= half)
+
+
+class _Clear(Nav2Action):
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+
+    def _set_result(self, code: int, message: str) -> None:
+        pass  # Nav2's clearing services report no result code
+
+    def step(self) -> Status:
+        return Status.SUCCESS
+
+
+@registry.register
+class ClearEntireCostmap(_Clear):
+    """Forgets every object drawn on the robot's map. SUCCESS."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = SERVICE_PORTS
+
+    def begin(self) -> None:
+        clear_map(navigator_for(self.world, self.base()))
+
+
+@registry.register
+class ClearCostmapAroundRobot(_Clear):
+    """Forgets the objects drawn within ``reset_distance`` (half the side of a square) of the
+    robot. SUCCESS."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **SERVICE_PORTS,
+        "reset_distance": Port(float, False, "Distance from the robot to clear (m)", 1.0,
+                               POSITIVE),
+    }
+
+    def begin(self) -> None:
+        robot = self.base()
+        nav = navigator_for(self.world, robot)
+        x, y, _ = robot.base_pose2d()
+        clear_map(nav, keep=~square_round(nav, x, y, float(self.get_input("reset_distance"))))
+
+
+@registry.register
+class ClearCostmapExceptRegion(_Clear):
+    """Forgets the objects drawn farther than ``reset_distance`` (half the side of a square)
+    from the robot, keeping those near it. SUCCESS."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **SERVICE_PORTS,
+        "reset_distance": Port(float, False, "Distance from the robot to keep (m)", 1.0,
+                               POSITIVE),
+    }
+
+    def begin(self) -> None:
+        robot = self.base()
+        nav = navigator_for(self.world, robot)
+        x, y, _ = robot.base_pose2d()
+        clear_map(nav, keep=square_round(nav, x, y, float(self.get_input("reset_distance"))))

@@ -1,0 +1,196 @@
+"""Nav2's control nodes: PipelineSequence, RecoveryNode and RoundRobin.
+
+They follow Nav2's ``nav2_behavior_tree`` plugins tick for tick. "Halt" of a child means: a
+RUNNING child is halted (its ``terminate(INVALID)`` runs once) and it goes back to IDLE; a child
+that finished is only set back to IDLE.
+"""
+
+from __future__ import annotations
+
+from typing import Any, ClassVar
+
+from py_trees.ports import PortInformation
+
+from bt_manip.bt.node import BtNode, ControlNode
+from bt_manip.bt.ports import NON_NEGATIVE, Port
+from bt_manip.bt.registry import registry
+from bt_manip.bt.status import NodeStatus
+
+RUNNING = NodeStatus.RUNNING
+SUCCESS = NodeStatus.SUCCESS
+FAILURE = NodeStatus.FAILURE
+SKIPPED = NodeStatus.SKIPPED
+
+
+class _Nav2Control(ControlNode):
+    def _start(self) -> None:
+        self.bt_status = RUNNING
+        self.status = RUNNING.to_py_trees()
+
+    def _kids(self) -> list[BtNode]:
+        return self.children  # type: ignore[return-value]
+
+
+@registry.register
+class PipelineSequence(_Nav2Control):
+    """Ticks its children in order, re-ticking every child it has already reached.
+
+    Each tick starts at the first child and goes on while children succeed, or are RUNNING but
+    lie before the furthest child reached so far (so an earlier child, such as a rate-limited
+    planner, keeps running alongside a later one, such as the controller):
+
+    - child FAILURE: halt every child and return FAILURE;
+    - child RUNNING at or beyond the furthest child reached: remember it, return RUNNING;
+    - child SUCCESS (or SKIPPED, or RUNNING before the furthest child): go on to the next one.
+
+    When the last child succeeds, every child is halted and it returns SUCCESS (SKIPPED when
+    every child was skipped).
+    """
+
+    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, children, **attributes)
+        self.last_child_ticked = 0
+
+    def tick_node(self) -> NodeStatus:
+        self._start()
+        skipped = 0
+        for index, child in enumerate(self._kids()):
+            status = child.execute_tick()
+            if status is FAILURE:
+                self.halt()
+                return FAILURE
+            if status is RUNNING and index >= self.last_child_ticked:
+                self.last_child_ticked = index
+                return RUNNING
+            if status is SKIPPED:
+                skipped += 1
+        all_skipped = skipped == len(self.children)
+        self.halt()
+        return SKIPPED if all_skipped else SUCCESS
+
+    def halt(self) -> None:
+        self.last_child_ticked = 0
+        super().halt()
+
+
+@registry.register
+class RecoveryNode(_Nav2Control):
+    """Runs its first child; when it fails, runs the second (the recovery) and tries again.
+
+    Exactly two children. First child:
+
+    - SUCCESS: halt both, return SUCCESS;
+    - RUNNING: return RUNNING;
+    - SKIPPED: halt both, return SKIPPED;
+    - FAILURE: with retries left, halt it and tick the recovery in the same tick; otherwise
+      halt both and return FAILURE.
+
+    Recovery child:
+
+    - SUCCESS: halt it, count one retry and tick the first child again in the same tick;
+    - RUNNING: return RUNNING;
+    - FAILURE: halt both, return FAILURE;
+    - SKIPPED: no recovery is possible: halt it and return FAILURE (not counted as a retry).
+
+    Halting resets the retry count.
+    """
+
+    MIN_CHILDREN = 2
+    MAX_CHILDREN = 2
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "number_of_retries": Port(int, False, "Number of retries", 1, NON_NEGATIVE),
+    }
+
+    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, children, **attributes)
+        self.current = 0
+        self.retries = 0
+
+    def tick_node(self) -> NodeStatus:
+        allowed = int(self.get_input("number_of_retries"))
+        self._start()
+        while self.retries <= allowed:
+            status = self._kids()[self.current].execute_tick()
+            if self.current == 0:
+                if status is RUNNING:
+                    return RUNNING
+                if status is SUCCESS or status is SKIPPED:
+                    self.halt()
+                    return status
+                if self.retries >= allowed:
+                    self.halt()
+                    return FAILURE
+                self.halt_child(0)
+                self.current = 1
+            else:
+                if status is RUNNING:
+                    return RUNNING
+                if status is SKIPPED:
+                    self.current = 0
+                    self.halt_child(1)
+                    return FAILURE
+                if status is FAILURE:
+                    self.halt()
+                    return FAILURE
+                self.halt_child(1)
+                self.retries += 1
+                self.current = 0
+        self.halt()
+        return FAILURE
+
+    def halt(self) -> None:
+        self.current = 0
+        self.retries = 0
+        super().halt()
+
+
+@registry.register
+class RoundRobin(_Nav2Control):
+    """Ticks one child per activation, moving to the next child each time one finishes.
+
+    - child SUCCESS: the next activation starts at the following child (wrapping round);
+      halt every child and return SUCCESS;
+    - child FAILURE (or SKIPPED): try the following child in the same tick;
+    - child RUNNING: return RUNNING; the next tick resumes it.
+
+    When every child failed (or was skipped) in a row it returns FAILURE (SKIPPED when all were
+    skipped). Where it stands is kept between activations, so recoveries take turns; halting
+    it while a child runs sends it back to the first child.
+    """
+
+    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, children, **attributes)
+        self.current = 0
+        self.failed = 0
+
+    def tick_node(self) -> NodeStatus:
+        kids = self._kids()
+        n = len(kids)
+        self._start()
+        skipped = 0
+        while self.failed + skipped < n:
+            status = kids[self.current].execute_tick()
+            if status is not RUNNING:
+                self.current = (self.current + 1) % n
+            if status is SUCCESS:
+                self.failed = 0
+                self.reset_children()
+                return SUCCESS
+            if status is RUNNING:
+                return RUNNING
+            if status is FAILURE:
+                self.failed += 1
+            else:
+                skipped += 1
+        all_skipped = skipped == n
+        self.halt()
+        self.failed = 0
+        return SKIPPED if all_skipped else FAILURE
+
+    def halt(self) -> None:
+        self.current = 0
+        self.failed = 0
+        super().halt()

@@ -1,0 +1,153 @@
+"""Nav2's nodes for navigating through several poses: ComputePathThroughPoses and
+RemovePassedGoals.
+
+The goals are a list of poses: from Python a list of ``(x, y, yaw)``, from the command line
+text with the poses separated by ``|``, each a named pose of the world or ``x;y;yaw``
+(``--bb "goals=-1;3;0|kitchen|2.6;-0.7;0.85"``).
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, RobotAction, WorldAccess
+from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.bt.node import PortError, SyncActionNode
+from bt_manip.bt.ports import POSITIVE, Port
+from bt_manip.bt.registry import registry
+from bt_manip.nav2.actions import Nav2Action, error_ports, plan_error
+from bt_manip.nav2.blocking import maybe_block
+from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
+
+
+class ThroughPosesError(enum.IntEnum):
+    """ComputePathThroughPoses result codes."""
+
+    NONE = 0
+    UNKNOWN = 300
+    INVALID_PLANNER = 301
+    TF_ERROR = 302
+    START_OUTSIDE_MAP = 303
+    GOAL_OUTSIDE_MAP = 304
+    START_OCCUPIED = 305
+    GOAL_OCCUPIED = 306
+    TIMEOUT = 307
+    NO_VALID_PATH = 308
+    NO_VIAPOINTS_GIVEN = 309
+
+
+def goals_list(world: Any, value: Any) -> list[Pose2D]:
+    """The goals of a port: a list of poses, or text with poses separated by ``|``."""
+    if value is None:
+        return []
+    if isinstance(value, str):
+        return [goal_pose(world, part) for part in value.split("|") if part.strip()]
+    if isinstance(value, (list, tuple)):
+        return [goal_pose(world, v) for v in value]
+    raise ActionFailed(f"goals {value!r} are neither a list of poses nor poses separated by |")
+
+
+@registry.register
+class ComputePathThroughPoses(Nav2Action):
+    """Plans one path from the robot (or ``start``) through every pose of ``goals`` in turn
+    (A* on the robot's costmap, leg by leg), ending on the last one.
+
+    - SUCCESS: ``path`` holds the path, ``error_code_id`` 0;
+    - FAILURE: 309 NO_VIAPOINTS_GIVEN without goals, else a leg without a path gives Nav2's
+      code (304 GOAL_OUTSIDE_MAP, 306 GOAL_OCCUPIED, 308 NO_VALID_PATH, ...) and the reason.
+    """
+
+    UNKNOWN = ThroughPosesError.UNKNOWN
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        **RobotAction.INPUT_PORTS,
+        "goals": PortInformation(object, True, "Destinations to plan through"),
+        "start": PortInformation(object, False, "Start pose of the path (default: the robot)"),
+        "planner_id": PortInformation(str, False, "Mapped name to the planner plugin", ""),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
+        **error_ports("The compute path through poses"),
+    }
+
+    def __init__(self, name: str | None = None, **attributes: Any) -> None:
+        super().__init__(name, **attributes)
+        self.blocked_goals: set[tuple[Pose2D, ...]] = set()
+
+    def begin(self) -> None:
+        robot = self.base()
+        world = self.world
+        goals = goals_list(world, self.get_input("goals"))
+        if not goals:
+            self.fail(ThroughPosesError.NO_VIAPOINTS_GIVEN, "no goals to plan through")
+        start_value = self.get_input("start", None)
+        start = goal_pose(world, start_value) if start_value else robot.base_pose2d()
+        nav = navigator_for(world, robot)
+        nav.refresh()
+        p = nav.pivot
+        here = (start[0] + p * math.cos(start[2]), start[1] + p * math.sin(start[2]))
+        legs = []
+        for k, goal in enumerate(goals):
+            last = k == len(goals) - 1
+            end = (goal[0] + p * math.cos(goal[2]), goal[1] + p * math.sin(goal[2])) if last \
+                else (goal[0], goal[1])
+            plan = nav.plan_to((*here, 0.0), (*end, goal[2]))
+            if not plan.ok or plan.polyline is None:
+                base = nav.plan_to((*here, 0.0), goal)
+                failed = plan if base.ok else base
+                # the through-poses codes are the to-pose codes plus 100
+                code = ThroughPosesError.NO_VALID_PATH if base.ok else ThroughPosesError(
+                    int(plan_error(failed.outcome, failed.reason)) + 100
+                )
+                self.fail(code, f"no path to goal {k + 1} ({goal[0]:.3f};{goal[1]:.3f}): "
+                                f"{failed.reason}")
+            legs.append(plan.polyline if not legs else plan.polyline[1:])
+            here = end
+        points = np.vstack(legs)
+        path = path_from_points(points, goals[-1], p)
+        self.set_output("path", path)
+        key = tuple(goals)
+        if key not in self.blocked_goals:
+            self.blocked_goals.add(key)
+            g = goals[-1]
+            maybe_block(self, points, f"{g[0]:.3f};{g[1]:.3f};{g[2]:.3f}")
+
+    def step(self) -> Status:
+        return Status.SUCCESS
+
+
+@registry.register
+class RemovePassedGoals(WorldAccess, SyncActionNode):
+    """Drops the goals at the front of ``input_goals`` that the robot is within ``radius`` of
+    (always keeping the last) and writes the rest to ``output_goals``. SUCCESS (FAILURE without
+    a world or with goals it cannot read)."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "robot": ROBOT_PORT,
+        "input_goals": PortInformation(object, True, "Original goals to remove viapoints from"),
+        "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
+                       POSITIVE),
+        "global_frame": PortInformation(str, False, "Global frame", "map"),
+        "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+        "output_goals": PortInformation(object, False, "Goals with passed viapoints removed"),
+    }
+
+    def update(self) -> Status:
+        try:
+            goals = goals_list(self.world, self.get_input("input_goals"))
+            x, y, _ = self.robot().base_pose2d()
+        except (ActionFailed, PortError) as exc:
+            self.feedback_message = str(exc)
+            return Status.FAILURE
+        radius = float(self.get_input("radius"))
+        while len(goals) > 1 and math.hypot(goals[0][0] - x, goals[0][1] - y) <= radius:
+            goals.pop(0)
+        self.set_output("output_goals", goals)
+        return Status.SUCCESS
