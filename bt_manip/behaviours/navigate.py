@@ -15,7 +15,7 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, RobotAction
+from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess
 from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
@@ -30,6 +30,17 @@ TIME_BUDGET_FACTOR = 1.5
 speed..."""
 TIME_BUDGET_MARGIN = 30.0
 """... plus this many sim seconds (turning on the spot, slowing down near the goal)."""
+
+
+def synced_navigator(node: WorldAccess, robot: Any) -> Navigator:
+    """The run's navigator of ``robot`` (one per robot and run), synced with the world; a grid
+    too large to build makes the node fail with the reason."""
+    name = node.robot_name_of(robot)
+    try:
+        nav = node.run_context.robot_services(name).navigator
+    except GridTooLarge as exc:
+        raise ActionFailed(str(exc)) from None
+    return sync_navigator(node.world, name, nav)
 
 
 def sync_navigator(world: Any, robot_name: str, nav: Navigator) -> Navigator:
@@ -109,11 +120,7 @@ class Navigate(RobotAction):
         if robot.description.base.type != "skid_steer":
             raise ActionFailed(f"{robot.description.name} has no mobile base")
         goal = parse_goal(world, self.get_input("goal"))
-        try:
-            nav = self.services().navigator
-        except GridTooLarge as exc:
-            raise ActionFailed(str(exc)) from None
-        sync_navigator(world, self.robot_name_of(robot), nav)
+        nav = synced_navigator(self, robot)
         follower = dataclasses.replace(
             nav.options.follower,
             xy_tolerance=float(self.get_input("xy_tolerance")),

@@ -21,7 +21,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
-from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.behaviours.navigate import synced_navigator
 from bt_manip.bt.node import PortError
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.bt.registry import registry
@@ -177,7 +177,7 @@ class ComputePathToPose(Nav2Action):
         goal = goal_pose(world, self.get_input("goal"))
         start_value = self.get_input("start", None)
         start = goal_pose(world, start_value) if start_value else robot.base_pose2d()
-        nav = navigator_for(world, robot)
+        nav = synced_navigator(self, robot)
         nav.refresh()
         p = nav.pivot
         ahead = (start[0] + p * math.cos(start[2]), start[1] + p * math.sin(start[2]))
@@ -240,7 +240,7 @@ class FollowPath(Nav2Action):
 
     def begin(self) -> None:
         robot = self.base()
-        self.nav = navigator_for(self.world, robot)
+        self.nav = synced_navigator(self, robot)
         self.path = self._path()
         options = dataclasses.replace(
             self.nav.options.follower,

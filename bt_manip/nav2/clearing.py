@@ -18,7 +18,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import RobotAction
-from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.behaviours.navigate import synced_navigator
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
 from bt_manip.nav2.actions import Nav2Action
@@ -79,7 +79,7 @@ class ClearEntireCostmap(_Clear):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = SERVICE_PORTS
 
     def begin(self) -> None:
-        clear_map(navigator_for(self.world, self.base()))
+        clear_map(synced_navigator(self, self.base()))
 
 
 @registry.register
@@ -95,7 +95,7 @@ class ClearCostmapAroundRobot(_Clear):
 
     def begin(self) -> None:
         robot = self.base()
-        nav = navigator_for(self.world, robot)
+        nav = synced_navigator(self, robot)
         x, y, _ = robot.base_pose2d()
         clear_map(nav, keep=~square_round(nav, x, y, float(self.get_input("reset_distance"))))
 
@@ -113,6 +113,6 @@ class ClearCostmapExceptRegion(_Clear):
 
     def begin(self) -> None:
         robot = self.base()
-        nav = navigator_for(self.world, robot)
+        nav = synced_navigator(self, robot)
         x, y, _ = robot.base_pose2d()
         clear_map(nav, keep=square_round(nav, x, y, float(self.get_input("reset_distance"))))

@@ -12,7 +12,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
-from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.behaviours.navigate import synced_navigator
 from bt_manip.bt.node import PortError
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.bt.registry import registry
@@ -143,7 +143,7 @@ class IsPathValid(WorldCondition):
         if not isinstance(path, Nav2Path) or len(path) == 0:
             return False, "no path to check"
         robot = self.robot()
-        nav = navigator_for(self.world, robot)
+        nav = synced_navigator(self, robot)
         nav.refresh()
         pts = path.shifted(nav.pivot)
         x, y, yaw = robot.base_pose2d()

@@ -17,7 +17,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, RobotAction, WorldAccess
-from bt_manip.behaviours.navigate import navigator_for
+from bt_manip.behaviours.navigate import synced_navigator
 from bt_manip.bt.node import PortError, SyncActionNode
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
@@ -87,7 +87,7 @@ class ComputePathThroughPoses(Nav2Action):
             self.fail(ThroughPosesError.NO_VIAPOINTS_GIVEN, "no goals to plan through")
         start_value = self.get_input("start", None)
         start = goal_pose(world, start_value) if start_value else robot.base_pose2d()
-        nav = navigator_for(world, robot)
+        nav = synced_navigator(self, robot)
         nav.refresh()
         p = nav.pivot
         here = (start[0] + p * math.cos(start[2]), start[1] + p * math.sin(start[2]))

@@ -11,26 +11,39 @@ import numpy as np
 import pytest
 
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
-from bt_manip.behaviours.navigate import navigator_for
-from bt_manip.bt import Tree, TreeContext, load_tree_string
+from bt_manip.bt import Tree, load_tree_string
 from bt_manip.nav2.path import Nav2Path
+from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 from bt_manip.sim.world import World
 
 ROOM = Path(__file__).resolve().parent / "room.yaml"
 
 
+_CONTEXTS: dict[int, RunContext] = {}
+
+
+def context_of(world: World) -> RunContext:
+    """One run context per world of a test, so that the trees a test runs one after the other
+    share the robot's navigator (as the nodes of one tree do)."""
+    context = _CONTEXTS.get(id(world))
+    if context is None or context.world is not world:
+        context = _CONTEXTS[id(world)] = RunContext.for_world(world)
+    return context
+
+
 @pytest.fixture
 def room() -> Iterator[World]:
     with World(ROOM, seed=0) as world:
         yield world
+    _CONTEXTS.clear()
 
 
 def run(world: World, body: str, bb: dict[str, Any] | None = None,
         max_sim_time: float = 60.0) -> tuple[RunReport, dict[str, Any]]:
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
     tree: Tree = load_tree_string(
-        xml, context=TreeContext(clock=world.clock, world=world), blackboard=dict(bb or {})
+        xml, context=context_of(world), blackboard=dict(bb or {})
     )
     report = Runner(tree, world, RunOptions(max_sim_time=max_sim_time)).run()
     entries = {key: tree.blackboard.get(key) for key in tree.blackboard.as_dict()}
@@ -121,7 +134,7 @@ def test_wait_waits_wait_duration_of_sim_time(room: World) -> None:
 def test_clear_entire_costmap_forgets_what_the_map_marked(room: World) -> None:
     report, _ = run(room, '<ComputePathToPose goal="east" path="{path}"/>')
     assert report.status == "SUCCESS", report.reason
-    nav = navigator_for(room, room.robots["husky"])
+    nav = context_of(room).robot_services("husky").navigator
     crate = room.movable["crate"]
     assert crate in nav.costmap.grid.sources  # the crate is marked
     report, _ = run(room, '<ClearEntireCostmap service_name="local_costmap/clear"/>')
@@ -144,7 +157,7 @@ def place(world: World, x: float, y: float, yaw: float = 0.0) -> None:
 def load(world: World, body: str, bb: dict[str, Any] | None = None) -> Tree:
     xml = f'<root BTCPP_format="4"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
     return load_tree_string(
-        xml, context=TreeContext(clock=world.clock, world=world), blackboard=dict(bb or {})
+        xml, context=context_of(world), blackboard=dict(bb or {})
     )
 
 
@@ -194,7 +207,7 @@ def test_is_path_valid_until_an_object_lands_on_the_path(room: World) -> None:
 def test_clearing_round_the_robot_or_except_there(room: World, node: str, kept: bool) -> None:
     report, _ = run(room, '<ComputePathToPose goal="east" path="{path}"/>')
     assert report.status == "SUCCESS", report.reason
-    nav = navigator_for(room, room.robots["husky"])
+    nav = context_of(room).robot_services("husky").navigator
     crate = room.movable["crate"]  # about 4 m from the robot
     report, _ = run(room, f'<{node} reset_distance="1.5"/>')
     assert report.status == "SUCCESS"

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
-from bt_manip.bt import Tree, TreeContext, load_tree
+from bt_manip.bt import Tree, load_tree
 from bt_manip.bt.status import NodeStatus
+from bt_manip.run_context import RunContext
 from bt_manip.sim.world import World
 from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
@@ -28,7 +29,7 @@ pytestmark = pytest.mark.skipif(
 
 def load(world: World, goal: str) -> Tree:
     return load_tree(
-        str(DEFAULT_TREE), context=TreeContext(clock=world.clock, world=world),
+        str(DEFAULT_TREE), context=RunContext.for_world(world),
         blackboard={"goal": goal},
     )
 
@@ -157,7 +158,7 @@ def test_a_path_made_invalid_is_planned_again_and_followed_round_the_obstacle() 
     with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
         tree = load_tree(
             "replan.xml", text=REPLAN_IF_INVALID,
-            context=TreeContext(clock=world.clock, world=world), blackboard={"goal": "east"},
+            context=RunContext.for_world(world), blackboard={"goal": "east"},
         )
         assert tree.tick() is NodeStatus.RUNNING
         first = tree.blackboard.get("path")
@@ -197,7 +198,7 @@ def test_through_poses_passes_each_goal_and_ends_on_the_last() -> None:
     with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
         tree = load_tree(
             "through.xml", text=THROUGH_POSES,
-            context=TreeContext(clock=world.clock, world=world),
+            context=RunContext.for_world(world),
             blackboard={"goals": "-0.2;1.2;0|1.8;0.5;0"},
         )
         closest = [math.inf]
@@ -219,7 +220,7 @@ def test_through_poses_without_goals_gives_no_viapoints() -> None:
     with World(Path(__file__).resolve().parent / "room.yaml", seed=0) as world:
         tree = load_tree(
             "through.xml", text=THROUGH_POSES,
-            context=TreeContext(clock=world.clock, world=world), blackboard={"goals": ""},
+            context=RunContext.for_world(world), blackboard={"goals": ""},
         )
         status, _ = run(world, tree)
         assert status is NodeStatus.FAILURE
