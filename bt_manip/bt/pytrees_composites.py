@@ -88,8 +88,21 @@ class _PyTreesComposite(_PyTreesNode, ControlNode):
     MIN_CHILDREN = 0
 
 
+class _MemoryComposite(_PyTreesComposite):
+    """A py_trees composite with the ``memory`` flag (``Sequence``, ``Selector``)."""
+
+    INPUT_PORTS: ClassVar[Ports] = {
+        "memory": PortInformation(bool, description="resume from the RUNNING child",
+                                  default_value=False)}
+
+    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
+                 **attributes: Any) -> None:
+        super().__init__(name, children, **attributes)
+        self.memory = bool(self.get_input("memory"))
+
+
 @registry.register
-class PyTreesSequence(_PyTreesComposite):
+class PyTreesSequence(_MemoryComposite):
     """py_trees' ``Sequence``: ticks children in order while they succeed.
 
     - child SUCCESS: go on with the next child (all succeeded: SUCCESS; no children: SUCCESS);
@@ -100,18 +113,10 @@ class PyTreesSequence(_PyTreesComposite):
     """
 
     PY = py_trees.composites.Sequence
-    INPUT_PORTS: ClassVar[Ports] = {
-        "memory": PortInformation(bool, description="resume from the RUNNING child",
-                                  default_value=False)}
-
-    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
-                 **attributes: Any) -> None:
-        super().__init__(name, children, **attributes)
-        self.memory = bool(self.get_input("memory"))
 
 
 @registry.register
-class PyTreesSelector(_PyTreesComposite):
+class PyTreesSelector(_MemoryComposite):
     """py_trees' ``Selector``: ticks children in order until one does not fail.
 
     - child FAILURE: try the next child (all failed, or no children: FAILURE);
@@ -121,14 +126,6 @@ class PyTreesSelector(_PyTreesComposite):
     """
 
     PY = py_trees.composites.Selector
-    INPUT_PORTS: ClassVar[Ports] = {
-        "memory": PortInformation(bool, description="resume from the RUNNING child",
-                                  default_value=False)}
-
-    def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
-                 **attributes: Any) -> None:
-        super().__init__(name, children, **attributes)
-        self.memory = bool(self.get_input("memory"))
 
 
 @registry.register
