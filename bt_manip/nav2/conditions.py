@@ -46,45 +46,42 @@ class AreErrorCodesPresent(ConditionNode):
         return Status.SUCCESS if present else Status.FAILURE
 
 
-@registry.register
-class WouldAPlannerRecoveryHelp(AreErrorCodesPresent):
-    """SUCCESS when ``error_code`` is a planner failure that a recovery may cure (200 UNKNOWN,
-    207 TIMEOUT, 208 NO_VALID_PATH), FAILURE otherwise."""
+class _WouldARecoveryHelp(AreErrorCodesPresent):
+    """SUCCESS when ``error_code`` is one of the fixed codes ``CODES``, FAILURE otherwise."""
 
+    CODES: ClassVar[frozenset[Any]] = frozenset()
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "error_code": PortInformation(int, False, "The active error code to compare against", 0),
     }
 
     def codes(self) -> frozenset[int]:
-        return frozenset(int(c) for c in PLANNER_RECOVERABLE)
+        return frozenset(int(c) for c in self.CODES)
 
 
 @registry.register
-class WouldAControllerRecoveryHelp(AreErrorCodesPresent):
+class WouldAPlannerRecoveryHelp(_WouldARecoveryHelp):
+    """SUCCESS when ``error_code`` is a planner failure that a recovery may cure (200 UNKNOWN,
+    207 TIMEOUT, 208 NO_VALID_PATH), FAILURE otherwise."""
+
+    CODES = PLANNER_RECOVERABLE
+
+
+@registry.register
+class WouldAControllerRecoveryHelp(_WouldARecoveryHelp):
     """SUCCESS when ``error_code`` is a controller failure that a recovery may cure (100 UNKNOWN,
     104 PATIENCE_EXCEEDED, 105 FAILED_TO_MAKE_PROGRESS, 106 NO_VALID_CONTROL), FAILURE
     otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "error_code": PortInformation(int, False, "The active error code to compare against", 0),
-    }
-
-    def codes(self) -> frozenset[int]:
-        return frozenset(int(c) for c in CONTROLLER_RECOVERABLE)
+    CODES = CONTROLLER_RECOVERABLE
 
 
 @registry.register
-class WouldASmootherRecoveryHelp(AreErrorCodesPresent):
+class WouldASmootherRecoveryHelp(_WouldARecoveryHelp):
     """SUCCESS when ``error_code`` is a smoother failure that a recovery may cure (500 UNKNOWN,
     502 TIMEOUT, 503 SMOOTHED_PATH_IN_COLLISION, 504 FAILED_TO_SMOOTH_PATH), FAILURE
     otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        "error_code": PortInformation(int, False, "The active error code to compare against", 0),
-    }
-
-    def codes(self) -> frozenset[int]:
-        return frozenset(int(c) for c in SMOOTHER_RECOVERABLE)
+    CODES = SMOOTHER_RECOVERABLE
 
 
 GOAL_PORTS: dict[str, PortInformation] = {
