@@ -27,7 +27,7 @@ from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.bt.registry import registry
 from bt_manip.nav2.blocking import maybe_block
 from bt_manip.nav2.errors import BehaviorError, ControllerError, PlannerError
-from bt_manip.nav2.path import Nav2Path, goal_pose, path_from_points
+from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
 from bt_manip.navigation.controller import FollowState, PathFollower
 from bt_manip.navigation.planner import PlanOutcome
 
@@ -140,8 +140,33 @@ def contacts(world: Any, robot: Any, robot_name: str) -> set[str]:
     return out
 
 
+PLAN_PORTS: dict[str, PortInformation] = {
+        "start": PortInformation(object, False, "Start pose of the path (default: the robot)"),
+        "planner_id": PortInformation(str, False, "Mapped name to the planner plugin", ""),
+}
+"""The input ports every Nav2 planning action has (besides its goal or goals)."""
+
+
+def ahead_of(pose: Pose2D, distance: float) -> tuple[float, float]:
+    """The point ``distance`` ahead of ``pose`` along its heading (where the pivot is)."""
+    return (pose[0] + distance * math.cos(pose[2]), pose[1] + distance * math.sin(pose[2]))
+
+
+class PlanAction(Nav2Action):
+    """A Nav2 planning action: plans within the tick from the robot (or ``start``), SUCCESS
+    once the path is written."""
+
+    def start_pose(self, robot: Any) -> Pose2D:
+        """The pose ``start`` names, else the robot's base pose."""
+        start_value = self.get_input("start", None)
+        return goal_pose(self.world, start_value) if start_value else robot.base_pose2d()
+
+    def step(self) -> Status:
+        return Status.SUCCESS
+
+
 @registry.register
-class ComputePathToPose(Nav2Action):
+class ComputePathToPose(PlanAction):
     """Plans a path from the robot (or ``start``) to ``goal`` on the robot's costmap (A*).
 
     Planning is done within the tick:
@@ -159,8 +184,7 @@ class ComputePathToPose(Nav2Action):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
         "goal": PortInformation(object, True, "Destination to plan to (x;y;yaw or a pose name)"),
-        "start": PortInformation(object, False, "Start pose of the path (default: the robot)"),
-        "planner_id": PortInformation(str, False, "Mapped name to the planner plugin", ""),
+        **PLAN_PORTS,
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathToPose node"),
@@ -175,13 +199,12 @@ class ComputePathToPose(Nav2Action):
         robot = self.base()
         world = self.world
         goal = goal_pose(world, self.get_input("goal"))
-        start_value = self.get_input("start", None)
-        start = goal_pose(world, start_value) if start_value else robot.base_pose2d()
+        start = self.start_pose(robot)
         nav = synced_navigator(self, robot)
         nav.refresh()
         p = nav.pivot
-        ahead = (start[0] + p * math.cos(start[2]), start[1] + p * math.sin(start[2]))
-        end = (goal[0] + p * math.cos(goal[2]), goal[1] + p * math.sin(goal[2]))
+        ahead = ahead_of(start, p)
+        end = ahead_of(goal, p)
         plan = nav.plan_to((*ahead, start[2]), (*end, goal[2]))
         if not plan.ok or plan.polyline is None:
             # the reason in the base frame's terms when its start or goal is the trouble
@@ -198,9 +221,6 @@ class ComputePathToPose(Nav2Action):
         if goal not in self.blocked_goals:
             self.blocked_goals.add(goal)
             maybe_block(self, plan.polyline, f"{goal[0]:.3f};{goal[1]:.3f};{goal[2]:.3f}")
-
-    def step(self) -> Status:
-        return Status.SUCCESS
 
 
 @registry.register

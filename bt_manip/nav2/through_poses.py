@@ -21,7 +21,7 @@ from bt_manip.behaviours.navigate import synced_navigator
 from bt_manip.bt.node import PortError, SyncActionNode
 from bt_manip.bt.ports import POSITIVE, Port
 from bt_manip.bt.registry import registry
-from bt_manip.nav2.actions import Nav2Action, error_ports, plan_error
+from bt_manip.nav2.actions import PLAN_PORTS, PlanAction, ahead_of, error_ports, plan_error
 from bt_manip.nav2.blocking import maybe_block
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
 
@@ -54,7 +54,7 @@ def goals_list(world: Any, value: Any) -> list[Pose2D]:
 
 
 @registry.register
-class ComputePathThroughPoses(Nav2Action):
+class ComputePathThroughPoses(PlanAction):
     """Plans one path from the robot (or ``start``) through every pose of ``goals`` in turn
     (A* on the robot's costmap, leg by leg), ending on the last one.
 
@@ -67,8 +67,7 @@ class ComputePathThroughPoses(Nav2Action):
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         **RobotAction.INPUT_PORTS,
         "goals": PortInformation(object, True, "Destinations to plan through"),
-        "start": PortInformation(object, False, "Start pose of the path (default: the robot)"),
-        "planner_id": PortInformation(str, False, "Mapped name to the planner plugin", ""),
+        **PLAN_PORTS,
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
@@ -85,17 +84,15 @@ class ComputePathThroughPoses(Nav2Action):
         goals = goals_list(world, self.get_input("goals"))
         if not goals:
             self.fail(ThroughPosesError.NO_VIAPOINTS_GIVEN, "no goals to plan through")
-        start_value = self.get_input("start", None)
-        start = goal_pose(world, start_value) if start_value else robot.base_pose2d()
+        start = self.start_pose(robot)
         nav = synced_navigator(self, robot)
         nav.refresh()
         p = nav.pivot
-        here = (start[0] + p * math.cos(start[2]), start[1] + p * math.sin(start[2]))
+        here = ahead_of(start, p)
         legs = []
         for k, goal in enumerate(goals):
             last = k == len(goals) - 1
-            end = (goal[0] + p * math.cos(goal[2]), goal[1] + p * math.sin(goal[2])) if last \
-                else (goal[0], goal[1])
+            end = ahead_of(goal, p) if last else (goal[0], goal[1])
             plan = nav.plan_to((*here, 0.0), (*end, goal[2]))
             if not plan.ok or plan.polyline is None:
                 base = nav.plan_to((*here, 0.0), goal)
@@ -116,9 +113,6 @@ class ComputePathThroughPoses(Nav2Action):
             self.blocked_goals.add(key)
             g = goals[-1]
             maybe_block(self, points, f"{g[0]:.3f};{g[1]:.3f};{g[2]:.3f}")
-
-    def step(self) -> Status:
-        return Status.SUCCESS
 
 
 @registry.register
