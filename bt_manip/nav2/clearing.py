@@ -82,37 +82,41 @@ class ClearEntireCostmap(_Clear):
         clear_map(synced_navigator(self, self.base()))
 
 
+def _square_ports(what: str) -> dict[str, PortInformation]:
+    """The service ports and ``reset_distance``, the distance from the robot to ``what``."""
+    return {
+        **SERVICE_PORTS,
+        "reset_distance": Port(float, False, f"Distance from the robot to {what} (m)", 1.0,
+                               POSITIVE),
+    }
+
+
+class _ClearSquare(_Clear):
+    """Clears on one side of the square of half side ``reset_distance`` round the robot:
+    inside it (``INSIDE``), else outside."""
+
+    INSIDE: ClassVar[bool] = True
+
+    def begin(self) -> None:
+        robot = self.base()
+        nav = synced_navigator(self, robot)
+        x, y, _ = robot.base_pose2d()
+        square = square_round(nav, x, y, float(self.get_input("reset_distance")))
+        clear_map(nav, keep=~square if self.INSIDE else square)
+
+
 @registry.register
-class ClearCostmapAroundRobot(_Clear):
+class ClearCostmapAroundRobot(_ClearSquare):
     """Forgets the objects drawn within ``reset_distance`` (half the side of a square) of the
     robot. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        **SERVICE_PORTS,
-        "reset_distance": Port(float, False, "Distance from the robot to clear (m)", 1.0,
-                               POSITIVE),
-    }
-
-    def begin(self) -> None:
-        robot = self.base()
-        nav = synced_navigator(self, robot)
-        x, y, _ = robot.base_pose2d()
-        clear_map(nav, keep=~square_round(nav, x, y, float(self.get_input("reset_distance"))))
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("clear")
 
 
 @registry.register
-class ClearCostmapExceptRegion(_Clear):
+class ClearCostmapExceptRegion(_ClearSquare):
     """Forgets the objects drawn farther than ``reset_distance`` (half the side of a square)
     from the robot, keeping those near it. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
-        **SERVICE_PORTS,
-        "reset_distance": Port(float, False, "Distance from the robot to keep (m)", 1.0,
-                               POSITIVE),
-    }
-
-    def begin(self) -> None:
-        robot = self.base()
-        nav = synced_navigator(self, robot)
-        x, y, _ = robot.base_pose2d()
-        clear_map(nav, keep=square_round(nav, x, y, float(self.get_input("reset_distance"))))
+    INSIDE = False
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("keep")
