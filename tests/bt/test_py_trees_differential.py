@@ -207,11 +207,11 @@ def clock(monkeypatch: pytest.MonkeyPatch) -> ManualClock:
     return manual
 
 
-def run_py_trees(seed: int, clock: ManualClock) -> tuple[list[str], Log, dict[str, Any]]:
-    builder = Builder(seed)
-    root = builder.tree()
-    storage = seeded_storage()
-    py_trees.blackboard.Blackboard.storage = storage
+def run_ticks(builder: Builder, seed: int, clock: ManualClock, tick: Callable[[], str]
+              ) -> tuple[list[str], Log]:
+    """Tick ``TICKS`` times from time 0 with ``random`` seeded: each tick's status ("raised"
+    when it raised: both engines must raise at the same tick, the converted one with a
+    TreeRuntimeError naming the node) and the log, a ``tick`` entry before each tick's."""
     clock.t = 0.0
     random.seed(seed)
     statuses = []
@@ -219,13 +219,26 @@ def run_py_trees(seed: int, clock: ManualClock) -> tuple[list[str], Log, dict[st
     for _ in range(TICKS):
         builder.log.clear()
         try:
-            root.tick_once()
-            statuses.append(root.status.name)
-        except Exception:  # both engines must raise at the same tick
+            statuses.append(tick())
+        except Exception:
             statuses.append("raised")
         logs.append(("tick", "", ""))
         logs.extend(builder.log)
         clock.advance(STEP)
+    return statuses, logs
+
+
+def run_py_trees(seed: int, clock: ManualClock) -> tuple[list[str], Log, dict[str, Any]]:
+    builder = Builder(seed)
+    root = builder.tree()
+    storage = seeded_storage()
+    py_trees.blackboard.Blackboard.storage = storage
+
+    def tick() -> str:
+        root.tick_once()
+        return str(root.status.name)
+
+    statuses, logs = run_ticks(builder, seed, clock, tick)
     return statuses, logs, {k: storage.get(k) for k in ("/a", "/b", "/c", "/st")}
 
 
@@ -235,19 +248,7 @@ def run_converted(seed: int, clock: ManualClock, builtins: bool
     root = builder.tree()
     tree = from_py_trees(root, builtins=builtins, context=TreeContext(clock=clock),
                          blackboard={k.lstrip("/"): v for k, v in seeded_storage().items()})
-    clock.t = 0.0
-    random.seed(seed)
-    statuses = []
-    logs: Log = []
-    for _ in range(TICKS):
-        builder.log.clear()
-        try:
-            statuses.append(tree.tick().value)
-        except Exception:  # a TreeRuntimeError naming the node
-            statuses.append("raised")
-        logs.append(("tick", "", ""))
-        logs.extend(builder.log)
-        clock.advance(STEP)
+    statuses, logs = run_ticks(builder, seed, clock, lambda: str(tree.tick().value))
     bb = tree.blackboard
     return statuses, logs, {"/" + k: bb.get_or(k) for k in ("a", "b", "c", "st")}
 
