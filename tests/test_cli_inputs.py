@@ -10,6 +10,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from tree_files import write_tree
 
 from bt_manip.bt import registry
 from bt_manip.cli import main
@@ -34,15 +35,6 @@ class RefuseForTest(ActionNode):
 '''
 
 
-def _tree(tmp_path: Path, body: str, name: str = "t.xml") -> Path:
-    path = tmp_path / name
-    path.write_text(
-        '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
-        f'  <BehaviorTree ID="Main">\n{body}\n  </BehaviorTree>\n</root>\n'
-    )
-    return path
-
-
 @pytest.fixture
 def node_module(tmp_path: Path) -> Iterator[Path]:
     """``refuse_nodes.py`` in tmp_path; the node it registers is unregistered afterwards."""
@@ -58,7 +50,7 @@ def node_module(tmp_path: Path) -> Iterator[Path]:
 
 
 def test_report_pointing_at_a_directory_is_refused_before_the_run(tmp_path: Path) -> None:
-    tree = _tree(tmp_path, '<Sleep msec="100"/>')
+    tree = write_tree(tmp_path, '<Sleep msec="100"/>')
     proc = subprocess.run(
         [sys.executable, "-m", "bt_manip.cli", "run", str(tree), "--report", str(tmp_path)],
         capture_output=True,
@@ -75,7 +67,7 @@ def test_report_pointing_at_a_directory_is_refused_before_the_run(tmp_path: Path
 def test_every_output_flag_is_checked(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, "<AlwaysSuccess/>")
+    tree = write_tree(tmp_path, "<AlwaysSuccess/>")
     a_file = tmp_path / "a_file"
     a_file.write_text("")
     missing = tmp_path / "missing"
@@ -108,7 +100,7 @@ def test_bench_default_output_folder_under_a_file_named_out(
 ) -> None:
     monkeypatch.chdir(tmp_path)
     (tmp_path / "out").write_text("")
-    tree = _tree(tmp_path, "<AlwaysSuccess/>")
+    tree = write_tree(tmp_path, "<AlwaysSuccess/>")
     assert main(["bench", str(tree), "--world", str(TABLE)]) == 2
     assert capsys.readouterr().err == (
         "--out: out is not a folder, so the outputs cannot be written below it\n"
@@ -118,7 +110,7 @@ def test_bench_default_output_folder_under_a_file_named_out(
 def test_outputs_create_their_own_folder_only(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, '<Script code="x := 2"/>')
+    tree = write_tree(tmp_path, '<Script code="x := 2"/>')
     report, bb = tmp_path / "new" / "r.json", tmp_path / "new2" / "bb.json"
     assert main(["run", str(tree), "--quiet", "--report", str(report), "--bb-out", str(bb)]) == 0
     assert json.loads(report.read_text())["status"] == "SUCCESS"
@@ -131,7 +123,7 @@ def test_outputs_create_their_own_folder_only(
 def test_import_by_file_registers_nodes_for_run_and_validate(
     tmp_path: Path, node_module: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, '<RefuseForTest name="no"/>')
+    tree = write_tree(tmp_path, '<RefuseForTest name="no"/>')
     assert main(["validate", str(tree)]) == 2
     assert "unknown node 'RefuseForTest'" in capsys.readouterr().err
     assert main(["validate", str(tree), "--import", str(node_module)]) == 0
@@ -146,7 +138,7 @@ def test_import_by_module_name_looks_in_the_working_directory(
 ) -> None:
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, "path", [p for p in sys.path if p not in ("", str(tmp_path))])
-    tree = _tree(tmp_path, "<RefuseForTest/>")
+    tree = write_tree(tmp_path, "<RefuseForTest/>")
     assert main(["show", str(tree), "--import", "refuse_nodes"]) == 0
     assert "RefuseForTest" in capsys.readouterr().out
 
@@ -156,7 +148,7 @@ def test_import_problems_name_the_flag(
 ) -> None:
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(sys, "path", list(sys.path))  # --import puts the working dir on it
-    tree = _tree(tmp_path, "<AlwaysSuccess/>")
+    tree = write_tree(tmp_path, "<AlwaysSuccess/>")
     (tmp_path / "broken.py").write_text("x = 1\ndef f(:\n")
     (tmp_path / "raising.py").write_text("import math\n\nraise RuntimeError('no robot here')\n")
     (tmp_path / "adir").mkdir()
@@ -231,7 +223,7 @@ IGNORED_THEN_REAL = """\
 def test_cause_is_the_failure_that_ended_the_run_not_one_the_tree_ignored(
     tmp_path: Path, node_module: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, IGNORED_THEN_REAL)
+    tree = write_tree(tmp_path, IGNORED_THEN_REAL)
     report = tmp_path / "r.json"
     code = main(["run", str(tree), "--quiet", "--import", str(node_module),
                  "--report", str(report)])
@@ -249,7 +241,7 @@ def test_cause_is_the_failure_that_ended_the_run_not_one_the_tree_ignored(
 def test_cause_of_a_built_in_failure_without_a_reason(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(
+    tree = write_tree(
         tmp_path,
         '<Sequence><ForceSuccess><AlwaysFailure name="tolerated"/></ForceSuccess>'
         '<Inverter name="must_not_hold"><AlwaysSuccess/></Inverter></Sequence>',
@@ -263,7 +255,7 @@ def test_cause_of_a_built_in_failure_without_a_reason(
 def test_bench_counts_failures_by_the_node_that_failed(
     tmp_path: Path, node_module: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, IGNORED_THEN_REAL)
+    tree = write_tree(tmp_path, IGNORED_THEN_REAL)
     out = tmp_path / "bench"
     code = main(["bench", str(tree), "--world", str(TABLE), "--runs", "2", "--jobs", "2",
                  "--import", str(node_module), "--out", str(out)])
@@ -296,6 +288,6 @@ def test_bench_counts_failures_by_the_node_that_failed(
 def test_cause_follows_the_failures_of_the_last_run(
     tmp_path: Path, node_module: Path, capsys: pytest.CaptureFixture[str], body: str, cause: str
 ) -> None:
-    tree = _tree(tmp_path, body)
+    tree = write_tree(tmp_path, body)
     assert main(["run", str(tree), "--quiet", "--import", str(node_module)]) == 1
     assert capsys.readouterr().out.splitlines()[0] == f"result: FAILURE ({cause})"

@@ -11,20 +11,12 @@ import time
 from pathlib import Path
 
 import pytest
+from tree_files import write_tree
 
 from bt_manip.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
 TABLE = ROOT / "worlds" / "sawyer_table.yaml"
-
-
-def _tree(tmp_path: Path, body: str, name: str = "t.xml") -> Path:
-    path = tmp_path / name
-    path.write_text(
-        '<root BTCPP_format="4" main_tree_to_execute="Main">\n'
-        f'  <BehaviorTree ID="Main">\n{body}\n  </BehaviorTree>\n</root>\n'
-    )
-    return path
 
 
 def test_builtins_demo_succeeds_and_writes_report_and_blackboard(
@@ -55,13 +47,13 @@ def test_builtins_demo_succeeds_and_writes_report_and_blackboard(
 def test_failing_tree_exits_1_with_the_failing_node(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, '<Sequence><AlwaysSuccess/><AlwaysFailure name="nope"/></Sequence>')
+    tree = write_tree(tmp_path, '<Sequence><AlwaysSuccess/><AlwaysFailure name="nope"/></Sequence>')
     assert main(["run", str(tree)]) == 1
     assert "result: FAILURE" in capsys.readouterr().out
 
 
 def test_tick_budget_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    tree = _tree(tmp_path, '<Sleep msec="100000"/>')
+    tree = write_tree(tmp_path, '<Sleep msec="100000"/>')
     assert main(["run", str(tree), "--max-ticks", "3", "--tick-hz", "200"]) == 1
     assert "tick budget of 3 spent" in capsys.readouterr().out
 
@@ -69,7 +61,7 @@ def test_tick_budget_exits_1(tmp_path: Path, capsys: pytest.CaptureFixture[str])
 def test_runtime_script_error_exits_2_naming_the_line(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, '<Sequence>\n<Script code="x := missing + 1"/>\n</Sequence>')
+    tree = write_tree(tmp_path, '<Sequence>\n<Script code="x := missing + 1"/>\n</Sequence>')
     assert main(["run", str(tree), "--quiet"]) == 2
     out = capsys.readouterr().out
     assert "result: ERROR" in out
@@ -79,7 +71,7 @@ def test_runtime_script_error_exits_2_naming_the_line(
 def test_bad_tree_exits_2_without_traceback(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    tree = _tree(tmp_path, "<Sequence><AlwaysSucces/></Sequence>")
+    tree = write_tree(tmp_path, "<Sequence><AlwaysSucces/></Sequence>")
     assert main(["run", str(tree)]) == 2
     err = capsys.readouterr().err
     assert f"{tree}:3:" in err and "AlwaysSuccess" in err and "Traceback" not in err
@@ -88,7 +80,7 @@ def test_bad_tree_exits_2_without_traceback(
 def test_durations_run_on_the_sim_clock(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    tree = _tree(tmp_path, '<Sleep msec="30000"/>')
+    tree = write_tree(tmp_path, '<Sleep msec="30000"/>')
     report = tmp_path / "r.json"
     waits: list[float] = []
     monkeypatch.setattr(time, "sleep", waits.append)
@@ -101,7 +93,7 @@ def test_durations_run_on_the_sim_clock(
 
 
 def test_ctrl_c_halts_and_exits_130(tmp_path: Path) -> None:
-    tree = _tree(tmp_path, '<Sleep msec="600000"/>')
+    tree = write_tree(tmp_path, '<Sleep msec="600000"/>')
     report = tmp_path / "r.json"
     proc = subprocess.Popen(
         [sys.executable, "-m", "bt_manip.cli", "run", str(tree), "--report", str(report)],
@@ -186,7 +178,7 @@ def test_bb_numbers_feed_ports_of_any_number_type_and_scripts(
 ) -> None:
     # `--bb t=3` holds the integer 3; a double port (CloseGripper's timeout) reads it, and a
     # script computes with it, as with an entry a script created
-    tree = _tree(
+    tree = write_tree(
         tmp_path,
         '    <Sequence><CloseGripper timeout="{t}"/><Script code="u := t + 0.5"/></Sequence>',
     )
