@@ -131,9 +131,13 @@ class GoalUpdated(GoalsReader, ConditionNode):
 
     _was_active = False
 
+    def records_only(self) -> bool:
+        """Whether this tick only records the goals: the node was not active."""
+        return not self._was_active
+
     def update(self) -> Status:
         now = self.current_goals()
-        if not self._was_active:
+        if self.records_only():
             self.recorded = now
             return Status.FAILURE
         if now != self.recorded:
@@ -150,16 +154,10 @@ class GlobalUpdatedGoal(GoalUpdated):
 
     first_time = True
 
-    def update(self) -> Status:
-        now = self.current_goals()
-        if self.first_time:
-            self.first_time = False
-            self.recorded = now
-            return Status.FAILURE
-        if now != self.recorded:
-            self.recorded = now
-            return Status.SUCCESS
-        return Status.FAILURE
+    def records_only(self) -> bool:
+        """Whether this tick only records the goals: it is the very first."""
+        first, self.first_time = self.first_time, False
+        return first
 
 
 def _plain(value: Any) -> Any:
