@@ -210,12 +210,18 @@ def _get(url: str) -> Any:
         return json.loads(res.read())
 
 
-def test_sigterm_stops_the_run_and_every_server(tmp_path: Path) -> None:
+def _long_tree(tmp_path: Path) -> Path:
+    """``long.xml``: a tree that sleeps for two minutes in node ``long_wait``."""
     tree = tmp_path / "long.xml"
     tree.write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="M">'
         '<Sleep name="long_wait" msec="120000"/></BehaviorTree></root>'
     )
+    return tree
+
+
+def test_sigterm_stops_the_run_and_every_server(tmp_path: Path) -> None:
+    tree = _long_tree(tmp_path)
     process, ports = _start([str(tree)], tmp_path)
     try:
         page = f"http://127.0.0.1:{ports['tree page']}/"
@@ -274,11 +280,7 @@ def test_a_taken_default_port_falls_back_to_a_free_one(monkeypatch: pytest.Monke
 
 
 def test_a_killed_run_leaves_no_meshcat_server(tmp_path: Path) -> None:
-    tree = tmp_path / "long.xml"
-    tree.write_text(
-        '<root BTCPP_format="4"><BehaviorTree ID="M">'
-        '<Sleep name="long_wait" msec="120000"/></BehaviorTree></root>'
-    )
+    tree = _long_tree(tmp_path)
     process, _ = _start([str(tree)], tmp_path)
     servers = _children(process.pid)
     assert servers
