@@ -70,11 +70,16 @@ REALTIME = _within(float, 0.01, 1000.0)
 """Real-time factors accepted by --realtime."""
 
 
-def _port(text: str) -> int:
+def _port_number(text: str) -> int:
+    """``text`` as an integer, else the error of every port option."""
     try:
-        value = int(text)
+        return int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a port number, got '{text}'") from None
+
+
+def _port(text: str) -> int:
+    value = _port_number(text)
     if not 0 <= value <= 65535:
         raise argparse.ArgumentTypeError(
             f"{value} is not a port; use 1..65535, or 0 for any free port"
@@ -105,10 +110,7 @@ def _address(text: str) -> str:
 
 def _groot_port(text: str) -> int:
     """A Groot2 port: PORT serves requests, PORT+1 publishes, so at most 65534 (0: any)."""
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a port number, got '{text}'") from None
+    value = _port_number(text)
     if not 0 <= value <= 65534:
         raise argparse.ArgumentTypeError(
             f"must be a port from 1 to 65534 (PUB uses the next one), or 0 for any, got {text}")
