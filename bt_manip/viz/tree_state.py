@@ -1,7 +1,7 @@
 """The behaviour tree as the pages show it: its nodes once, then their statuses tick by tick.
 
-:class:`TreeWatcher` walks a tree's py_trees root in depth-first order (the order of
-``Tree.node_records()``), keeps each node's name, node ID, depth and parent, and after every
+:class:`TreeWatcher` walks a tree once with :func:`bt_manip.bt.walk.walk_nodes` (the order and
+node IDs of the run report), keeps each node's name, node ID, depth and parent, and after every
 tick reports which nodes changed status or reason. Statuses use BehaviorTree.CPP's names:
 IDLE (py_trees' INVALID), RUNNING, SUCCESS, FAILURE.
 
@@ -16,6 +16,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from typing import Any
+
+from bt_manip.bt.node import BtNode
+from bt_manip.bt.walk import walk_nodes
 
 STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
 """Status codes used on the pages: the index of the name."""
@@ -46,16 +49,10 @@ class TreeWatcher:
     def __post_init__(self) -> None:
         self._behaviours: list[Any] = []
         self.nodes = []
-
-        def walk(node: Any, depth: int, parent: int) -> None:
-            index = len(self.nodes)
-            node_id = getattr(node, "node_id", None) or type(node).__name__
-            self.nodes.append(TreeNodeInfo(index, str(node.name), str(node_id), depth, parent))
-            self._behaviours.append(node)
-            for child in getattr(node, "children", []) or []:
-                walk(child, depth + 1, index)
-
-        walk(self.tree.root, 0, -1)
+        for walked in walk_nodes(self.tree.root):
+            self.nodes.append(TreeNodeInfo(walked.index, walked.name, walked.node_id,
+                                           walked.depth, walked.parent))
+            self._behaviours.append(walked.node)
         self.statuses = [0] * len(self.nodes)
         self.reasons = [""] * len(self.nodes)
         self._seen = [IDLE] * len(self.nodes)  # status at the end of the last tick
@@ -69,18 +66,12 @@ class TreeWatcher:
 
     def _current(self) -> list[tuple[int, str]]:
         """(shown status, reason) of every node now."""
-        records = getattr(self.tree, "node_records", None)
-        if callable(records):
-            recs = list(records())
-            if len(recs) == len(self.nodes):
-                return [
-                    (shown_status(status_code(r.status),
-                                  status_code(getattr(r, "last_status", "IDLE"))),
-                     str(r.reason or ""))
-                    for r in recs
-                ]
         out = []
         for i, b in enumerate(self._behaviours):
+            if isinstance(b, BtNode):
+                out.append((shown_status(status_code(b.bt_status), status_code(b.last_status)),
+                            str(b.feedback_message or "")))
+                continue
             now = status_code(b.status.name)
             if now != IDLE or self._seen[i] == RUNNING:
                 self._seen[i] = now  # a halted node forgets its result
