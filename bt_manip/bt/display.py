@@ -10,6 +10,7 @@ from __future__ import annotations
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
+from bt_manip.bt.walk import walk_nodes
 
 MARKERS = {"IDLE": " ", "RUNNING": "*", "SUCCESS": "+", "FAILURE": "x", "SKIPPED": "-"}
 _SHAPES = {"Action": "box", "Condition": "ellipse", "Control": "box3d",
@@ -57,11 +58,11 @@ def _dot_escape(text: str) -> str:
 
 def render_dot(tree: Tree) -> str:
     """Graphviz (dot) source of the tree."""
-    ids: dict[int, str] = {}
     lines = [f'digraph "{_dot_escape(tree.tree_id)}" {{', "  rankdir=TB;",
              '  node [fontname="Helvetica", fontsize=10];']
-    for index, (_, _, node) in enumerate(tree.walk()):
-        ids[id(node)] = f"n{index}"
+    walked_nodes = list(walk_nodes(tree.root))
+    for walked in walked_nodes:
+        index, node = walked.index, walked.node
         kind = "SubTree" if isinstance(node, SubTree) else node.KIND
         label = _dot_escape(_label(node))
         if node.attribute_texts:
@@ -69,8 +70,8 @@ def render_dot(tree: Tree) -> str:
                 _dot_escape(f"{k}={v}") for k, v in node.attribute_texts.items())
         lines.append(f'  n{index} [label="{label}", '
                      f"shape={_SHAPES.get(kind, 'box')}];")
-    for _, _, node in tree.walk():
-        for child in node.bt_children():
-            lines.append(f"  {ids[id(node)]} -> {ids[id(child)]};")
+    for walked in walked_nodes:
+        if walked.parent >= 0:
+            lines.append(f"  n{walked.parent} -> n{walked.index};")
     lines.append("}")
     return "\n".join(lines) + "\n"
