@@ -30,6 +30,7 @@ from typing import Any, Protocol
 import py_trees
 
 from bt_manip.bt.node import BtNode, TreeRuntimeError
+from bt_manip.bt.status import as_status
 from bt_manip.bt.walk import walk_nodes
 from bt_manip.failure_cause import FailureCause
 from bt_manip.outputs import write_text
@@ -160,7 +161,7 @@ def node_reports(tree: Any) -> list[NodeReport]:
         if isinstance(node, BtNode):
             status, last = node.bt_status.value, node.last_status.value
         else:
-            status = last = node.status.name
+            status = last = as_status(node.status).value
         out.append(NodeReport(walked.path, walked.node_id, status,
                               node.feedback_message or "", last))
     return out

@@ -8,6 +8,7 @@ reason); :func:`render_tree` is the static outline that ``bt-manip show`` prints
 from __future__ import annotations
 
 from bt_manip.bt.node import BtNode
+from bt_manip.bt.status import shown
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 from bt_manip.bt.walk import walk_nodes
@@ -35,10 +36,7 @@ def render_status(tree: Tree) -> str:
     BehaviorTree.CPP it is IDLE again). Its feedback message (failure reason) follows ``--``."""
     lines = []
     for _, depth, node in tree.walk():
-        status = node.bt_status.value
-        if status == "IDLE":
-            status = node.last_status.value
-        marker = MARKERS[status]
+        marker = MARKERS[shown(node.bt_status, node.last_status).value]
         reason = f" -- {node.feedback_message}" if node.feedback_message else ""
         lines.append(f"{'  ' * depth}[{marker}] {_label(node)}{reason}")
     return "\n".join(lines)

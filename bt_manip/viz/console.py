@@ -12,14 +12,13 @@ import sys
 import time
 from typing import Any, TextIO
 
+from bt_manip.bt.status import as_status, shown
 from bt_manip.runner import NodeReport, Runner, node_reports
 
 
 def _shown(rec: NodeReport) -> str:
     """RUNNING while running; once finished, what the node returned (not IDLE)."""
-    if rec.status == "IDLE" and rec.last_status:
-        return rec.last_status
-    return rec.status
+    return shown(as_status(rec.status), as_status(rec.last_status)).value
 
 
 class StatusLog:
