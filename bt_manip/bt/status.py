@@ -33,11 +33,11 @@ class NodeStatus(enum.Enum):
         return self is NodeStatus.SUCCESS or self is NodeStatus.FAILURE
 
     def to_py_trees(self) -> Status:
-        return _TO_PY_TREES[self]
+        return PY_TREES_OF[self]
 
     @staticmethod
     def from_py_trees(status: Status) -> NodeStatus:
-        return _FROM_PY_TREES[status]
+        return STATUS_OF_PY_TREES[status]
 
     @staticmethod
     def parse(text: str) -> NodeStatus:
@@ -50,19 +50,23 @@ class NodeStatus(enum.Enum):
             ) from None
 
 
-_TO_PY_TREES = {
+PY_TREES_OF = {
     NodeStatus.IDLE: Status.INVALID,
     NodeStatus.RUNNING: Status.RUNNING,
     NodeStatus.SUCCESS: Status.SUCCESS,
     NodeStatus.FAILURE: Status.FAILURE,
     NodeStatus.SKIPPED: Status.INVALID,
 }
-_FROM_PY_TREES = {
+"""The py_trees status of each status (IDLE and SKIPPED are both INVALID)."""
+STATUS_OF_PY_TREES = {
     Status.INVALID: NodeStatus.IDLE,
     Status.RUNNING: NodeStatus.RUNNING,
     Status.SUCCESS: NodeStatus.SUCCESS,
     Status.FAILURE: NodeStatus.FAILURE,
 }
+"""The status of each py_trees status (INVALID is IDLE)."""
+RESULT_OF_PY_TREES = {p: b for p, b in STATUS_OF_PY_TREES.items() if p is not Status.INVALID}
+"""What a py_trees tick result means as a node's result (INVALID is no result)."""
 
 
 STATUS_CODES: dict[NodeStatus, int] = {
@@ -82,7 +86,7 @@ def as_status(value: object) -> NodeStatus:
     if isinstance(value, NodeStatus):
         return value
     if isinstance(value, Status):
-        return _FROM_PY_TREES[value]
+        return STATUS_OF_PY_TREES[value]
     if isinstance(value, int):
         return STATUS_OF_CODE.get(value, NodeStatus.IDLE)
     text = str(getattr(value, "name", value) or "").strip().upper()
