@@ -29,7 +29,9 @@ from typing import Any, Protocol
 
 import py_trees
 
-from bt_manip.bt.node import TreeRuntimeError
+from bt_manip.bt.node import BtNode, TreeRuntimeError
+from bt_manip.bt.status import as_status
+from bt_manip.bt.walk import walk_nodes
 from bt_manip.failure_cause import FailureCause
 from bt_manip.outputs import write_text
 
@@ -146,19 +148,22 @@ def _cause_json(cause: FailureCause | None) -> dict[str, str]:
     return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
 
 
-def node_reports(root: py_trees.behaviour.Behaviour) -> list[NodeReport]:
-    """Every node under ``root`` with its status and feedback, paths joined by '/'."""
+def node_reports(tree: Any) -> list[NodeReport]:
+    """Every node of ``tree`` (a bt-manip tree or anything with a py_trees ``root``) with its
+    status and feedback, in the order and with the paths of :func:`bt_manip.bt.walk.walk_nodes`.
+    """
+    root = getattr(tree, "root", None)
+    if root is None:
+        return []
     out: list[NodeReport] = []
-
-    def walk(node: py_trees.behaviour.Behaviour, prefix: str) -> None:
-        path = f"{prefix}/{node.name}" if prefix else node.name
-        node_id = getattr(node, "node_id", type(node).__name__)
-        status = node.status.name
-        out.append(NodeReport(path, node_id, status, node.feedback_message or "", status))
-        for child in node.children:
-            walk(child, path)
-
-    walk(root, "")
+    for walked in walk_nodes(root):
+        node = walked.node
+        if isinstance(node, BtNode):
+            status, last = node.bt_status.value, node.last_status.value
+        else:
+            status = last = as_status(node.status).value
+        out.append(NodeReport(walked.path, walked.node_id, status,
+                              node.feedback_message or "", last))
     return out
 
 
@@ -270,13 +275,7 @@ class Runner:
             time.sleep(1.0 / opts.tick_hz)
 
     def _records(self) -> list[NodeReport]:
-        records = getattr(self.tree, "node_records", None)
-        if callable(records):
-            return [
-                NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
-                for r in records()
-            ]
-        return node_reports(self.tree.root)
+        return node_reports(self.tree)
 
     def _failure_reason(self) -> str:
         """The reason of the failure that ended the run (see :mod:`bt_manip.failure_cause`):

@@ -8,8 +8,10 @@ reason); :func:`render_tree` is the static outline that ``bt-manip show`` prints
 from __future__ import annotations
 
 from bt_manip.bt.node import BtNode
+from bt_manip.bt.status import shown
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
+from bt_manip.bt.walk import walk_nodes
 
 MARKERS = {"IDLE": " ", "RUNNING": "*", "SUCCESS": "+", "FAILURE": "x", "SKIPPED": "-"}
 _SHAPES = {"Action": "box", "Condition": "ellipse", "Control": "box3d",
@@ -34,10 +36,7 @@ def render_status(tree: Tree) -> str:
     BehaviorTree.CPP it is IDLE again). Its feedback message (failure reason) follows ``--``."""
     lines = []
     for _, depth, node in tree.walk():
-        status = node.bt_status.value
-        if status == "IDLE":
-            status = node.last_status.value
-        marker = MARKERS[status]
+        marker = MARKERS[shown(node.bt_status, node.last_status).value]
         reason = f" -- {node.feedback_message}" if node.feedback_message else ""
         lines.append(f"{'  ' * depth}[{marker}] {_label(node)}{reason}")
     return "\n".join(lines)
@@ -57,11 +56,11 @@ def _dot_escape(text: str) -> str:
 
 def render_dot(tree: Tree) -> str:
     """Graphviz (dot) source of the tree."""
-    ids: dict[int, str] = {}
     lines = [f'digraph "{_dot_escape(tree.tree_id)}" {{', "  rankdir=TB;",
              '  node [fontname="Helvetica", fontsize=10];']
-    for index, (_, _, node) in enumerate(tree.walk()):
-        ids[id(node)] = f"n{index}"
+    walked_nodes = list(walk_nodes(tree.root))
+    for walked in walked_nodes:
+        index, node = walked.index, walked.node
         kind = "SubTree" if isinstance(node, SubTree) else node.KIND
         label = _dot_escape(_label(node))
         if node.attribute_texts:
@@ -69,8 +68,8 @@ def render_dot(tree: Tree) -> str:
                 _dot_escape(f"{k}={v}") for k, v in node.attribute_texts.items())
         lines.append(f'  n{index} [label="{label}", '
                      f"shape={_SHAPES.get(kind, 'box')}];")
-    for _, _, node in tree.walk():
-        for child in node.bt_children():
-            lines.append(f"  {ids[id(node)]} -> {ids[id(child)]};")
+    for walked in walked_nodes:
+        if walked.parent >= 0:
+            lines.append(f"  n{walked.parent} -> n{walked.index};")
     lines.append("}")
     return "\n".join(lines) + "\n"

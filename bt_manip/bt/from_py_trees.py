@@ -52,6 +52,7 @@ from bt_manip.bt.pytrees_leaf import wrap
 from bt_manip.bt.registry import registry
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
+from bt_manip.bt.walk import walk_nodes
 
 D = py_trees.decorators
 _SIMPLE_DECORATORS: dict[type, type[BtNode]] = {
@@ -213,10 +214,8 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
 def _register_leaves(root: BtNode) -> None:
     """Register the classes of the tree's leaves whose IDs are free, so the XML that
     ``to_xml`` writes loads back."""
-    stack = [root]
-    while stack:
-        node = stack.pop()
-        stack.extend(node.bt_children())
+    for walked in walk_nodes(root):
+        node = walked.node
         if isinstance(node, SubTree) or getattr(node, "PYTHON_ONLY", False):
             continue
         if registry.get(node.NODE_ID) is None:

@@ -46,7 +46,7 @@ from bt_manip.bt.ports import (
     value_problem,
 )
 from bt_manip.bt.script import Script, ScriptRuntimeError, ScriptSyntaxError, parse_script
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import PY_TREES_OF, RESULT_OF_PY_TREES, STATUS_OF_PY_TREES, NodeStatus
 
 PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
 POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
@@ -55,11 +55,9 @@ IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
 _MISSING = object()
 _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
-_PY_FROM_BT = {s: s.to_py_trees() for s in NodeStatus}
-_BT_FROM_PY = {s: NodeStatus.from_py_trees(s) for s in Status}
 # Enum members hash in Python code: the hot path maps statuses through identity lookups.
-_PY_BY_ID = {id(s): p for s, p in _PY_FROM_BT.items()}
-_LEAF_RESULT = {id(s): b for s, b in _BT_FROM_PY.items() if s is not Status.INVALID}
+_PY_BY_ID = {id(s): p for s, p in PY_TREES_OF.items()}
+_LEAF_RESULT = {id(s): b for s, b in RESULT_OF_PY_TREES.items()}
 
 
 class TreeRuntimeError(RuntimeError):
@@ -418,7 +416,7 @@ class BtNode(PortsMixin):
             self.status = Status.INVALID
         else:
             self.status = new_status
-            self.bt_status = _BT_FROM_PY[new_status]
+            self.bt_status = STATUS_OF_PY_TREES[new_status]
 
     def bt_children(self) -> list[BtNode]:
         return list(self.children)  # type: ignore[attr-defined]

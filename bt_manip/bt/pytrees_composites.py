@@ -38,12 +38,10 @@ from bt_manip.bt.node import (
 from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage, raised_as_tree_error
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import STATUS_OF_PY_TREES, NodeStatus
 
 Ports = dict[str, PortInformation]
 INVALID = Status.INVALID
-_BT_FROM_PY = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,
-               Status.RUNNING: NodeStatus.RUNNING, Status.INVALID: NodeStatus.IDLE}
 POLICIES = ("SuccessOnAll", "SuccessOnOne", "SuccessOnSelected")
 ONESHOT_POLICIES = tuple(p.name for p in py_trees.common.OneShotPolicy)
 
@@ -52,7 +50,7 @@ def _result(node: BtNode) -> NodeStatus:
     status = node.status
     if status == INVALID:
         raise TreeRuntimeError(f"{node.describe()}: py_trees' tick left the node INVALID")
-    return _BT_FROM_PY[status]
+    return STATUS_OF_PY_TREES[status]
 
 
 class _PyTreesNode:
@@ -75,7 +73,7 @@ class _PyTreesNode:
     def stop(self, new_status: Status = INVALID) -> None:
         """py_trees' stop (INVALID stops the children too), keeping the BT.CPP status in step."""
         self.PY.stop(self, new_status)
-        self.bt_status = _BT_FROM_PY[new_status]
+        self.bt_status = STATUS_OF_PY_TREES[new_status]
 
     def halt(self) -> None:
         self.stop(INVALID)

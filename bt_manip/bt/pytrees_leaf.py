@@ -46,13 +46,11 @@ from py_trees.ports import PortInformation, PortsMixin
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.node import AttributeCheck, LeafNode, TreeRuntimeError
 from bt_manip.bt.ports import Literal, Ref, convert_literal
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import RESULT_OF_PY_TREES, NodeStatus
 
 PORT_PREFIX = "/__bt_manip_port__/"
 """py_trees key of a port that is not wired to an entry (kept by the leaf itself)."""
 
-_BT_FROM_PY = {Status.SUCCESS: NodeStatus.SUCCESS, Status.FAILURE: NodeStatus.FAILURE,
-               Status.RUNNING: NodeStatus.RUNNING}
 _NONE_TEXT = ("", "null", "none")
 _UNKNOWN = object()  # a constructor argument of a wrapped object that its attributes hide
 
@@ -407,7 +405,7 @@ class PyTreesLeaf(LeafNode):
             for _ in behaviour.tick():
                 pass
         self.feedback_message = behaviour.feedback_message
-        status = _BT_FROM_PY.get(behaviour.status)
+        status = RESULT_OF_PY_TREES.get(behaviour.status)
         if status is None:
             raise TreeRuntimeError(
                 f"{self.describe()}: the py_trees behaviour returned {behaviour.status!r}")

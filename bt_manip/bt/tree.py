@@ -14,6 +14,7 @@ from bt_manip.bt.node import BtNode
 from bt_manip.bt.ports import Ref
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
+from bt_manip.bt.walk import walk_nodes
 from bt_manip.errors import InputError
 
 INVALID = Status.INVALID
@@ -165,34 +166,25 @@ class Tree:
         self.bt_status = NodeStatus.IDLE
 
     def walk(self) -> Iterator[tuple[str, int, BtNode]]:
-        """Every node with its path and depth, depth first, parents before children."""
-
-        def visit(node: BtNode, path: str, depth: int) -> Iterator[tuple[str, int, BtNode]]:
-            yield path, depth, node
-            seen: dict[str, int] = {}
-            for child in node.bt_children():
-                count = seen.get(child.name, 0) + 1
-                seen[child.name] = count
-                suffix = f"#{count}" if count > 1 else ""
-                yield from visit(child, f"{path}/{child.name}{suffix}", depth + 1)
-
-        yield from visit(self.root, self.root.name, 0)
+        """Every node with its path and depth, depth first, parents before children (see
+        :func:`bt_manip.bt.walk.walk_nodes`)."""
+        for walked in walk_nodes(self.root):
+            yield walked.path, walked.depth, walked.node
 
     def node_records(self) -> list[NodeRecord]:
-        records = []
-        for path, depth, node in self.walk():
-            records.append(
-                NodeRecord(
-                    path=path,
-                    name=node.name,
-                    node_id=node.NODE_ID if not isinstance(node, SubTree) else node.tree_id,
-                    status=node.bt_status.value,
-                    reason=node.feedback_message or "",
-                    depth=depth,
-                    last_status=node.last_status.value,
-                )
+        """Every node as the run report and the console show it, in walk order."""
+        return [
+            NodeRecord(
+                path=walked.path,
+                name=walked.name,
+                node_id=walked.node_id,
+                status=walked.node.bt_status.value,
+                reason=walked.node.feedback_message or "",
+                depth=walked.depth,
+                last_status=walked.node.last_status.value,
             )
-        return records
+            for walked in walk_nodes(self.root)
+        ]
 
     def nodes(self) -> list[BtNode]:
         return [node for _, _, node in self.walk()]

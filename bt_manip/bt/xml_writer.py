@@ -12,6 +12,7 @@ from xml.sax.saxutils import quoteattr
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
+from bt_manip.bt.walk import walk_nodes
 
 
 def _node_lines(node: BtNode, indent: int, subtrees: dict[str, BtNode], out: list[str]) -> None:
@@ -68,10 +69,8 @@ def _models(root: BtNode) -> list[str]:
     from bt_manip.bt.registry import registry
 
     classes: dict[str, type[BtNode]] = {}
-    stack = [root]
-    while stack:
-        node = stack.pop()
-        stack.extend(node.bt_children())
+    for walked in walk_nodes(root):
+        node = walked.node
         if not isinstance(node, SubTree) and not registry.is_builtin(node.NODE_ID):
             classes.setdefault(node.NODE_ID, type(node))
     if not classes:

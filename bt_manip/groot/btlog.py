@@ -16,10 +16,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import BinaryIO
 
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import STATUS_CODES, NodeStatus
 from bt_manip.groot.layout import registered_classes, tree_xml
 from bt_manip.groot.monitor import TreeMonitor
-from bt_manip.groot.protocol import STATUS_CODES, decode_transitions
+from bt_manip.groot.protocol import decode_transitions
 
 MAGIC = b"BTCPP4-FileLogger2"
 _TRANSITION = struct.Struct("<IHHB")  # 48-bit timestamp as 32 + 16 bits, uid, status

@@ -17,6 +17,7 @@ from bt_manip.bt.models import spec_of
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
+from bt_manip.bt.walk import walk_nodes
 
 INDENT = "    "
 SUBTREE_AUTOREMAP = ("if true, every entry whose key does not start with '_' is shared "
@@ -67,23 +68,24 @@ def layout_of(tree: Tree) -> TreeLayout:
     main = Instance(tree.tree_id, "", tree.root, tree.blackboard)
     layout = TreeLayout([main], {}, {})
 
-    def visit(node: BtNode, inst: Instance) -> None:
-        uid = len(layout.uid_of) + 1
+    instance_of: list[Instance] = []  # by walk index: the instance the node belongs to
+    for walked in walk_nodes(tree.root):
+        node = walked.node
+        uid = walked.index + 1
         layout.uid_of[id(node)] = uid
         layout.nodes_by_uid[uid] = node
-        inst.nodes.append(node)
-        if isinstance(node, SubTree):
-            own = node.name if node.name != node.tree_id else f"{node.tree_id}::{uid}"
+        inst = main if walked.parent < 0 else instance_of[walked.parent]
+        parent = layout.nodes_by_uid.get(walked.parent + 1) if walked.parent >= 0 else None
+        if isinstance(parent, SubTree):
+            # the root of a subtree: a new instance, named by its SubTree node
+            own = parent.name
+            if own == parent.tree_id:
+                own = f"{parent.tree_id}::{walked.parent + 1}"
             path = f"{inst.path}/{own}" if inst.path else own
-            child = node.child
-            sub = Instance(node.tree_id, path, child, child.blackboard)
-            layout.instances.append(sub)
-            visit(child, sub)
-            return
-        for child in node.bt_children():
-            visit(child, inst)
-
-    visit(tree.root, main)
+            inst = Instance(parent.tree_id, path, node, node.blackboard)
+            layout.instances.append(inst)
+        inst.nodes.append(node)
+        instance_of.append(inst)
     return layout
 
 

@@ -13,20 +13,13 @@ import os
 import struct
 from collections.abc import Iterable
 
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import STATUS_CODES, NodeStatus
 
 PROTOCOL_ID = 2
 REQUEST_HEADER_SIZE = 6
 _HEADER = struct.Struct("<BBI")
 _TRANSITION_TAIL = struct.Struct("<HB")
 
-STATUS_CODES: dict[NodeStatus, int] = {
-    NodeStatus.IDLE: 0,
-    NodeStatus.RUNNING: 1,
-    NodeStatus.SUCCESS: 2,
-    NodeStatus.FAILURE: 3,
-    NodeStatus.SKIPPED: 4,
-}
 IDLE_OFFSET = 10
 """A node back to IDLE shows in STATUS as 10 + the status it had before."""
 

@@ -24,12 +24,11 @@ import msgpack
 import zmq
 
 from bt_manip.bt.node import BtNode
-from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.status import STATUS_CODES, NodeStatus
 from bt_manip.groot import hooks as hk
 from bt_manip.groot.layout import registered_classes, tree_xml
 from bt_manip.groot.monitor import TreeMonitor
 from bt_manip.groot.protocol import (
-    STATUS_CODES,
     RequestType,
     encode_transitions,
     parse_request_header,

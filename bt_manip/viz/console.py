@@ -12,24 +12,13 @@ import sys
 import time
 from typing import Any, TextIO
 
+from bt_manip.bt.status import as_status, shown
 from bt_manip.runner import NodeReport, Runner, node_reports
-
-
-def _records(tree: Any) -> list[NodeReport]:
-    fn = getattr(tree, "node_records", None)
-    if callable(fn):
-        return [
-            NodeReport(r.path, r.node, r.status, r.reason, getattr(r, "last_status", ""))
-            for r in fn()
-        ]
-    return node_reports(tree.root)
 
 
 def _shown(rec: NodeReport) -> str:
     """RUNNING while running; once finished, what the node returned (not IDLE)."""
-    if rec.status == "IDLE" and rec.last_status:
-        return rec.last_status
-    return rec.status
+    return shown(as_status(rec.status), as_status(rec.last_status)).value
 
 
 class StatusLog:
@@ -41,7 +30,7 @@ class StatusLog:
         self._last: dict[str, str] = {}
 
     def __call__(self, runner: Runner) -> None:
-        for rec in _records(self.tree):
+        for rec in node_reports(self.tree):
             before = self._last.get(rec.path, "IDLE")
             now = _shown(rec)
             if now != before:

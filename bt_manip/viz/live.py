@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.bt.status import STATUS_CODES, NodeStatus
 from bt_manip.overlay import FrameItem, Overlay
 from bt_manip.run_context import run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
@@ -31,12 +32,13 @@ from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, row_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
-from bt_manip.viz.tree_state import FAILURE, TreeWatcher, run_result
+from bt_manip.viz.tree_state import TreeWatcher, run_result
 
 OVERLAY_ROOT = "/meshcat/bt_manip_overlay"
 HIGHLIGHT_RGBA = (0.15, 0.95, 0.55, 1.0)
 """Colour of an object while a robot holds it."""
 MAX_FAILURES = 12
+FAILURE_CODE = STATUS_CODES[NodeStatus.FAILURE]
 """Recent failures listed on the page."""
 POSE_EPS = 1e-5
 """Pose changes below this (m, or quaternion units) are not sent again."""
@@ -300,7 +302,7 @@ class LiveViewer:
         """After a tick: statuses to the page, poses/overlays/highlights to meshcat."""
         t = float(getattr(runner, "sim_time", 0.0))
         for index, code, reason in self.watcher.update():
-            if code == FAILURE:
+            if code == FAILURE_CODE:
                 self._failures.append((round(t, 4), index, reason))
         del self._failures[:-MAX_FAILURES]
         self._publish_state(runner)

@@ -1,15 +1,15 @@
 """The behaviour tree as the pages show it: its nodes once, then their statuses tick by tick.
 
-:class:`TreeWatcher` walks a tree's py_trees root in depth-first order (the order of
-``Tree.node_records()``), keeps each node's name, node ID, depth and parent, and after every
+:class:`TreeWatcher` walks a tree once with :func:`bt_manip.bt.walk.walk_nodes` (the order and
+node IDs of the run report), keeps each node's name, node ID, depth and parent, and after every
 tick reports which nodes changed status or reason. Statuses use BehaviorTree.CPP's names:
 IDLE (py_trees' INVALID), RUNNING, SUCCESS, FAILURE.
 
 What a node shows is its status while it runs and, once it has finished, what it last
 returned: BehaviorTree.CPP (and py_trees) reset finished children to IDLE, but a failed leaf
-must stay red beside its red parent. A node that was halted while RUNNING shows IDLE. The
-last result comes from the tree's records (``last_status``) when it keeps them, otherwise from
-what the watcher saw at the end of earlier ticks.
+must stay red beside its red parent. A node that was halted while RUNNING shows IDLE (see
+:func:`bt_manip.bt.status.shown`). The last result of a bt-manip node is its ``last_status``;
+for a plain py_trees tree it is what the watcher saw at the end of earlier ticks.
 """
 
 from __future__ import annotations
@@ -17,10 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-STATUS_NAMES = ("IDLE", "RUNNING", "SUCCESS", "FAILURE", "SKIPPED")
-"""Status codes used on the pages: the index of the name."""
-IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = range(5)
-FINISHED = (SUCCESS, FAILURE)
+from bt_manip.bt.node import BtNode
+from bt_manip.bt.status import STATUS_CODES, NodeStatus, as_status, shown, status_code
+from bt_manip.bt.walk import walk_nodes
+
+STATUS_NAMES = tuple(status.value for status in sorted(STATUS_CODES, key=STATUS_CODES.get))
+"""Status names by their page code (:data:`bt_manip.bt.status.STATUS_CODES`)."""
+IDLE = STATUS_CODES[NodeStatus.IDLE]
 
 
 @dataclass(frozen=True)
@@ -46,19 +49,13 @@ class TreeWatcher:
     def __post_init__(self) -> None:
         self._behaviours: list[Any] = []
         self.nodes = []
-
-        def walk(node: Any, depth: int, parent: int) -> None:
-            index = len(self.nodes)
-            node_id = getattr(node, "node_id", None) or type(node).__name__
-            self.nodes.append(TreeNodeInfo(index, str(node.name), str(node_id), depth, parent))
-            self._behaviours.append(node)
-            for child in getattr(node, "children", []) or []:
-                walk(child, depth + 1, index)
-
-        walk(self.tree.root, 0, -1)
-        self.statuses = [0] * len(self.nodes)
+        for walked in walk_nodes(self.tree.root):
+            self.nodes.append(TreeNodeInfo(walked.index, walked.name, walked.node_id,
+                                           walked.depth, walked.parent))
+            self._behaviours.append(walked.node)
+        self.statuses = [IDLE] * len(self.nodes)
         self.reasons = [""] * len(self.nodes)
-        self._seen = [IDLE] * len(self.nodes)  # status at the end of the last tick
+        self._seen = [NodeStatus.IDLE] * len(self.nodes)  # status at the end of the last tick
 
     def structure(self) -> list[dict[str, Any]]:
         """The nodes as JSON-ready dicts (index, name, id, depth, parent)."""
@@ -69,22 +66,16 @@ class TreeWatcher:
 
     def _current(self) -> list[tuple[int, str]]:
         """(shown status, reason) of every node now."""
-        records = getattr(self.tree, "node_records", None)
-        if callable(records):
-            recs = list(records())
-            if len(recs) == len(self.nodes):
-                return [
-                    (shown_status(status_code(r.status),
-                                  status_code(getattr(r, "last_status", "IDLE"))),
-                     str(r.reason or ""))
-                    for r in recs
-                ]
         out = []
         for i, b in enumerate(self._behaviours):
-            now = status_code(b.status.name)
-            if now != IDLE or self._seen[i] == RUNNING:
-                self._seen[i] = now  # a halted node forgets its result
-            out.append((shown_status(now, self._seen[i]),
+            if isinstance(b, BtNode):
+                now, last = b.bt_status, b.last_status
+            else:
+                now = as_status(b.status)
+                if now is not NodeStatus.IDLE or self._seen[i] is NodeStatus.RUNNING:
+                    self._seen[i] = now  # a halted node forgets its result
+                last = self._seen[i]
+            out.append((status_code(shown(now, last)),
                         str(getattr(b, "feedback_message", "") or "")))
         return out
 
@@ -100,10 +91,9 @@ class TreeWatcher:
 
 
 def shown_status(status: int, last: int) -> int:
-    """What a page shows for a node with ``status`` now that last returned ``last``."""
-    if status == IDLE and last in FINISHED:
-        return last
-    return status
+    """What a page shows (a code) for a node with code ``status`` now that last returned
+    ``last`` (see :func:`bt_manip.bt.status.shown`)."""
+    return status_code(shown(as_status(status), as_status(last)))
 
 
 def run_result(watcher: TreeWatcher) -> str:
@@ -117,15 +107,3 @@ def run_result(watcher: TreeWatcher) -> str:
     if name is None:
         name = STATUS_NAMES[watcher.statuses[0]] if watcher.statuses else ""
     return name if name in ("SUCCESS", "FAILURE") else ""
-
-
-def status_code(name: Any) -> int:
-    """The page's code of a status name (py_trees or BehaviorTree.CPP spelling)."""
-    text = getattr(name, "name", name)
-    text = str(text).upper()
-    if text in ("INVALID", "IDLE"):
-        return 0
-    try:
-        return STATUS_NAMES.index(text)
-    except ValueError:
-        return 0
