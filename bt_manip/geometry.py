@@ -39,7 +39,7 @@ def yaw_of(quat: Sequence[float]) -> float:
     return float(pb.getEulerFromQuaternion(list(quat))[2])
 
 
-def rotation_matrix(quat: Sequence[float]) -> np.ndarray:
+def rotation_matrix(quat: Sequence[float] | np.ndarray) -> np.ndarray:
     """3x3 rotation matrix of a quaternion (normalised first)."""
     return np.array(pb.getMatrixFromQuaternion(list(quat))).reshape(3, 3)
 
@@ -79,7 +79,9 @@ def quat_from_matrix(r: np.ndarray) -> np.ndarray:
     return -quat if quat[3] < 0 else quat
 
 
-def pose_matrix(position: Sequence[float] | np.ndarray, quat: Sequence[float]) -> np.ndarray:
+def pose_matrix(
+    position: Sequence[float] | np.ndarray, quat: Sequence[float] | np.ndarray
+) -> np.ndarray:
     """4x4 transform of a position and a quaternion (x, y, z, w)."""
     out = np.eye(4)
     out[:3, :3] = rotation_matrix(quat)

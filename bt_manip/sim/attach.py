@@ -12,7 +12,7 @@ frame; the relative pose is computed in those frames so nothing jumps when the j
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import pybullet as pb
 
@@ -60,7 +60,7 @@ class Attachments:
 
     @property
     def client(self) -> int:
-        return self.world.client
+        return cast(int, self.world.client)
 
     def finger_distance(self, robot: Any, body: int) -> float:
         """Smallest distance (m) between the object and any finger link; <= 0 when touching."""

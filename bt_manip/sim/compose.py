@@ -30,7 +30,7 @@ import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, cast
 
 import defusedxml.ElementTree as SafeET
 
@@ -107,10 +107,10 @@ def composed_urdf(description: RobotDescription | Recipe | Path | str) -> Path:
     :class:`Recipe` or a URDF path. A plain URDF without meshes is returned as it is; otherwise
     the resolved or composed file is written to :func:`cache_dir` once and its path returned.
     """
-    source = getattr(description, "urdf", description)
+    source: object = getattr(description, "urdf", description)
     if isinstance(source, Recipe):
         return _compose_recipe(source)
-    return _resolve_single(Path(source))
+    return _resolve_single(Path(cast("Path | str", source)))
 
 
 def _compose_recipe(recipe: Recipe) -> Path:
@@ -165,7 +165,7 @@ def _read_urdf(path: Path) -> ET.Element:
     """Parse a URDF (no entities), drop simulator-specific tags, make mesh paths absolute."""
     data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
     try:
-        root = SafeET.fromstring(data)
+        root: ET.Element = SafeET.fromstring(data)
     except Exception as exc:  # defusedxml and expat raise several unrelated types
         raise InputError.single(str(path), None, f"unreadable URDF: {exc}") from None
     if root.tag != "robot":
@@ -247,9 +247,9 @@ def _graft(robot: ET.Element, att: Attachment, path: Path, where: str) -> None:
     for j in kept_joints:
         j.set("name", att.joint_prefix + (j.get("name") or ""))
         for end in ("parent", "child"):
-            el = j.find(end)
-            if el is not None:
-                el.set("link", link_name(el.get("link", "")))
+            end_el = j.find(end)
+            if end_el is not None:
+                end_el.set("link", link_name(end_el.get("link", "")))
         robot.append(j)
     mount = ET.SubElement(robot, "joint", name=mount_name, type="fixed")
     ET.SubElement(mount, "parent", link=att.parent)
@@ -335,7 +335,7 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
 
     def line(d: object, key: str | int | None = None) -> int | None:
         if key is not None and hasattr(d, "line_of"):
-            return d.line_of(key)  # type: ignore[union-attr]
+            return cast("int | None", d.line_of(key))
         return getattr(d, "line", None)
 
     def fail(where: object, key: str | int | None, message: str) -> None:

@@ -21,7 +21,7 @@ Quat = tuple[float, float, float, float]
 class JointInfo(NamedTuple):
     """``getJointInfo``: one joint and the link it moves (the link has the joint's index)."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # mypy: a field named like tuple.index
     name: str
     type: int
     q_index: int
@@ -145,7 +145,8 @@ def joint_info(client: int, body: int, joint: int) -> JointInfo:
     """Joint ``joint`` of ``body`` (names decoded)."""
     info = pb.getJointInfo(body, joint, physicsClientId=client)
     return JointInfo(
-        info[0], _text(info[1]), *info[2:12], _text(info[12]), *info[13:17]  # type: ignore[arg-type]
+        info[0], _text(info[1]), info[2], info[3], info[4], info[5], info[6], info[7], info[8],
+        info[9], info[10], info[11], _text(info[12]), info[13], info[14], info[15], info[16],
     )
 
 

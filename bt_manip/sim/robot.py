@@ -293,7 +293,7 @@ class Robot:
         return np.array([s.velocity for s in states])
 
     def set_arm_targets(
-        self, q: Sequence[float], max_velocity: float | Sequence[float] | None = None
+        self, q: Sequence[float] | np.ndarray, max_velocity: float | Sequence[float] | None = None
     ) -> None:
         """Drive the arm joints toward ``q`` (rad, descriptor order) under position control.
 
@@ -301,17 +301,17 @@ class Robot:
         joints or one per joint, if lower) and pushes with at most its effort limit. Targets
         outside the joint limits are clipped.
         """
-        q = np.asarray(q, dtype=float)
+        q_arr = np.asarray(q, dtype=float)
         arm = self.description.arm
         n = len(self.arm_joint_ids)
-        if q.shape != (n,):
-            raise ValueError(f"{self.name}: expected {n} arm targets, got {q.shape}")
+        if q_arr.shape != (n,):
+            raise ValueError(f"{self.name}: expected {n} arm targets, got {q_arr.shape}")
         limits = np.asarray(self._arm_velocity, dtype=float)
         if max_velocity is not None:
             limits = np.minimum(limits, np.broadcast_to(np.asarray(max_velocity, float), (n,)))
-        q = np.clip(q, arm.lower, arm.upper)
+        q_arr = np.clip(q_arr, arm.lower, arm.upper)
         for j, target, speed, effort in zip(
-            self.arm_joint_ids, q, limits, self._arm_effort, strict=True
+            self.arm_joint_ids, q_arr, limits, self._arm_effort, strict=True
         ):
             pb.setJointMotorControl2(
                 self.body,
@@ -394,7 +394,7 @@ class Robot:
                     self.link_name(c.link_a),
                     c.body_b,
                     c.link_b,
-                    tuple(c.position_on_a),
+                    (c.position_on_a[0], c.position_on_a[1], c.position_on_a[2]),
                     float(c.normal_force),
                 )
             )

@@ -196,7 +196,7 @@ class World:
         )
         body = pb.createMultiBody(0, col, vis, [x0, y0, 0.0], quat, physicsClientId=c)
         pb.changeVisualShape(body, -1, rgbaColor=wall.colour, physicsClientId=c)
-        return body
+        return int(body)
 
     def _make_body(self, spec: BodySpec, offset: tuple[float, float, float]) -> int:
         c = self.client
@@ -221,7 +221,7 @@ class World:
         if spec.movable:
             for link in range(-1, pbq.joint_count(c, body)):
                 pb.changeDynamics(body, link, lateralFriction=spec.friction, physicsClientId=c)
-        return body
+        return int(body)
 
     def _placed_pose(
         self, spec: BodySpec, offset: tuple[float, float, float]
@@ -241,8 +241,8 @@ class World:
         parts = [
             Part(
                 p.shape,
-                tuple(v * s for v in p.size),
-                tuple(v * s for v in p.xyz),  # type: ignore[arg-type]
+                (p.size[0] * s, p.size[1] * s, p.size[2] * s),
+                (p.xyz[0] * s, p.xyz[1] * s, p.xyz[2] * s),
                 p.rpy,
                 p.colour,
             )
@@ -285,7 +285,7 @@ class World:
         base = np.asarray(pos) + rot @ com
         body = pb.createMultiBody(spec.mass, col, vis, list(base), quat, physicsClientId=c)
         pb.changeVisualShape(body, -1, rgbaColor=spec.colour, physicsClientId=c)
-        return body
+        return int(body)
 
     def _make_robot(self, rspec: Any) -> Any:
         from bt_manip.sim.robot import Robot, RobotDescription

@@ -241,6 +241,7 @@ class _Reader(FieldReader):
             if "yaw" in value and ("qz" in value or "qw" in value):
                 self.fail(value.line, f"{where}: give either 'yaw' or 'qz'/'qw', not both")
                 return None
+            yaw: float | None
             if "qz" in value or "qw" in value:
                 qz = self.number(value, "qz", where)
                 qw = self.number(value, "qw", where)
