@@ -60,7 +60,7 @@ def _max_finite_bits(bits: np.ndarray) -> int:
         b = bits[i]
         b = b if b < np.int32(0x7F800000) else np.int32(0)
         hi = max(hi, b)
-    return hi
+    return hi  # type: ignore[return-value]  # numba body: the int32 comes back as an int
 
 
 def cost_range(grid: np.ndarray) -> tuple[float, float]:
@@ -171,7 +171,7 @@ def search_buckets(
             cur += 1
             b += 1
             if b == span:
-                b = 0
+                b = 0  # type: ignore[assignment]  # numba body: numba unifies int64 and int
         if cur * delta >= g_goal:
             break  # every open entry has f >= g_goal
         slot = heads[b]

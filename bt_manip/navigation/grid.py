@@ -199,7 +199,8 @@ def _disc_hits(d: Disc, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarra
     interior, as an (m, n) mask."""
     nx = np.clip(d.cx, lx, lx + res)
     ny = np.clip(d.cy, ly, ly + res)
-    return (nx - d.cx) ** 2 + (ny - d.cy) ** 2 < (d.radius - _EPS) ** 2
+    hits: np.ndarray = (nx - d.cx) ** 2 + (ny - d.cy) ** 2 < (d.radius - _EPS) ** 2
+    return hits
 
 
 def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
@@ -240,7 +241,7 @@ def write_png(path: str | Path, rgb: np.ndarray) -> None:
 
     png = b"\x89PNG\r\n\x1a\n"
     png += chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
-    png += chunk(b"IDAT", zlib.compress(rows, 6))
+    png += chunk(b"IDAT", zlib.compress(rows.tobytes(), 6))
     png += chunk(b"IEND", b"")
     Path(path).write_bytes(png)
 

@@ -154,7 +154,7 @@ def _known(dist: np.ndarray, row: int, col: int, goal: int) -> float:
     d = dist[row, col]
     if d == 0.0 and row * dist.shape[1] + col != goal:
         return np.inf
-    return d
+    return d  # type: ignore[no-any-return]  # numba body: dist items are floats
 
 
 @numba.njit(cache=True, inline="always")
@@ -281,7 +281,7 @@ def _clearance_value(value: float | int, res: float) -> float:
     return math.sqrt(float(value)) * res - res / math.sqrt(2.0)
 
 
-@overload(_clearance_value, jit_options={"cache": True})
+@overload(_clearance_value, jit_options={"cache": True})  # type: ignore[typeddict-unknown-key]  # numba stubs: jit_options lack "cache"
 def _clearance_value_jit(value, res):  # type: ignore[no-untyped-def]  # numba wants them bare
     """The compiled :func:`_clearance_value` for the cell type of the grid."""
     if isinstance(value, types.Float):
@@ -425,7 +425,7 @@ def _search(
         ix = math.floor((x - x0) / xyb)
         iy = math.floor((y - y0) / xyb)
         ih = math.floor(((th % two_pi) / two_pi) * nh + 0.5) % nh
-        return (iy * bx + ix) * nh + ih
+        return (iy * bx + ix) * nh + ih  # type: ignore[no-any-return]  # numba body: integer arithmetic
 
     k0 = 0
     slot_of[key(start[0], start[1], start[2])] = k0
@@ -506,7 +506,7 @@ def _search(
                     parent = _grown(parent, 2 * used)
                     move_of = _grown(move_of, 2 * used)
                     pose = _grown_rows(pose, 2 * used)
-                nk = used
+                nk = used  # type: ignore[assignment]  # numba body: numba unifies int64 and int
                 used += 1
                 slot_of[bin_key] = nk
             best[nk] = ng
@@ -526,7 +526,7 @@ def _search(
                 nx, ny, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
             )
             nf = ng + h
-            size = _heap_push(hf, hi, size, nf, nk)
+            size = _heap_push(hf, hi, size, nf, nk)  # type: ignore[arg-type]  # numba body: int64 is numba's int
     return parent, move_of, pose, -1, expanded
 
 

@@ -31,7 +31,7 @@ import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -307,7 +307,7 @@ class Navigator:
             return self._start_carrying(pose, goal)
         self._plan_cost = self.cost
         self.follower = PathFollower(
-            self.plan.polyline,
+            cast(np.ndarray, self.plan.polyline),  # an OK plan has its polyline
             goal if align else goal[:2],
             dataclasses.replace(self._follower_options, pivot=self.pivot),
             path_blocked=self._path_blocked,
@@ -403,4 +403,4 @@ class Navigator:
             return plan.reason
         self.plan = plan
         self._plan_cost = self.cost
-        return plan.polyline
+        return cast(np.ndarray, plan.polyline)  # an OK plan has its polyline

@@ -84,8 +84,8 @@ class SegmentFollower:
         kind, poses = self._queue.pop(0)
         end = poses[-1]
         if kind == TURN:
-            here = self._pivot_path(poses[-1:])
-            return PathFollower(here, (end[0], end[1], end[2]), self._loose)
+            turn_path = self._pivot_path(poses[-1:])
+            return PathFollower(turn_path, (end[0], end[1], end[2]), self._loose)
         return PathFollower(
             self._pivot_path(poses), (end[0], end[1]), self._loose, reverse=kind == BACKWARD
         )

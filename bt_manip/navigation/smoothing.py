@@ -57,8 +57,8 @@ def segment_max_cost(cost: np.ndarray, r0: int, c0: int, r1: int, c1: int) -> fl
             ir += 1
         worst = max(worst, cost[r, c])
         if worst == np.inf:
-            return worst
-    return worst
+            return worst  # type: ignore[no-any-return]  # numba body: cost items are floats
+    return worst  # type: ignore[no-any-return]  # numba body: cost items are floats
 
 
 @numba.njit(cache=True)
