@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -113,7 +113,7 @@ def _extent(client: int, body: int) -> tuple[np.ndarray, np.ndarray]:
 def look_height(world: Any, robot_body: int) -> float:
     """Height (m) above the floor that the views look at: the middle of the robot."""
     lo, hi = _extent(world.client, robot_body)
-    return LOOK_FRACTION * max(0.2, hi[2] - max(0.0, lo[2]))
+    return cast(float, LOOK_FRACTION * max(0.2, hi[2] - max(0.0, lo[2])))
 
 
 def _ray_ends(world: Any, robot_body: int, positions: Sequence[np.ndarray],

@@ -199,8 +199,9 @@ class LiveViewer:
         pending, self._pending[:] = list(self._pending), []
         for change, what in pending:
             if change == "add":
-                if scene.bodies.get(what.name) is what:  # still there (not gone in the tick)
-                    self._send_bodies([what])
+                body = scene.bodies.get(what.name)
+                if body is not None and body is what:  # still there (not gone in the tick)
+                    self._send_bodies([body])
             elif change == "remove":
                 link.delete(what.path)
                 for path in what.tracks:

@@ -97,7 +97,7 @@ class MeshcatLink:
                  host: str = "127.0.0.1") -> None:
         self.timeout = timeout
         self.server: subprocess.Popen[bytes] | None = None
-        self._context = zmq.Context.instance()
+        self._context: zmq.Context[Any] = zmq.Context.instance()
         self._socket: Any = None
         if zmq_url is None:
             self.server, zmq_url = _start_server(host, timeout)

@@ -63,7 +63,11 @@ def build_container(rec: Recording, title: str = "") -> bytes:
         "duration": duration,
         "root": ROOT,
     }
-    objects, meshes, static, tracks, bodies = [], [], [], [], []
+    objects: list[dict[str, Any]] = []
+    meshes: list[dict[str, Any]] = []
+    static: list[list[Any]] = []
+    tracks: list[dict[str, Any]] = []
+    bodies: list[dict[str, Any]] = []
     body_objects: dict[str, list[list[Any]]] = {}
     mesh_index: dict[Path, int] = {}
     all_objects = rec.objects
@@ -92,11 +96,11 @@ def build_container(rec: Recording, title: str = "") -> bytes:
         if not body.samples:
             continue
         samples = np.stack(body.samples).astype(np.float32)  # (samples, tracks, 7)
-        for k, path in enumerate(drawing.tracks):
+        for k, track_path in enumerate(drawing.tracks):
             series = samples[:, k, :]
             constant = bool(np.abs(series - series[0]).max() < STILL)
             data = series[0] if constant else series.T  # component-major
-            tracks.append({"path": path, "const": constant, "first": body.first_frame,
+            tracks.append({"path": track_path, "const": constant, "first": body.first_frame,
                            "count": len(series),
                            **blobs.add(np.ascontiguousarray(data).tobytes())})
     times = np.asarray(rec.times, dtype=np.float32)

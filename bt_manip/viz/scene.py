@@ -356,6 +356,7 @@ def _add_primitive_body(body: SceneBody, c: int, info: Any, movable: bool) -> No
         local = pose_matrix(shape.local_position, shape.local_orientation)
         part_rgba = parts[k].colour if k < len(parts) and parts[k].colour else None
         rgba = tuple(part_rgba or default_rgba)
+        size: tuple[float, ...]
         if geom_type == pb.GEOM_BOX:
             kind, size = "box", (dims[0], dims[1], dims[2])
         elif geom_type == pb.GEOM_CYLINDER:

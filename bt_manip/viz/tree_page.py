@@ -21,6 +21,7 @@ import errno
 import json
 import socket
 import threading
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
@@ -78,7 +79,7 @@ class PageState:
     version: int = 0
 
     def publish(self, time: float, ticks: int, statuses: list[int], reasons: list[str],
-                result: str = "", failures: list[tuple[float, int, str]] = ()) -> None:
+                result: str = "", failures: Sequence[tuple[float, int, str]] = ()) -> None:
         """Swap in the statuses after a tick (``failures``: recent (time, node, reason))."""
         self.version += 1
         data = json.dumps(

@@ -21,7 +21,7 @@ from bt_manip.bt.node import BtNode
 from bt_manip.bt.status import STATUS_CODES, NodeStatus, as_status, shown, status_code
 from bt_manip.bt.walk import walk_nodes
 
-STATUS_NAMES = tuple(status.value for status in sorted(STATUS_CODES, key=STATUS_CODES.get))
+STATUS_NAMES = tuple(status.value for status in sorted(STATUS_CODES, key=STATUS_CODES.__getitem__))
 """Status names by their page code (:data:`bt_manip.bt.status.STATUS_CODES`)."""
 IDLE = STATUS_CODES[NodeStatus.IDLE]
 
