@@ -313,8 +313,8 @@ def build_parser() -> argparse.ArgumentParser:
     try:
         from bt_manip.bt.cli_verbs import add_verbs
     except ImportError:
-        add_verbs = None
-    if add_verbs is not None:
+        pass
+    else:
         add_verbs(sub)
     return parser
 

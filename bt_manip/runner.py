@@ -25,7 +25,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any, Protocol, cast
 
 import py_trees
 
@@ -54,7 +54,9 @@ EXIT_CODES = {
 class TickableTree(Protocol):
     """What the runner needs of a tree (``bt_manip.bt.Tree`` provides it)."""
 
-    root: py_trees.behaviour.Behaviour
+    @property
+    def root(self) -> BtNode | py_trees.behaviour.Behaviour: ...
+    """The root node: a bt-manip node or a py_trees behaviour."""
 
     def tick(self) -> Any: ...
     """The root's status after the tick: a ``NodeStatus`` (or a py_trees ``Status``)."""
@@ -201,7 +203,7 @@ class Runner:
 
     def _now(self) -> float:
         if self.world is not None:
-            return self.world.time
+            return cast(float, self.world.time)
         return time.monotonic()
 
     @property

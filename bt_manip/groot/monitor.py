@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
+from typing import cast
 
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.status import NodeStatus
@@ -29,7 +30,7 @@ _LISTENERS = "_status_listeners"
 
 
 def _get_status(node: BtNode) -> NodeStatus:
-    return node.__dict__[_STATUS]
+    return cast(NodeStatus, node.__dict__[_STATUS])
 
 
 def _set_status(node: BtNode, value: NodeStatus) -> None:

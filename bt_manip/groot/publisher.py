@@ -18,7 +18,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import msgpack
 import zmq
@@ -259,7 +259,7 @@ class GrootPublisher:
             else:
                 entries = {}
             out[name] = entries or None
-        return msgpack.packb(out)
+        return cast(bytes, msgpack.packb(out))
 
     # ------------------------------------------------------------------ hooks
 

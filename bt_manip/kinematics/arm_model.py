@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import pinocchio as pin
@@ -96,7 +97,7 @@ class ArmModel:
             jm = model.joints[model.getJointId(name)]
             self._slots.append((jm.idx_q, jm.nq))
             self._columns.append(jm.idx_v)
-        self._q_pin = pin.neutral(model)
+        self._q_pin: np.ndarray = pin.neutral(model)
         # Joints above the base are locked, so the base placement never changes.
         pin.framesForwardKinematics(model, self.data, self._q_pin)
         self._base_inv = self.data.oMf[self._base_id].inverse()
@@ -179,7 +180,7 @@ class ArmModel:
         qp = self._to_pin(q)
         pin.forwardKinematics(self.model, self.data, qp)
         tip = pin.updateFramePlacement(self.model, self.data, self._tip_id)
-        return (self._base_inv * tip).homogeneous
+        return cast(np.ndarray, (self._base_inv * tip).homogeneous)  # pinocchio: no stubs
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Geometric Jacobian (6 x nq) of the tip, expressed in the base link frame.

@@ -100,7 +100,7 @@ def _turn_between(a: ca.SX, b: ca.SX) -> ca.SX:
     ax, ay, az = ca.fabs(a[0]), ca.fabs(a[1]), ca.fabs(a[2])
     basis = _pick(
         [ca.logic_and(ax <= ay, ax <= az), ay <= az],
-        [ca.DM([1.0, 0.0, 0.0]), ca.DM([0.0, 1.0, 0.0]), ca.DM([0.0, 0.0, 1.0])],
+        [ca.SX([1.0, 0.0, 0.0]), ca.SX([0.0, 1.0, 0.0]), ca.SX([0.0, 0.0, 1.0])],
     )
     perp = ca.cross(a, basis)
     perp = perp / ca.fmax(ca.sqrt(ca.dot(perp, perp)), 1e-30)
