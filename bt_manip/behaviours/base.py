@@ -87,14 +87,15 @@ class WorldAccess:
         return self.robot_name_of(self.robot())
 
     def robot_name_of(self, robot: Any) -> str:
-        for name, r in self.world.robots.items():
+        robots: dict[str, Any] = self.world.robots
+        for name, r in robots.items():
             if r is robot:
                 return name
         return ""
 
     def object_body(self, name: str) -> int:
         """PyBullet id of a movable object of the world."""
-        movable = self.world.movable
+        movable: dict[str, int] = self.world.movable
         if name not in movable:
             raise ActionFailed(
                 f"no movable object named '{name}'; objects: {', '.join(sorted(movable)) or 'none'}"

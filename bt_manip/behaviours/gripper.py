@@ -25,7 +25,8 @@ TIME_EPS = 1e-9
 
 def grasped_object(world: Any, robot: Any) -> str:
     """Name of the movable object every finger touches, or ''."""
-    for name, body in world.movable.items():
+    movable: dict[str, int] = world.movable
+    for name, body in movable.items():
         if robot.is_grasping(body):
             return name
     return ""

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NoReturn
 
 import pybullet as pb
 from py_trees.common import Status
@@ -101,7 +101,7 @@ class Nav2Action(RobotAction):
             self._set_result(0, "")
         return status
 
-    def fail(self, code: int, reason: str) -> None:
+    def fail(self, code: int, reason: str) -> NoReturn:
         """End the action with FAILURE, result ``code`` and ``reason``."""
         self._code = int(code)
         raise Nav2Failed(code, reason)

@@ -59,7 +59,8 @@ def square_round(nav: Navigator, x: float, y: float, half: float) -> np.ndarray:
     rows, cols = grid.shape
     xs = grid.origin[0] + (np.arange(cols) + 0.5) * grid.resolution
     ys = grid.origin[1] + (np.arange(rows) + 0.5) * grid.resolution
-    return (np.abs(ys - y)[:, None] <= half) & (np.abs(xs - x)[None, :] <= half)
+    inside: np.ndarray = (np.abs(ys - y)[:, None] <= half) & (np.abs(xs - x)[None, :] <= half)
+    return inside
 
 
 class _Clear(Nav2Action):

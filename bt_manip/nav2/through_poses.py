@@ -89,7 +89,7 @@ class ComputePathThroughPoses(PlanAction):
         nav.refresh()
         p = nav.pivot
         here = ahead_of(start, p)
-        legs = []
+        legs: list[np.ndarray] = []
         for k, goal in enumerate(goals):
             last = k == len(goals) - 1
             end = ahead_of(goal, p) if last else (goal[0], goal[1])
