@@ -63,7 +63,7 @@ class JointMove(RobotAction):
 
     CARRIES = True
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "units": UNITS,
         "tolerance": TOLERANCE,
@@ -185,7 +185,7 @@ class MoveJointsSequentially(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
         "order": Port(
@@ -222,7 +222,7 @@ class MoveJoints(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], False, "joint targets (or use state)", []),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
@@ -260,7 +260,7 @@ class Lift(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "deltas": PortInformation(list[float], False, "change of each arm joint", []),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
@@ -320,7 +320,7 @@ class MoveToPose(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),

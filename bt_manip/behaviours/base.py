@@ -118,7 +118,7 @@ class RobotAction(WorldAccess, ActionNode):
       :meth:`on_halt` runs.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
     CARRIES: ClassVar[bool] = False
     """Moves what the robot holds: a ``slip`` fault may make it let go on the way."""
 

@@ -98,7 +98,7 @@ class RecoveryNode(_Nav2Control):
 
     MIN_CHILDREN = 2
     MAX_CHILDREN = 2
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "number_of_retries": Port(int, False, "Number of retries", 1, NON_NEGATIVE),
     }
 
