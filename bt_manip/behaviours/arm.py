@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from py_trees.common import Status
@@ -21,6 +21,9 @@ from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix, yaw_of
+
+if TYPE_CHECKING:
+    from bt_manip.sim.robot import Robot
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
 TOLERANCE = Port(float, False, "how close each joint must get (rad)", 0.01, POSITIVE)
@@ -404,10 +407,10 @@ class MoveToPose(JointMove):
         return stages
 
     @staticmethod
-    def _turned_to(robot: object, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
+    def _turned_to(robot: Robot, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
         """``target`` turned about the world vertical by the object's yaw plus k x 90 deg,
         choosing k so the tool turns least from where it points now."""
-        now = robot.link_transform(tip)[:3, :3]  # type: ignore[attr-defined]
+        now = robot.link_transform(tip)[:3, :3]
         best, best_angle = target, np.inf
         for k in range(4):
             a = yaw + k * np.pi / 2

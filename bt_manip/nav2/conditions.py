@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -90,6 +90,12 @@ GOAL_PORTS: dict[str, PortInformation] = {
 }
 
 
+class _PortReader(Protocol):
+    """What :class:`GoalsReader` uses of the node class it is mixed into (a ``BtNode``)."""
+
+    def get_input(self, port_name: str, default: Any = ...) -> Any: ...
+
+
 class GoalsReader:
     """Mixin: the goals now, from the ports ``goal`` and ``goals`` or, when a port is not
     given, from the blackboard entries of the same names (Nav2's ``getInputOrBlackboard``)."""
@@ -99,7 +105,7 @@ class GoalsReader:
 
     def _read(self, port: str) -> Any:
         if port in self.bindings:
-            return self.get_input(port, None)  # type: ignore[attr-defined]
+            return cast(_PortReader, self).get_input(port, None)
         try:
             return self.blackboard.get(port)
         except KeyError:
