@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 from py_trees.common import Status
@@ -21,6 +21,9 @@ from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix, yaw_of
+
+if TYPE_CHECKING:
+    from bt_manip.sim.robot import Robot
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
 TOLERANCE = Port(float, False, "how close each joint must get (rad)", 0.01, POSITIVE)
@@ -63,7 +66,7 @@ class JointMove(RobotAction):
 
     CARRIES = True
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "units": UNITS,
         "tolerance": TOLERANCE,
@@ -185,7 +188,7 @@ class MoveJointsSequentially(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
         "order": Port(
@@ -222,7 +225,7 @@ class MoveJoints(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], False, "joint targets (or use state)", []),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
@@ -260,7 +263,7 @@ class Lift(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "deltas": PortInformation(list[float], False, "change of each arm joint", []),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
@@ -320,7 +323,7 @@ class MoveToPose(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **JointMove.INPUT_PORTS,
         "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),
@@ -404,10 +407,10 @@ class MoveToPose(JointMove):
         return stages
 
     @staticmethod
-    def _turned_to(robot: object, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
+    def _turned_to(robot: Robot, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
         """``target`` turned about the world vertical by the object's yaw plus k x 90 deg,
         choosing k so the tool turns least from where it points now."""
-        now = robot.link_transform(tip)[:3, :3]  # type: ignore[attr-defined]
+        now = robot.link_transform(tip)[:3, :3]
         best, best_angle = target, np.inf
         for k in range(4):
             a = yaw + k * np.pi / 2

@@ -28,7 +28,7 @@ class Attach(RobotAction):
       gives the distance), unknown, or already attached.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
         "link": PortInformation(str, False, "robot link to attach to (default: end effector)", ""),
@@ -58,7 +58,7 @@ class Detach(RobotAction):
     - FAILURE when it was not attached.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
     }

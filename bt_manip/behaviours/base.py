@@ -10,12 +10,12 @@ reason in ``feedback_message``, which the console and the run report show.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt import ActionNode, ConditionNode, PortError
+from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
 from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
 from bt_manip.overlay import Overlay
 from bt_manip.run_context import RobotServices, RunContext
@@ -32,6 +32,15 @@ class ActionFailed(Exception):
     """Raised inside a behaviour to end it with FAILURE and this reason."""
 
 
+class _Node(Protocol):
+    """What :class:`WorldAccess` uses of the node class it is mixed into (a ``BtNode``)."""
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]]
+    context: TreeContext
+
+    def get_input(self, port_name: str, default: Any = ...) -> Any: ...
+
+
 class WorldAccess:
     """Mixin: the world and robot a node acts on, resolved from its ports and context."""
 
@@ -39,7 +48,7 @@ class WorldAccess:
 
     @property
     def world(self) -> Any:
-        world = self.context.world  # type: ignore[attr-defined]
+        world = cast(_Node, self).context.world
         if world is None:
             raise ActionFailed("this node needs a world (run with --world)")
         return world
@@ -48,7 +57,7 @@ class WorldAccess:
     def run_context(self) -> RunContext:
         """The run's services; a tree built in Python is given them with
         ``RunContext.for_world(world)``."""
-        context = self.context  # type: ignore[attr-defined]
+        context = cast(_Node, self).context
         if not isinstance(context, RunContext):
             _ = self.world  # without a world, that is the problem to report
             raise ActionFailed(
@@ -65,13 +74,14 @@ class WorldAccess:
     @property
     def overlay(self) -> Overlay:
         """What this run's viewers draw over the world (a throwaway one outside a run)."""
-        context = self.context  # type: ignore[attr-defined]
+        context = cast(_Node, self).context
         return context.overlay if isinstance(context, RunContext) else Overlay()
 
     def robot(self) -> Any:
         """The robot named by the ``robot`` port, or the only robot of the world."""
         robots = self.world.robots
-        name = self.get_input("robot") if "robot" in self.INPUT_PORTS else ""  # type: ignore[attr-defined]
+        node = cast(_Node, self)
+        name = node.get_input("robot") if "robot" in node.INPUT_PORTS else ""
         if not name:
             if len(robots) != 1:
                 raise ActionFailed(
@@ -87,14 +97,15 @@ class WorldAccess:
         return self.robot_name_of(self.robot())
 
     def robot_name_of(self, robot: Any) -> str:
-        for name, r in self.world.robots.items():
+        robots: dict[str, Any] = self.world.robots
+        for name, r in robots.items():
             if r is robot:
                 return name
         return ""
 
     def object_body(self, name: str) -> int:
         """PyBullet id of a movable object of the world."""
-        movable = self.world.movable
+        movable: dict[str, int] = self.world.movable
         if name not in movable:
             raise ActionFailed(
                 f"no movable object named '{name}'; objects: {', '.join(sorted(movable)) or 'none'}"
@@ -103,7 +114,7 @@ class WorldAccess:
 
     def faults(self) -> FaultInjector | None:
         """The run's fault injector, when faults are injected."""
-        context = self.context  # type: ignore[attr-defined]
+        context = cast(_Node, self).context
         return context.faults if isinstance(context, RunContext) else None
 
 
@@ -117,7 +128,7 @@ class RobotAction(WorldAccess, ActionNode):
       :meth:`on_halt` runs.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
     CARRIES: ClassVar[bool] = False
     """Moves what the robot holds: a ``slip`` fault may make it let go on the way."""
 

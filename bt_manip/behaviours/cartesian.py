@@ -34,7 +34,8 @@ def arm_ik(services: RobotServices, tip: str) -> ArmIK:
 def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
     """A world pose (4x4) expressed in the arm's base link frame."""
     base = robot.link_transform(robot.description.arm.base_link)
-    return np.linalg.inv(base) @ pose_world
+    pose_base: np.ndarray = np.linalg.inv(base) @ pose_world
+    return pose_base
 
 
 def solve(
@@ -68,7 +69,7 @@ def line(
     solutions."""
     a, b = start_world[:3, 3], goal_world[:3, 3]
     turn = _angle(start_world[:3, :3], goal_world[:3, :3])
-    n = max(1, int(np.ceil(max(np.linalg.norm(b - a) / STEP, turn / TURN_STEP))))
+    n = max(1, int(np.ceil(max(float(np.linalg.norm(b - a)) / STEP, turn / TURN_STEP))))
     out = []
     q = seed
     for i in range(1, n + 1):
@@ -100,6 +101,7 @@ def _slerp(ra: np.ndarray, rb: np.ndarray, s: float) -> np.ndarray:
     k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
     a = angle * s
     step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    return ra @ step
+    turned: np.ndarray = ra @ step
+    return turned
 
 

@@ -20,7 +20,7 @@ OBJECT = PortInformation(str, True, "name of a movable object of the world")
 class IsAttached(WorldCondition):
     """SUCCESS when ``object`` is held by an attach joint (of ``robot``, if given), else FAILURE."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT, "robot": ROBOT_PORT}
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT, "robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")
@@ -36,7 +36,7 @@ class IsHolding(WorldCondition):
     """SUCCESS when the gripper holds ``object`` (every finger touches it, or it is attached);
     with ``object`` empty, when it holds anything. FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "object": PortInformation(str, False, "object name (empty: any object)", ""),
         "robot": ROBOT_PORT,
     }
@@ -62,7 +62,7 @@ class ObjectInRegion(WorldCondition):
     ``min``/``max`` corners as ``x;y;z``.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "object": OBJECT,
         "inside": PortInformation(str, False, "body whose bounding box is the region", ""),
         "min": Port(list[float], False, "lower corner x;y;z", [], count_of(0, 3)),
@@ -93,7 +93,7 @@ class ObjectInRegion(WorldCondition):
 class ObjectAbove(WorldCondition):
     """SUCCESS when the lowest point of ``object`` is at least ``height`` m above the floor."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "object": OBJECT,
         "height": Port(float, False, "clearance above the floor (m)", 0.1, NON_NEGATIVE),
     }
@@ -113,7 +113,7 @@ class CarriedClear(WorldCondition):
     """SUCCESS when ``object`` has touched no wall, furniture or floor while attached, since
     it was last attached; FAILURE naming what it touched (or when it is not attached)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT}
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT}  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")

@@ -25,7 +25,8 @@ TIME_EPS = 1e-9
 
 def grasped_object(world: Any, robot: Any) -> str:
     """Name of the movable object every finger touches, or ''."""
-    for name, body in world.movable.items():
+    movable: dict[str, int] = world.movable
+    for name, body in movable.items():
         if robot.is_grasping(body):
             return name
     return ""
@@ -34,7 +35,7 @@ def grasped_object(world: Any, robot: Any) -> str:
 class _GripperMove(RobotAction):
     """Command an opening, then wait until the fingers stop moving."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "timeout": Port(float, False, "sim seconds allowed", 3.0, POSITIVE),
     }
@@ -84,7 +85,7 @@ class OpenGripper(_GripperMove):
     - FAILURE if they are still moving after ``timeout`` s.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **_GripperMove.INPUT_PORTS,
         "opening": Port(
             float, False, "opening between the pads (m); -1 = fully", -1.0, OPENING
@@ -105,7 +106,7 @@ class CloseGripper(_GripperMove):
     - FAILURE if ``require_object`` is true and the fingers closed on nothing, or on a time-out.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **_GripperMove.INPUT_PORTS,
         "opening": Port(
             float, False, "target opening (m); -1 = fully closed", -1.0, OPENING
@@ -114,7 +115,7 @@ class CloseGripper(_GripperMove):
             bool, False, "fail when nothing is between the fingers", False
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "holding": PortInformation(bool, False, "an object is between the fingers"),
         "object": PortInformation(str, False, "name of the object between the fingers"),
     }

@@ -99,7 +99,7 @@ class Navigate(RobotAction):
     """
 
     CARRIES = True
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "goal": Port(str, True, "named world pose, or x;y;yaw", accepts=Accepts(check=_goal_text)),
         "xy_tolerance": Port(
@@ -110,7 +110,7 @@ class Navigate(RobotAction):
             float, False, "sim seconds; 0 = from the path length", 0.0, NON_NEGATIVE
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "path_length": PortInformation(float, False, "length of the planned path (m)"),
     }
 
@@ -199,7 +199,7 @@ class Reverse(RobotAction):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "distance": Port(float, False, "how far to reverse (m)", 0.5, POSITIVE),
         "speed": Port(float, False, "reversing speed (m/s)", 0.2, POSITIVE),

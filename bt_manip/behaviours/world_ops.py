@@ -45,7 +45,7 @@ class SpawnModel(RobotAction):
       inside another body.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "model": PortInformation(str, True, "a model of the world file, or a new name"),
         "shape": Port(str, False, "box, cylinder or sphere", "box",
                       Accepts(choices=tuple(SHAPE_SIZES))),
@@ -134,7 +134,7 @@ class DeleteModel(RobotAction):
     - FAILURE when there is no such model.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "model": PortInformation(str, True, "name of the model to remove"),
     }
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NoReturn
 
 import pybullet as pb
 from py_trees.common import Status
@@ -101,7 +101,7 @@ class Nav2Action(RobotAction):
             self._set_result(0, "")
         return status
 
-    def fail(self, code: int, reason: str) -> None:
+    def fail(self, code: int, reason: str) -> NoReturn:
         """End the action with FAILURE, result ``code`` and ``reason``."""
         self._code = int(code)
         raise Nav2Failed(code, reason)
@@ -181,12 +181,12 @@ class ComputePathToPose(PlanAction):
     """
 
     UNKNOWN = PlannerError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "goal": PortInformation(object, True, "Destination to plan to (x;y;yaw or a pose name)"),
         **PLAN_PORTS,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathToPose node"),
         **error_ports("The compute path to pose"),
     }
@@ -238,7 +238,7 @@ class FollowPath(Nav2Action):
     """
 
     UNKNOWN = ControllerError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "path": PortInformation(Nav2Path, True, "Path to follow"),
         "controller_id": PortInformation(str, False, "Mapped name of the controller plugin", ""),
@@ -247,7 +247,7 @@ class FollowPath(Nav2Action):
             str, False, "Mapped name of the progress checker", ""
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("The follow path")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("The follow path")  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def _path(self) -> Nav2Path:
         try:
@@ -357,11 +357,11 @@ class Spin(_BaseBehavior):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **BEHAVIOR_PORTS,
         "spin_dist": Port(float, False, "Spin distance (rad)", 1.57),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Spin")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Spin")  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def begin(self) -> None:
         super().begin()
@@ -407,12 +407,12 @@ class BackUp(_Drive):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **BEHAVIOR_PORTS,
         "backup_dist": Port(float, False, "Distance to backup (m)", 0.15, POSITIVE),
         "backup_speed": Port(float, False, "Speed at which to backup (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Back up")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Back up")  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def begin(self) -> None:
         super().begin()
@@ -426,12 +426,12 @@ class DriveOnHeading(_Drive):
     """Drives the base straight along its heading by ``dist_to_travel`` at ``speed``
     (a negative distance drives backwards); statuses as :class:`BackUp`."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **BEHAVIOR_PORTS,
         "dist_to_travel": Port(float, False, "Distance to travel (m)", 0.15),
         "speed": Port(float, False, "Speed at which to travel (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Drive on heading")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Drive on heading")  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def begin(self) -> None:
         super().begin()
@@ -442,10 +442,10 @@ class DriveOnHeading(_Drive):
 class Wait(Nav2Action):
     """Waits ``wait_duration`` seconds of sim time: RUNNING until then, then SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "wait_duration": Port(float, False, "Wait time (s)", 1.0, NON_NEGATIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Wait")
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Wait")  # type: ignore[misc]  # py_trees stub: not ClassVar
     UNKNOWN = BehaviorError.UNKNOWN
 
     def begin(self) -> None:

@@ -59,11 +59,12 @@ def square_round(nav: Navigator, x: float, y: float, half: float) -> np.ndarray:
     rows, cols = grid.shape
     xs = grid.origin[0] + (np.arange(cols) + 0.5) * grid.resolution
     ys = grid.origin[1] + (np.arange(rows) + 0.5) * grid.resolution
-    return (np.abs(ys - y)[:, None] <= half) & (np.abs(xs - x)[None, :] <= half)
+    inside: np.ndarray = (np.abs(ys - y)[:, None] <= half) & (np.abs(xs - x)[None, :] <= half)
+    return inside
 
 
 class _Clear(Nav2Action):
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def _set_result(self, code: int, message: str) -> None:
         pass  # Nav2's clearing services report no result code
@@ -76,7 +77,7 @@ class _Clear(Nav2Action):
 class ClearEntireCostmap(_Clear):
     """Forgets every object drawn on the robot's map. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = SERVICE_PORTS
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = SERVICE_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def begin(self) -> None:
         clear_map(synced_navigator(self, self.base()))
@@ -110,7 +111,7 @@ class ClearCostmapAroundRobot(_ClearSquare):
     """Forgets the objects drawn within ``reset_distance`` (half the side of a square) of the
     robot. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("clear")
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("clear")  # type: ignore[misc]  # py_trees stub: not ClassVar
 
 
 @registry.register
@@ -119,4 +120,4 @@ class ClearCostmapExceptRegion(_ClearSquare):
     from the robot, keeping those near it. SUCCESS."""
 
     INSIDE = False
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("keep")
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("keep")  # type: ignore[misc]  # py_trees stub: not ClassVar

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -29,7 +29,7 @@ def _codes(text: Any) -> frozenset[int]:
 class AreErrorCodesPresent(ConditionNode):
     """SUCCESS when ``error_code`` is one of ``error_codes_to_check``, FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "error_code": PortInformation(int, False, "The active error code to compare against", 0),
         "error_codes_to_check": PortInformation(
             str, False, "Error codes to check, separated by commas", ""
@@ -50,7 +50,7 @@ class _WouldARecoveryHelp(AreErrorCodesPresent):
     """SUCCESS when ``error_code`` is one of the fixed codes ``CODES``, FAILURE otherwise."""
 
     CODES: ClassVar[frozenset[Any]] = frozenset()
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "error_code": PortInformation(int, False, "The active error code to compare against", 0),
     }
 
@@ -90,6 +90,12 @@ GOAL_PORTS: dict[str, PortInformation] = {
 }
 
 
+class _PortReader(Protocol):
+    """What :class:`GoalsReader` uses of the node class it is mixed into (a ``BtNode``)."""
+
+    def get_input(self, port_name: str, default: Any = ...) -> Any: ...
+
+
 class GoalsReader:
     """Mixin: the goals now, from the ports ``goal`` and ``goals`` or, when a port is not
     given, from the blackboard entries of the same names (Nav2's ``getInputOrBlackboard``)."""
@@ -99,7 +105,7 @@ class GoalsReader:
 
     def _read(self, port: str) -> Any:
         if port in self.bindings:
-            return self.get_input(port, None)  # type: ignore[attr-defined]
+            return cast(_PortReader, self).get_input(port, None)
         try:
             return self.blackboard.get(port)
         except KeyError:
@@ -119,7 +125,7 @@ class GoalUpdated(GoalsReader, ConditionNode):
     SUCCESS (and records them) when they differ, FAILURE when they are the same.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name, **attributes)

@@ -7,7 +7,7 @@ that finished is only set back to IDLE.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -28,7 +28,7 @@ class _Nav2Control(ControlNode):
         self.status = RUNNING.to_py_trees()
 
     def _kids(self) -> list[BtNode]:
-        return self.children  # type: ignore[return-value]
+        return cast(list[BtNode], self.children)  # a control's children are BtNodes
 
 
 @registry.register
@@ -98,7 +98,7 @@ class RecoveryNode(_Nav2Control):
 
     MIN_CHILDREN = 2
     MAX_CHILDREN = 2
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "number_of_retries": Port(int, False, "Number of retries", 1, NON_NEGATIVE),
     }
 

@@ -32,7 +32,7 @@ class TransformAvailable(WorldCondition):
     of the world or of the robot); from then on SUCCESS at every tick, as Nav2's latches.
     FAILURE, naming the unknown frame, until then."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "robot": ROBOT_PORT,
         "child": PortInformation(str, False, "Child frame for transform", ""),
         "parent": PortInformation(str, False, "Parent frame for transform", ""),

@@ -64,12 +64,12 @@ class ComputePathThroughPoses(PlanAction):
     """
 
     UNKNOWN = ThroughPosesError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         **RobotAction.INPUT_PORTS,
         "goals": PortInformation(object, True, "Destinations to plan through"),
         **PLAN_PORTS,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
         **error_ports("The compute path through poses"),
     }
@@ -89,7 +89,7 @@ class ComputePathThroughPoses(PlanAction):
         nav.refresh()
         p = nav.pivot
         here = ahead_of(start, p)
-        legs = []
+        legs: list[np.ndarray] = []
         for k, goal in enumerate(goals):
             last = k == len(goals) - 1
             end = ahead_of(goal, p) if last else (goal[0], goal[1])
@@ -121,7 +121,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
     (always keeping the last) and writes the rest to ``output_goals``. SUCCESS (FAILURE without
     a world or with goals it cannot read)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "robot": ROBOT_PORT,
         "input_goals": PortInformation(object, True, "Original goals to remove viapoints from"),
         "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
@@ -129,7 +129,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
         "global_frame": PortInformation(str, False, "Global frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "output_goals": PortInformation(object, False, "Goals with passed viapoints removed"),
     }
 
