@@ -231,7 +231,7 @@ class Parallel(_Control):
     all of them. A finished child is not ticked again until the Parallel completes.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "success_count": PortInformation(
             int, required=False, default_value=-1,
             description="number of children that must succeed; -1 means all"),
@@ -300,7 +300,7 @@ class ParallelAll(_Control):
     the number of children), SUCCESS otherwise, and resets the children.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "max_failures": PortInformation(
             int, required=False, default_value=1,
             description="if this many children fail, the node fails; -1 means all"),

@@ -82,7 +82,7 @@ class Repeat(_Decorator):
     SKIPPED child makes the node SKIPPED (the count is kept).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "num_cycles": PortInformation(
             int, description="repeat a successful child N times; -1 repeats forever"),
     }
@@ -135,7 +135,7 @@ class RetryUntilSuccessful(_Decorator):
     the node SKIPPED.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "num_attempts": PortInformation(
             int, description="try the child up to N times; -1 tries forever"),
     }
@@ -204,7 +204,7 @@ class Timeout(_Decorator):
     the blackboard, it makes the node fail (halting the child) with the reason.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "msec": Port(
             int, description="After a certain amount of time, halt() the child if it is still "
                              "running.", accepts=NON_NEGATIVE),
@@ -266,7 +266,7 @@ class Delay(_Decorator):
     ``delay_msec`` is refused at load (an unsigned int in BT.CPP).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "delay_msec": Port(
             int, description="Tick the child after a few milliseconds", accepts=NON_NEGATIVE),
     }
@@ -314,7 +314,7 @@ class RunOnce(_Decorator):
     returns the child's remembered status forever.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "then_skip": PortInformation(
             bool, required=False, default_value=True,
             description="if true, skip after the first execution, otherwise return the "
@@ -376,7 +376,7 @@ class Precondition(_Decorator):
     it is ticked until it finishes, then the node returns the child's status.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "if": PortInformation(str, description="script: the condition"),
         "else": PortInformation(
             NodeStatus, required=False, default_value=NodeStatus.FAILURE,

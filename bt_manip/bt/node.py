@@ -116,8 +116,10 @@ class BtNode(PortsMixin):
     DESCRIPTION: ClassVar[str] = ""
     MIN_CHILDREN: ClassVar[int] = 0
     MAX_CHILDREN: ClassVar[int | None] = 0
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    # "py_trees stub" below: py_trees annotates the two as instance attributes, though they are
+    # class-level declarations, and mypy lets no ClassVar override an instance attribute.
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     started_order: int = 0
     failure_order: int = 0

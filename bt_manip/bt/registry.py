@@ -16,13 +16,13 @@ too: it is wrapped as a leaf (see :mod:`bt_manip.bt.pytrees_leaf`) under its cla
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar, overload
 
 import py_trees
 
 from bt_manip.bt.node import BtNode
 
-N = TypeVar("N", bound=type[BtNode])
+N = TypeVar("N", bound=type[Any])  # a BtNode or py_trees Behaviour subclass
 
 SUBTREE_ID = "SubTree"
 
@@ -33,6 +33,12 @@ class NodeRegistry:
     def __init__(self) -> None:
         self._classes: dict[str, type[BtNode]] = {}
         self._builtin: set[str] = set()
+
+    @overload
+    def register(self, cls: N, *, builtin: bool = False) -> N: ...
+
+    @overload
+    def register(self, cls: None = None, *, builtin: bool = False) -> Callable[[N], N]: ...
 
     def register(
         self, cls: N | None = None, *, builtin: bool = False
