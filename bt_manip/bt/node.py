@@ -27,7 +27,7 @@ import difflib
 import itertools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import py_trees
 from py_trees.common import Status
@@ -255,7 +255,7 @@ class BtNode(PortsMixin):
             if default is not _MISSING:
                 return default
             raise PortError(f"{self.describe()}: input port '{port_name}' has no value")
-        if type(binding) is Literal:
+        if isinstance(binding, Literal):  # Binding is Ref | Literal, neither subclassed
             return binding.value
         try:
             value = self.blackboard.get(binding.key)
@@ -421,7 +421,8 @@ class BtNode(PortsMixin):
             self.bt_status = STATUS_OF_PY_TREES[new_status]
 
     def bt_children(self) -> list[BtNode]:
-        return list(self.children)  # type: ignore[attr-defined]
+        # the children of a bt-manip node are bt-manip nodes (the XML loader builds them)
+        return cast("list[BtNode]", list(self.children))
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:
