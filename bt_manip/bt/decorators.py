@@ -6,7 +6,7 @@ when a world is loaded, so they are deterministic and as fast as physics allows.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -353,7 +353,7 @@ class _ScriptHolder:
     def get(self, node: BtNode, port: str) -> Script:
         binding = node.bindings.get(port)
         if not isinstance(binding, Ref):
-            return node.get_input(port)
+            return cast(Script, node.get_input(port))  # a script port's literal is parsed
         text = str(node.get_input(port))
         if text != self._text or self._script is None:
             try:
@@ -398,7 +398,7 @@ class Precondition(_Decorator):
 
             self._child_running = _truth(self, "if", script)
         if not self._child_running:
-            return otherwise
+            return cast(NodeStatus, otherwise)  # the "else" port holds a NodeStatus
         status = self.child.execute_tick()
         if status.completed:
             self.reset_child()

@@ -509,7 +509,7 @@ class ControlNode(BtNode, py_trees.composites.Composite):
 
     KIND = "Control"
     MIN_CHILDREN = 1
-    MAX_CHILDREN = None
+    MAX_CHILDREN: ClassVar[int | None] = None
 
     def __init__(
         self, name: str | None = None, children: list[BtNode] | None = None, **attributes: Any

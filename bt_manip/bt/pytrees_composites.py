@@ -20,7 +20,7 @@ from __future__ import annotations
 import functools
 import inspect
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import py_trees
 from py_trees.common import Status
@@ -56,7 +56,7 @@ def _result(node: BtNode) -> NodeStatus:
 class _PyTreesNode:
     """What the py_trees composites and decorators share (mixed before ControlNode etc.)."""
 
-    PY: ClassVar[Any]
+    PY: ClassVar[Any]  # the py_trees class whose methods run with this node as self
 
     def _storage(self) -> Any:
         return py_trees_storage(EntryView(self.blackboard))  # type: ignore[attr-defined]
@@ -187,7 +187,8 @@ class PyTreesParallel(_PyTreesComposite):
 class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
     """A py_trees decorator: its child keeps its status when it finishes (no BT.CPP reset)."""
 
-    PY = py_trees.decorators.PassThrough
+    # any py_trees decorator class: its methods run on this node (see _PyTreesNode.PY)
+    PY: ClassVar[Any] = py_trees.decorators.PassThrough
 
     def execute_tick(self) -> NodeStatus:
         return BtNode.execute_tick(self)
@@ -196,7 +197,7 @@ class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
         self.PY.initialise(self)
 
     def update(self) -> Status:
-        return self.PY.update(self)  # type: ignore[no-any-return]
+        return cast(Status, self.PY.update(self))  # py_trees' update() gives a Status
 
     def terminate(self, new_status: Status) -> None:
         self.PY.terminate(self, new_status)
@@ -304,7 +305,7 @@ class PyTreesCount(_PyTreesDecorator):
     """py_trees' ``Count``: returns the child's status and counts ticks, RUNNING ticks,
     successes, failures and interruptions (shown in its feedback message)."""
 
-    PY = py_trees.decorators.Count
+    PY: ClassVar[Any] = py_trees.decorators.Count
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:

@@ -34,7 +34,7 @@ import enum
 import inspect
 import json
 import typing
-from collections.abc import Iterator, MutableMapping
+from collections.abc import Callable, Iterator, MutableMapping
 from dataclasses import dataclass
 from typing import Any, ClassVar, get_args, get_origin
 
@@ -145,7 +145,7 @@ class Param:
     default: Any = None
 
 
-def _hints(cls: type) -> dict[str, Any]:
+def _hints(cls: type[Any]) -> dict[str, Any]:
     try:
         return typing.get_type_hints(cls.__init__)
     except Exception:  # unresolvable annotations: use them as written
@@ -321,7 +321,7 @@ class PyTreesLeaf(LeafNode):
     while RUNNING, the behaviour's ``terminate(INVALID)`` runs once.
     """
 
-    BEHAVIOUR: ClassVar[type[Behaviour]] = Behaviour
+    BEHAVIOUR: ClassVar[Callable[..., Behaviour]] = Behaviour  # the class (abstract here)
     PARAMS: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, name: str | None = None, behaviour: Behaviour | None = None,
@@ -340,7 +340,7 @@ class PyTreesLeaf(LeafNode):
             kwargs = {p: b.value for p, b in self.bindings.items()
                       if p in self.PARAMS and isinstance(b, Literal)}
             try:
-                behaviour = self.BEHAVIOUR(name=self.name, **kwargs)  # type: ignore[call-arg]
+                behaviour = self.BEHAVIOUR(name=self.name, **kwargs)
             except Exception as e:  # the constructor refused its arguments
                 raise ValueError(f"{self.NODE_ID}: {type(e).__name__}: {e}") from None
         self.behaviour = behaviour

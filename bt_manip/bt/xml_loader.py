@@ -257,11 +257,11 @@ class _Checker:
                      f"allows at most {MAX_SUBTREE_DEPTH} levels of SubTree nesting")
         if deep:
             return
-        tree_id = max(self.doc.trees, key=lambda t: nodes.get(t, 0), default=None)
-        if tree_id is not None and nodes.get(tree_id, 0) > MAX_NODE_DEPTH:
-            tree = self.doc.trees[tree_id]
+        deepest = max(self.doc.trees, key=lambda t: nodes.get(t, 0), default=None)
+        if deepest is not None and nodes.get(deepest, 0) > MAX_NODE_DEPTH:
+            tree = self.doc.trees[deepest]
             self.add(tree.file, tree.element,
-                     f"tree '{tree_id}' nests nodes {nodes[tree_id]} levels deep once its "
+                     f"tree '{deepest}' nests nodes {nodes[deepest]} levels deep once its "
                      f"SubTrees are expanded; bt-manip allows at most {MAX_NODE_DEPTH}")
 
 
@@ -446,9 +446,10 @@ class _Builder:
 
 def make_stand_in(spec: NodeSpec) -> type[BtNode]:
     """A class standing for a node known only from a model (for ``show``); ticking it fails."""
-    base: type[BtNode] = {"Action": ActionNode, "Condition": ConditionNode,
-                          "Control": ControlNode, "Decorator": DecoratorNode}.get(
-                              spec.kind, ActionNode)
+    # abstract node classes, only subclassed here (type[BtNode] would promise instances)
+    bases: dict[str, type] = {"Action": ActionNode, "Condition": ConditionNode,
+                              "Control": ControlNode, "Decorator": DecoratorNode}
+    base = bases.get(spec.kind, ActionNode)
     inputs = {name: PortInformation(object, required=False, description=p.description)
               for name, p in spec.ports.items() if p.direction != "output"}
     outputs = {name: PortInformation(object, required=False, description=p.description)
