@@ -23,7 +23,7 @@ import math
 import sys
 from dataclasses import dataclass
 from types import FrameType
-from typing import Any, Protocol, TypeGuard
+from typing import Any, Protocol, TypeGuard, cast
 
 FLOAT_EPS = 1.1920928955078125e-07  # float epsilon, the tolerance BT.CPP uses for ==
 
@@ -479,12 +479,12 @@ def compare(op: str, lhs: Any, rhs: Any) -> bool:
         return not eq
     # two strs or two numbers: the comparison gives a bool
     if op == "<":
-        return bool(a < b)
+        return cast(bool, a < b)
     if op == ">":
-        return bool(a > b)
+        return cast(bool, a > b)
     if op == "<=":
-        return bool(a <= b)
-    return bool(a >= b)
+        return cast(bool, a <= b)
+    return cast(bool, a >= b)
 
 
 # ---------------------------------------------------------------------------------------------
