@@ -47,7 +47,7 @@ def _common(parser: argparse.ArgumentParser, models: bool = True) -> None:
     add_import_flag(parser)
 
 
-def add_verbs(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def add_verbs(subparsers: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``validate``, ``show`` and ``nodes`` to ``subparsers``."""
     p = subparsers.add_parser("validate", help="check tree files without running them",
                               description="Check everything loading checks and report ALL "

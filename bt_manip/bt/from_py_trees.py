@@ -130,7 +130,7 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
             cls: type[BtNode] = controls.Sequence if memory else controls.ReactiveSequence
         else:
             cls = controls.Fallback if memory else controls.ReactiveFallback
-        return cls(name, children=children)  # type: ignore[call-arg]
+        return cls(name, children=children)
     pt_cls = ptc.PyTreesSequence if kind is py_trees.composites.Sequence else ptc.PyTreesSelector
     return pt_cls(name, children, memory=memory)
 
@@ -140,9 +140,9 @@ def _decorator(node: py_trees.decorators.Decorator, builtins: bool) -> BtNode:
     name = node.name
     child = convert_node(node.decorated, builtins)
     if builtins and kind in _BUILTIN_DECORATORS:
-        return _BUILTIN_DECORATORS[kind](name, child=child)  # type: ignore[call-arg]
+        return _BUILTIN_DECORATORS[kind](name, child=child)
     if kind in _SIMPLE_DECORATORS:
-        return _SIMPLE_DECORATORS[kind](name, child)  # type: ignore[call-arg]
+        return _SIMPLE_DECORATORS[kind](name, child)
     made: BtNode
     # each branch tests the exact class, which the cast names
     if kind is D.Repeat:

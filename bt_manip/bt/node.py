@@ -515,7 +515,7 @@ class ControlNode(BtNode, py_trees.composites.Composite):
         self, name: str | None = None, children: list[BtNode] | None = None, **attributes: Any
     ) -> None:
         kids = [as_bt_node(c) for c in children or []]
-        super().__init__(name or self.NODE_ID, children=kids)  # type: ignore[arg-type]
+        super().__init__(name or self.NODE_ID, children=kids)
         self._init_node(attributes)
         self._check_children()
 
@@ -557,7 +557,7 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
     ) -> None:
         if child is None:
             raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got 0")
-        super().__init__(name or self.NODE_ID, as_bt_node(child))  # type: ignore[arg-type]
+        super().__init__(name or self.NODE_ID, as_bt_node(child))
         self._init_node(attributes)
 
     @property
@@ -599,7 +599,7 @@ def children_rule(cls: type[BtNode]) -> str:
 def as_bt_node(node: Any) -> BtNode:
     """``node`` itself, or a plain py_trees behaviour (or whole py_trees tree) converted."""
     if isinstance(node, BtNode) or not isinstance(node, py_trees.behaviour.Behaviour):
-        return node  # type: ignore[return-value]
+        return node
     from bt_manip.bt.from_py_trees import convert_node
 
     return convert_node(node)

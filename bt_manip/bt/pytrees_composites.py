@@ -206,7 +206,7 @@ class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
 def _simple(py_class: type, doc: str) -> type:
     cls = type(f"PyTrees{py_class.__name__}", (_PyTreesDecorator,),
                {"PY": py_class, "__doc__": doc, "__module__": __name__})
-    return registry.register(cls)  # type: ignore[return-value]
+    return registry.register(cls)
 
 
 PyTreesPassThrough = _simple(py_trees.decorators.PassThrough,
@@ -388,7 +388,7 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
 
     def update(self) -> Status:
         self.client.set(self.variable_name, self.decorated.status, overwrite=True)
-        return self.decorated.status  # type: ignore[no-any-return]
+        return self.decorated.status
 
 
 @registry.register
@@ -443,7 +443,7 @@ class PyTreesEternalGuard(_ClientDecorator):
         return py_trees.decorators.Decorator.tick(self)
 
     def update(self) -> Status:
-        return self.decorated.status  # type: ignore[no-any-return]
+        return self.decorated.status
 
 
 @registry.register
@@ -494,7 +494,7 @@ class PyTreesForEach(_ClientDecorator):
             self._advance()
             if self._current is not None:
                 return Status.RUNNING
-        return status  # type: ignore[no-any-return]
+        return status
 
     def terminate(self, new_status: Status) -> None:
         self._items = None

@@ -58,7 +58,7 @@ _UNKNOWN = object()  # a constructor argument of a wrapped object that its attri
 # ---------------------------------------------------------------------- blackboard bridge
 
 
-class EntryView(MutableMapping):  # type: ignore[type-arg]
+class EntryView(MutableMapping[str, Any]):
     """py_trees' key-value store seen through a bt-manip :class:`Blackboard`.
 
     ``/foo`` and ``foo`` are entry ``foo``; keys under :data:`PORT_PREFIX` live in ``local``.
@@ -109,7 +109,7 @@ class EntryView(MutableMapping):  # type: ignore[type-arg]
 
 
 @contextlib.contextmanager
-def py_trees_storage(view: MutableMapping) -> Iterator[None]:  # type: ignore[type-arg]
+def py_trees_storage(view: MutableMapping[str, Any]) -> Iterator[None]:
     """Make py_trees' blackboard clients use ``view`` while the block runs."""
     storage = py_trees.blackboard.Blackboard
     saved = storage.storage
@@ -480,8 +480,8 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
         "__qualname__": cls.__qualname__,
     })
     if node_id is None:
-        _CLASSES[cls] = wrapper  # type: ignore[assignment]
-    return wrapper  # type: ignore[return-value]
+        _CLASSES[cls] = wrapper
+    return wrapper
 
 
 def _port_info(p: Param) -> PortInformation:
