@@ -8,7 +8,7 @@ runs once), then every child goes back to IDLE.
 from __future__ import annotations
 
 import re
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -30,7 +30,7 @@ class _Control(ControlNode):
         self.status = RUNNING.to_py_trees()
 
     def _kids(self) -> list[BtNode]:
-        return self.children  # type: ignore[return-value]
+        return cast("list[BtNode]", self.children)  # the children of a bt-manip node
 
 
 class _OrderedControl(_Control):

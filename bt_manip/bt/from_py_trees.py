@@ -213,7 +213,7 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
     made.parent = None
     made.status = py_trees.common.Status.INVALID
     made._init_node({})
-    return made  # type: ignore[no-any-return]
+    return cast(BtNode, made)  # an instance of made_class, a BtNode subclass
 
 
 def _register_leaves(root: BtNode) -> None:

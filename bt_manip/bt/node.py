@@ -525,7 +525,7 @@ class ControlNode(BtNode, py_trees.composites.Composite):
             raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got {n}")
 
     def halt_child(self, index: int) -> None:
-        child: BtNode = self.children[index]  # type: ignore[assignment]
+        child = cast(BtNode, self.children[index])  # a bt-manip node's children are BtNodes
         if child.bt_status is NodeStatus.RUNNING:
             child.halt_node()
         child.reset_status()
@@ -562,7 +562,7 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
 
     @property
     def child(self) -> BtNode:
-        return self.decorated  # type: ignore[return-value]
+        return cast(BtNode, self.decorated)  # the child of a bt-manip node is a BtNode
 
     def execute_tick(self) -> NodeStatus:
         status = BtNode.execute_tick(self)

@@ -50,7 +50,7 @@ class NodeRegistry:
                     and not issubclass(node_cls, BtNode):
                 from bt_manip.bt.pytrees_leaf import leaf_class_for
 
-                add(leaf_class_for(node_cls))  # type: ignore[arg-type]
+                self.register(leaf_class_for(node_cls), builtin=builtin)
                 return node_cls  # the user's class stays as it is
             if not (isinstance(node_cls, type) and issubclass(node_cls, BtNode)):
                 raise TypeError(f"{node_cls!r} is neither a bt-manip node class nor a "

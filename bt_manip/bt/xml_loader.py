@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -248,7 +248,7 @@ class _Checker:
                 continue
             chain = [tree_id]
             while below.get(chain[-1]) is not None and len(chain) <= depth[tree_id]:
-                chain.append(below[chain[-1]])  # type: ignore[arg-type]
+                chain.append(cast(str, below[chain[-1]]))  # not None: the loop test
             shown = " -> ".join(chain[:3]) + " -> ... -> " + " -> ".join(chain[-2:])
             tree = self.doc.trees[tree_id]
             element = next(e for t, e, _f in self.edges[tree_id] if t == chain[1])
