@@ -27,7 +27,7 @@ import difflib
 import itertools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, cast
+from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
 from py_trees.common import Status
@@ -585,7 +585,17 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
         return self.status
 
 
-def children_rule(cls: type[BtNode]) -> str:
+class ChildCounts(Protocol):
+    """What :func:`children_rule` reads: a node class, or a model's numbers."""
+
+    @property
+    def MIN_CHILDREN(self) -> int: ...
+
+    @property
+    def MAX_CHILDREN(self) -> int | None: ...
+
+
+def children_rule(cls: ChildCounts) -> str:
     lo, hi = cls.MIN_CHILDREN, cls.MAX_CHILDREN
     if hi == 0:
         return "is a leaf and takes no children"

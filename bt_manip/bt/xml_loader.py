@@ -153,7 +153,7 @@ class _Checker:
         n = len(element.children)
         lo, hi = spec.min_children, spec.max_children
         if n < lo or (hi is not None and n > hi):
-            rule = children_rule(_Rule(lo, hi))  # type: ignore[arg-type]
+            rule = children_rule(_Rule(lo, hi))
             self.add(file, element, f"{spec.node_id} {rule}, found {n}")
         if spec.node_id == "ReactiveSequence":  # BT.CPP's VerifyXML refuses these trees
             async_children = [c for c in element.children if c.tag == "AsyncSequence"]
