@@ -36,7 +36,7 @@ import json
 import typing
 from collections.abc import Callable, Iterator, MutableMapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, get_args, get_origin
+from typing import Any, ClassVar, cast, get_args, get_origin
 
 import py_trees
 from py_trees.behaviour import Behaviour
@@ -113,7 +113,7 @@ def py_trees_storage(view: MutableMapping[str, Any]) -> Iterator[None]:
     """Make py_trees' blackboard clients use ``view`` while the block runs."""
     storage = py_trees.blackboard.Blackboard
     saved = storage.storage
-    storage.storage = view  # type: ignore[assignment]
+    storage.storage = view  # type: ignore[assignment]  # py_trees types it dict; a mapping does
     try:
         yield
     finally:
@@ -518,7 +518,8 @@ def wrap(behaviour: Behaviour) -> LeafNode:
     """A bt-manip leaf running ``behaviour`` (the object itself, not a copy)."""
     counterpart = _clock_counterparts().get(type(behaviour))
     if counterpart is not None:
-        return counterpart(behaviour.name, duration=behaviour.duration)  # type: ignore
+        timer = cast(py_trees.timers.Timer, behaviour)  # the only class with a counterpart
+        return counterpart(timer.name, duration=timer.duration)
     return leaf_class_for(type(behaviour))(behaviour=behaviour)
 
 

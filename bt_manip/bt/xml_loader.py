@@ -489,7 +489,7 @@ def load_tree(
     allow_depth(_Builder.depth_of(doc, main))
     root = _Builder(doc, reg, placeholders).tree_root(main)
     tree = Tree(root, context=context, blackboard=blackboard, tree_id=main, source=path)
-    tree.warnings = doc.warnings  # type: ignore[attr-defined]
+    tree.warnings = doc.warnings
     return tree
 
 
