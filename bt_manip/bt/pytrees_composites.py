@@ -59,13 +59,14 @@ class _PyTreesNode:
     PY: ClassVar[Any]  # the py_trees class whose methods run with this node as self
 
     def _storage(self) -> Any:
-        return py_trees_storage(EntryView(self.blackboard))  # type: ignore[attr-defined]
+        node = cast(BtNode, self)  # mixed into BtNode classes only
+        return py_trees_storage(EntryView(node.blackboard))
 
     def tick_node(self) -> NodeStatus:
         with self._storage(), raised_as_tree_error(self):
             for _ in self._py_tick():
                 pass
-        return _result(self)  # type: ignore[arg-type]
+        return _result(cast(BtNode, self))
 
     def _py_tick(self) -> Any:
         return self.PY.tick(self)
