@@ -72,14 +72,15 @@ class Blackboard:
         while True:
             if key.startswith("@"):
                 return bb.root(), key[1:]
-            if key in bb._data or key in bb._types or bb.parent is None:
+            parent = bb.parent
+            if key in bb._data or key in bb._types or parent is None:
                 return bb, key
             if key in bb.remap:
                 key = bb.remap[key]
-                bb = bb.parent
+                bb = parent
                 continue
             if bb.autoremap and not key.startswith("_"):
-                bb = bb.parent
+                bb = parent
                 continue
             return bb, key
 

@@ -10,6 +10,7 @@ import argparse
 import importlib
 import sys
 from collections.abc import Iterable
+from typing import Any
 
 from bt_manip.bt.display import render_dot, render_tree
 from bt_manip.bt.models import write_models
@@ -47,7 +48,7 @@ def _common(parser: argparse.ArgumentParser, models: bool = True) -> None:
     add_import_flag(parser)
 
 
-def add_verbs(subparsers: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+def add_verbs(subparsers: argparse._SubParsersAction[Any]) -> None:
     """Add ``validate``, ``show`` and ``nodes`` to ``subparsers``."""
     p = subparsers.add_parser("validate", help="check tree files without running them",
                               description="Check everything loading checks and report ALL "

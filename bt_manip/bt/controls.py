@@ -8,7 +8,7 @@ runs once), then every child goes back to IDLE.
 from __future__ import annotations
 
 import re
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -30,7 +30,7 @@ class _Control(ControlNode):
         self.status = RUNNING.to_py_trees()
 
     def _kids(self) -> list[BtNode]:
-        return self.children  # type: ignore[return-value]
+        return cast("list[BtNode]", self.children)  # the children of a bt-manip node
 
 
 class _OrderedControl(_Control):
@@ -231,7 +231,7 @@ class Parallel(_Control):
     all of them. A finished child is not ticked again until the Parallel completes.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "success_count": PortInformation(
             int, required=False, default_value=-1,
             description="number of children that must succeed; -1 means all"),
@@ -300,7 +300,7 @@ class ParallelAll(_Control):
     the number of children), SUCCESS otherwise, and resets the children.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "max_failures": PortInformation(
             int, required=False, default_value=1,
             description="if this many children fail, the node fails; -1 means all"),

@@ -6,7 +6,7 @@ when a world is loaded, so they are deterministic and as fast as physics allows.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -82,7 +82,7 @@ class Repeat(_Decorator):
     SKIPPED child makes the node SKIPPED (the count is kept).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "num_cycles": PortInformation(
             int, description="repeat a successful child N times; -1 repeats forever"),
     }
@@ -135,7 +135,7 @@ class RetryUntilSuccessful(_Decorator):
     the node SKIPPED.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "num_attempts": PortInformation(
             int, description="try the child up to N times; -1 tries forever"),
     }
@@ -204,7 +204,7 @@ class Timeout(_Decorator):
     the blackboard, it makes the node fail (halting the child) with the reason.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "msec": Port(
             int, description="After a certain amount of time, halt() the child if it is still "
                              "running.", accepts=NON_NEGATIVE),
@@ -266,7 +266,7 @@ class Delay(_Decorator):
     ``delay_msec`` is refused at load (an unsigned int in BT.CPP).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "delay_msec": Port(
             int, description="Tick the child after a few milliseconds", accepts=NON_NEGATIVE),
     }
@@ -314,7 +314,7 @@ class RunOnce(_Decorator):
     returns the child's remembered status forever.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "then_skip": PortInformation(
             bool, required=False, default_value=True,
             description="if true, skip after the first execution, otherwise return the "
@@ -353,7 +353,7 @@ class _ScriptHolder:
     def get(self, node: BtNode, port: str) -> Script:
         binding = node.bindings.get(port)
         if not isinstance(binding, Ref):
-            return node.get_input(port)
+            return cast(Script, node.get_input(port))  # a script port's literal is parsed
         text = str(node.get_input(port))
         if text != self._text or self._script is None:
             try:
@@ -376,7 +376,7 @@ class Precondition(_Decorator):
     it is ticked until it finishes, then the node returns the child's status.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
         "if": PortInformation(str, description="script: the condition"),
         "else": PortInformation(
             NodeStatus, required=False, default_value=NodeStatus.FAILURE,
@@ -398,7 +398,7 @@ class Precondition(_Decorator):
 
             self._child_running = _truth(self, "if", script)
         if not self._child_running:
-            return otherwise
+            return cast(NodeStatus, otherwise)  # the "else" port holds a NodeStatus
         status = self.child.execute_tick()
         if status.completed:
             self.reset_child()

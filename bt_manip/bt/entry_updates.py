@@ -53,7 +53,8 @@ class _EntryWatch:
 class WasEntryUpdated(SyncActionNode):
     """SUCCESS if the entry ``entry`` was written since this node's last tick, else FAILURE."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = ENTRY_PORT
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = (  # type: ignore[misc]  # py_trees stub
+        ENTRY_PORT)
     PORT_TYPE_NAMES = ENTRY_TYPE
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
@@ -66,7 +67,8 @@ class WasEntryUpdated(SyncActionNode):
 
 class _EntryUpdatedDecorator(DecoratorNode):
     IF_NOT_UPDATED = NodeStatus.SKIPPED
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = ENTRY_PORT
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = (  # type: ignore[misc]  # py_trees stub
+        ENTRY_PORT)
     PORT_TYPE_NAMES = ENTRY_TYPE
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,

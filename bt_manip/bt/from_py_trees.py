@@ -38,7 +38,7 @@ reads the tree's clock. Nodes that already are bt-manip nodes are kept.
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import Any, cast
 
 import py_trees
 from py_trees.behaviour import Behaviour
@@ -112,8 +112,8 @@ def _children(node: Behaviour, builtins: bool) -> list[BtNode]:
 def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
     kind = type(node)
     name = node.name
-    if kind is py_trees.composites.Parallel:
-        policy = node.policy
+    if kind is py_trees.composites.Parallel:  # the exact class, hence the casts below
+        policy = cast(py_trees.composites.Parallel, node).policy
         originals = list(node.children)
         children = _children(node, builtins)
         attributes: dict[str, Any] = {"policy": type(policy).__name__,
@@ -123,14 +123,14 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
         return ptc.PyTreesParallel(name, children, **attributes)
     if kind not in (py_trees.composites.Sequence, py_trees.composites.Selector):
         return _own_class(node, builtins)
-    memory = bool(node.memory)
+    memory = bool(cast("py_trees.composites.Sequence | py_trees.composites.Selector", node).memory)
     children = _children(node, builtins)
     if builtins and children:
         if kind is py_trees.composites.Sequence:
             cls: type[BtNode] = controls.Sequence if memory else controls.ReactiveSequence
         else:
             cls = controls.Fallback if memory else controls.ReactiveFallback
-        return cls(name, children=children)  # type: ignore[call-arg]
+        return cls(name, children=children)
     pt_cls = ptc.PyTreesSequence if kind is py_trees.composites.Sequence else ptc.PyTreesSelector
     return pt_cls(name, children, memory=memory)
 
@@ -140,28 +140,33 @@ def _decorator(node: py_trees.decorators.Decorator, builtins: bool) -> BtNode:
     name = node.name
     child = convert_node(node.decorated, builtins)
     if builtins and kind in _BUILTIN_DECORATORS:
-        return _BUILTIN_DECORATORS[kind](name, child=child)  # type: ignore[call-arg]
+        return _BUILTIN_DECORATORS[kind](name, child=child)
     if kind in _SIMPLE_DECORATORS:
-        return _SIMPLE_DECORATORS[kind](name, child)  # type: ignore[call-arg]
+        return _SIMPLE_DECORATORS[kind](name, child)
     made: BtNode
+    # each branch tests the exact class, which the cast names
     if kind is D.Repeat:
-        made = ptc.PyTreesRepeat(name, child, num_success=node.num_success)
+        made = ptc.PyTreesRepeat(name, child, num_success=cast(D.Repeat, node).num_success)
     elif kind is D.Retry:
-        made = ptc.PyTreesRetry(name, child, num_failures=node.num_failures)
+        made = ptc.PyTreesRetry(name, child, num_failures=cast(D.Retry, node).num_failures)
     elif kind is D.Timeout:
-        made = ptc.PyTreesTimeout(name, child, duration=float(node.duration))
+        made = ptc.PyTreesTimeout(name, child, duration=float(cast(D.Timeout, node).duration))
     elif kind is D.OneShot:
-        made = ptc.PyTreesOneShot(name, child, policy=node.policy.name)
+        made = ptc.PyTreesOneShot(name, child, policy=cast(D.OneShot, node).policy.name)
     elif kind is D.Condition:
-        made = ptc.PyTreesCondition(name, child, status=node.succeed_status.name)
+        made = ptc.PyTreesCondition(name, child,
+                                    status=cast(D.Condition, node).succeed_status.name)
     elif kind is D.StatusToBlackboard:
-        made = ptc.PyTreesStatusToBlackboard(name, child, variable_name=node.variable_name)
+        made = ptc.PyTreesStatusToBlackboard(
+            name, child, variable_name=cast(D.StatusToBlackboard, node).variable_name)
     elif kind is D.ForEach:
-        made = ptc.PyTreesForEach(name, child, source_key=node.source_key,
-                                  target_key=node.target_key)
+        for_each = cast(D.ForEach, node)
+        made = ptc.PyTreesForEach(name, child, source_key=for_each.source_key,
+                                  target_key=for_each.target_key)
     elif kind is D.EternalGuard:
-        guard = ptc.PyTreesEternalGuard(name, child, condition=node.condition)
-        guard.condition = node.condition  # already bound to the original guard's client
+        original = cast(D.EternalGuard, node)
+        guard = ptc.PyTreesEternalGuard(name, child, condition=original.condition)
+        guard.condition = original.condition  # already bound to the original guard's client
         guard.blackboards.extend(node.blackboards)
         made = guard
     else:
@@ -208,7 +213,7 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
     made.parent = None
     made.status = py_trees.common.Status.INVALID
     made._init_node({})
-    return made  # type: ignore[no-any-return]
+    return cast(BtNode, made)  # an instance of made_class, a BtNode subclass
 
 
 def _register_leaves(root: BtNode) -> None:

@@ -16,7 +16,8 @@ BT.CPP 4.8.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from types import GenericAlias
+from typing import Any, ClassVar, cast
 
 from py_trees.ports import PortInformation
 
@@ -67,7 +68,7 @@ class _Loop(DecoratorNode):
                 popped = True
                 self.set_output("value", value)
         if not popped and not self._child_running:
-            return self.get_input("if_empty")
+            return cast(NodeStatus, self.get_input("if_empty"))  # a NodeStatus port
         if self.bt_status is IDLE:
             self.bt_status = RUNNING
             self.status = RUNNING.to_py_trees()
@@ -87,7 +88,8 @@ def _make_loop(node_id: str, item: type) -> type[_Loop]:
             NodeStatus, required=False, default_value=NodeStatus.SUCCESS,
             description="Status to return if queue is empty: SUCCESS, FAILURE, SKIPPED"),
         "queue": InOutPortInformation(
-            list[item], description="items to loop over: a list entry, or text 'a;b;c'"),
+            GenericAlias(list, (item,)),  # list[item], made at run time
+            description="items to loop over: a list entry, or text 'a;b;c'"),
     }
     cls = type(node_id, (_Loop,), {
         "NODE_ID": node_id,

@@ -27,7 +27,7 @@ import difflib
 import itertools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
 from py_trees.common import Status
@@ -116,8 +116,10 @@ class BtNode(PortsMixin):
     DESCRIPTION: ClassVar[str] = ""
     MIN_CHILDREN: ClassVar[int] = 0
     MAX_CHILDREN: ClassVar[int | None] = 0
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}
+    # "py_trees stub" below: py_trees annotates the two as instance attributes, though they are
+    # class-level declarations, and mypy lets no ClassVar override an instance attribute.
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     started_order: int = 0
     failure_order: int = 0
@@ -253,7 +255,7 @@ class BtNode(PortsMixin):
             if default is not _MISSING:
                 return default
             raise PortError(f"{self.describe()}: input port '{port_name}' has no value")
-        if type(binding) is Literal:
+        if isinstance(binding, Literal):  # Binding is Ref | Literal, neither subclassed
             return binding.value
         try:
             value = self.blackboard.get(binding.key)
@@ -419,7 +421,8 @@ class BtNode(PortsMixin):
             self.bt_status = STATUS_OF_PY_TREES[new_status]
 
     def bt_children(self) -> list[BtNode]:
-        return list(self.children)  # type: ignore[attr-defined]
+        # the children of a bt-manip node are bt-manip nodes (the XML loader builds them)
+        return cast("list[BtNode]", list(self.children))
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:
@@ -506,13 +509,13 @@ class ControlNode(BtNode, py_trees.composites.Composite):
 
     KIND = "Control"
     MIN_CHILDREN = 1
-    MAX_CHILDREN = None
+    MAX_CHILDREN: ClassVar[int | None] = None
 
     def __init__(
         self, name: str | None = None, children: list[BtNode] | None = None, **attributes: Any
     ) -> None:
         kids = [as_bt_node(c) for c in children or []]
-        super().__init__(name or self.NODE_ID, children=kids)  # type: ignore[arg-type]
+        super().__init__(name or self.NODE_ID, children=kids)
         self._init_node(attributes)
         self._check_children()
 
@@ -522,7 +525,7 @@ class ControlNode(BtNode, py_trees.composites.Composite):
             raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got {n}")
 
     def halt_child(self, index: int) -> None:
-        child: BtNode = self.children[index]  # type: ignore[assignment]
+        child = cast(BtNode, self.children[index])  # a bt-manip node's children are BtNodes
         if child.bt_status is NodeStatus.RUNNING:
             child.halt_node()
         child.reset_status()
@@ -554,12 +557,12 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
     ) -> None:
         if child is None:
             raise ValueError(f"{self.NODE_ID}: {children_rule(type(self))}, got 0")
-        super().__init__(name or self.NODE_ID, as_bt_node(child))  # type: ignore[arg-type]
+        super().__init__(name or self.NODE_ID, as_bt_node(child))
         self._init_node(attributes)
 
     @property
     def child(self) -> BtNode:
-        return self.decorated  # type: ignore[return-value]
+        return cast(BtNode, self.decorated)  # the child of a bt-manip node is a BtNode
 
     def execute_tick(self) -> NodeStatus:
         status = BtNode.execute_tick(self)
@@ -582,7 +585,17 @@ class DecoratorNode(BtNode, py_trees.decorators.Decorator):
         return self.status
 
 
-def children_rule(cls: type[BtNode]) -> str:
+class ChildCounts(Protocol):
+    """What :func:`children_rule` reads: a node class, or a model's numbers."""
+
+    @property
+    def MIN_CHILDREN(self) -> int: ...
+
+    @property
+    def MAX_CHILDREN(self) -> int | None: ...
+
+
+def children_rule(cls: ChildCounts) -> str:
     lo, hi = cls.MIN_CHILDREN, cls.MAX_CHILDREN
     if hi == 0:
         return "is a leaf and takes no children"
@@ -596,7 +609,7 @@ def children_rule(cls: type[BtNode]) -> str:
 def as_bt_node(node: Any) -> BtNode:
     """``node`` itself, or a plain py_trees behaviour (or whole py_trees tree) converted."""
     if isinstance(node, BtNode) or not isinstance(node, py_trees.behaviour.Behaviour):
-        return node  # type: ignore[return-value]
+        return node
     from bt_manip.bt.from_py_trees import convert_node
 
     return convert_node(node)

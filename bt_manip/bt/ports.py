@@ -13,7 +13,7 @@ import numbers
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, get_args, get_origin
+from typing import Any, cast, get_args, get_origin
 
 from py_trees.ports import PortInformation
 
@@ -74,8 +74,10 @@ class Accepts:
             return True
         if self.low is not None and (value < self.low or (self.low_open and value == self.low)):
             return False
+        # a numbers.Real here; typeshed gives Real no __gt__, hence the cast
         return not (self.high is not None
-                    and (value > self.high or (self.high_open and value == self.high)))
+                    and (cast(float, value) > self.high
+                         or (self.high_open and value == self.high)))
 
 
 NON_NEGATIVE = Accepts(low=0)
@@ -110,7 +112,7 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
     shown = text if text is not None else format_literal(value)
     many = isinstance(value, list | tuple)
     numeric = _carries_floats(info.data_type)
-    rule = getattr(info, "accepts", None)
+    rule: Accepts | None = getattr(info, "accepts", None)
     for item in value if many else [value]:
         if (numeric and isinstance(item, numbers.Real) and not isinstance(item, bool)
                 and not math.isfinite(item)):

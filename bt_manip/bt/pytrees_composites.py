@@ -20,7 +20,7 @@ from __future__ import annotations
 import functools
 import inspect
 from collections.abc import Callable
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import py_trees
 from py_trees.common import Status
@@ -56,16 +56,17 @@ def _result(node: BtNode) -> NodeStatus:
 class _PyTreesNode:
     """What the py_trees composites and decorators share (mixed before ControlNode etc.)."""
 
-    PY: ClassVar[Any]
+    PY: ClassVar[Any]  # the py_trees class whose methods run with this node as self
 
     def _storage(self) -> Any:
-        return py_trees_storage(EntryView(self.blackboard))  # type: ignore[attr-defined]
+        node = cast(BtNode, self)  # mixed into BtNode classes only
+        return py_trees_storage(EntryView(node.blackboard))
 
     def tick_node(self) -> NodeStatus:
         with self._storage(), raised_as_tree_error(self):
             for _ in self._py_tick():
                 pass
-        return _result(self)  # type: ignore[arg-type]
+        return _result(cast(BtNode, self))
 
     def _py_tick(self) -> Any:
         return self.PY.tick(self)
@@ -89,7 +90,7 @@ class _PyTreesComposite(_PyTreesNode, ControlNode):
 class _MemoryComposite(_PyTreesComposite):
     """A py_trees composite with the ``memory`` flag (``Sequence``, ``Selector``)."""
 
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "memory": PortInformation(bool, description="resume from the RUNNING child",
                                   default_value=False)}
 
@@ -138,7 +139,7 @@ class PyTreesParallel(_PyTreesComposite):
     """
 
     PY = py_trees.composites.Parallel
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "policy": PortInformation(str, description="SuccessOnAll, SuccessOnOne or "
                                                    "SuccessOnSelected",
                                   default_value="SuccessOnAll"),
@@ -187,7 +188,8 @@ class PyTreesParallel(_PyTreesComposite):
 class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
     """A py_trees decorator: its child keeps its status when it finishes (no BT.CPP reset)."""
 
-    PY = py_trees.decorators.PassThrough
+    # any py_trees decorator class: its methods run on this node (see _PyTreesNode.PY)
+    PY: ClassVar[Any] = py_trees.decorators.PassThrough
 
     def execute_tick(self) -> NodeStatus:
         return BtNode.execute_tick(self)
@@ -196,7 +198,7 @@ class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
         self.PY.initialise(self)
 
     def update(self) -> Status:
-        return self.PY.update(self)  # type: ignore[no-any-return]
+        return cast(Status, self.PY.update(self))  # py_trees' update() gives a Status
 
     def terminate(self, new_status: Status) -> None:
         self.PY.terminate(self, new_status)
@@ -205,7 +207,7 @@ class _PyTreesDecorator(_PyTreesNode, DecoratorNode):
 def _simple(py_class: type, doc: str) -> type:
     cls = type(f"PyTrees{py_class.__name__}", (_PyTreesDecorator,),
                {"PY": py_class, "__doc__": doc, "__module__": __name__})
-    return registry.register(cls)  # type: ignore[return-value]
+    return registry.register(cls)
 
 
 PyTreesPassThrough = _simple(py_trees.decorators.PassThrough,
@@ -239,7 +241,7 @@ class PyTreesRepeat(_PyTreesDecorator):
     RUNNING gives RUNNING. One cycle per tick."""
 
     PY = py_trees.decorators.Repeat
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "num_success": PortInformation(int, description="successes needed; -1 repeats forever")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -255,7 +257,7 @@ class PyTreesRetry(_PyTreesDecorator):
     FAILURE); child SUCCESS gives SUCCESS; RUNNING gives RUNNING. One attempt per tick."""
 
     PY = py_trees.decorators.Retry
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "num_failures": PortInformation(int, description="failures before giving up")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -272,7 +274,7 @@ class PyTreesTimeout(_PyTreesDecorator):
     otherwise returns the child's status."""
 
     PY = py_trees.decorators.Timeout
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "duration": PortInformation(float, description="seconds", default_value=5.0)}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -304,7 +306,7 @@ class PyTreesCount(_PyTreesDecorator):
     """py_trees' ``Count``: returns the child's status and counts ticks, RUNNING ticks,
     successes, failures and interruptions (shown in its feedback message)."""
 
-    PY = py_trees.decorators.Count
+    PY: ClassVar[Any] = py_trees.decorators.Count
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
@@ -323,7 +325,7 @@ class PyTreesOneShot(_PyTreesDecorator):
     status for ever without ticking the child."""
 
     PY = py_trees.decorators.OneShot
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "policy": PortInformation(str, description="ON_COMPLETION or ON_SUCCESSFUL_COMPLETION",
                                   default_value="ON_COMPLETION")}
 
@@ -349,7 +351,7 @@ class PyTreesCondition(_PyTreesDecorator):
     ``status``, RUNNING otherwise."""
 
     PY = py_trees.decorators.Condition
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "status": PortInformation(NodeStatus, description="child status that means SUCCESS",
                                   default_value=NodeStatus.SUCCESS)}
 
@@ -375,7 +377,7 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
     ``variable_name`` after each tick and returns it."""
 
     PY = py_trees.decorators.StatusToBlackboard
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "variable_name": PortInformation(str, description="entry to write the status to")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -387,7 +389,7 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
 
     def update(self) -> Status:
         self.client.set(self.variable_name, self.decorated.status, overwrite=True)
-        return self.decorated.status  # type: ignore[no-any-return]
+        return self.decorated.status
 
 
 @registry.register
@@ -401,7 +403,7 @@ class PyTreesEternalGuard(_ClientDecorator):
     """
 
     PY = py_trees.decorators.EternalGuard
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "condition": PortInformation(object, description="script (XML) or Python callable"),
         "blackboard_keys": PortInformation(list[str], required=False,
                                            description="entries a Python condition reads"),
@@ -442,7 +444,7 @@ class PyTreesEternalGuard(_ClientDecorator):
         return py_trees.decorators.Decorator.tick(self)
 
     def update(self) -> Status:
-        return self.decorated.status  # type: ignore[no-any-return]
+        return self.decorated.status
 
 
 @registry.register
@@ -453,7 +455,7 @@ class PyTreesForEach(_ClientDecorator):
     returned as is."""
 
     PY = py_trees.decorators.ForEach
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "source_key": PortInformation(str, description="entry holding the items"),
         "target_key": PortInformation(str, description="entry receiving the current item"),
     }
@@ -493,7 +495,7 @@ class PyTreesForEach(_ClientDecorator):
             self._advance()
             if self._current is not None:
                 return Status.RUNNING
-        return status  # type: ignore[no-any-return]
+        return status
 
     def terminate(self, new_status: Status) -> None:
         self._items = None
@@ -508,7 +510,7 @@ class PyTreesTimer(LeafNode):
     """py_trees' ``Timer`` on the tree's clock: RUNNING until more than ``duration`` seconds
     have passed since it started, then SUCCESS."""
 
-    INPUT_PORTS: ClassVar[Ports] = {
+    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
         "duration": PortInformation(float, description="seconds", default_value=5.0)}
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:

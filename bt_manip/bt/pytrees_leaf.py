@@ -34,9 +34,9 @@ import enum
 import inspect
 import json
 import typing
-from collections.abc import Iterator, MutableMapping
+from collections.abc import Callable, Iterator, MutableMapping
 from dataclasses import dataclass
-from typing import Any, ClassVar, get_args, get_origin
+from typing import Any, ClassVar, cast, get_args, get_origin
 
 import py_trees
 from py_trees.behaviour import Behaviour
@@ -58,7 +58,7 @@ _UNKNOWN = object()  # a constructor argument of a wrapped object that its attri
 # ---------------------------------------------------------------------- blackboard bridge
 
 
-class EntryView(MutableMapping):  # type: ignore[type-arg]
+class EntryView(MutableMapping[str, Any]):
     """py_trees' key-value store seen through a bt-manip :class:`Blackboard`.
 
     ``/foo`` and ``foo`` are entry ``foo``; keys under :data:`PORT_PREFIX` live in ``local``.
@@ -109,11 +109,11 @@ class EntryView(MutableMapping):  # type: ignore[type-arg]
 
 
 @contextlib.contextmanager
-def py_trees_storage(view: MutableMapping) -> Iterator[None]:  # type: ignore[type-arg]
+def py_trees_storage(view: MutableMapping[str, Any]) -> Iterator[None]:
     """Make py_trees' blackboard clients use ``view`` while the block runs."""
     storage = py_trees.blackboard.Blackboard
     saved = storage.storage
-    storage.storage = view  # type: ignore[assignment]
+    storage.storage = view  # type: ignore[assignment]  # py_trees types it dict; a mapping does
     try:
         yield
     finally:
@@ -145,7 +145,7 @@ class Param:
     default: Any = None
 
 
-def _hints(cls: type) -> dict[str, Any]:
+def _hints(cls: type[Any]) -> dict[str, Any]:
     try:
         return typing.get_type_hints(cls.__init__)
     except Exception:  # unresolvable annotations: use them as written
@@ -321,7 +321,7 @@ class PyTreesLeaf(LeafNode):
     while RUNNING, the behaviour's ``terminate(INVALID)`` runs once.
     """
 
-    BEHAVIOUR: ClassVar[type[Behaviour]] = Behaviour
+    BEHAVIOUR: ClassVar[Callable[..., Behaviour]] = Behaviour  # the class (abstract here)
     PARAMS: ClassVar[dict[str, Param]] = {}
 
     def __init__(self, name: str | None = None, behaviour: Behaviour | None = None,
@@ -340,7 +340,7 @@ class PyTreesLeaf(LeafNode):
             kwargs = {p: b.value for p, b in self.bindings.items()
                       if p in self.PARAMS and isinstance(b, Literal)}
             try:
-                behaviour = self.BEHAVIOUR(name=self.name, **kwargs)  # type: ignore[call-arg]
+                behaviour = self.BEHAVIOUR(name=self.name, **kwargs)
             except Exception as e:  # the constructor refused its arguments
                 raise ValueError(f"{self.NODE_ID}: {type(e).__name__}: {e}") from None
         self.behaviour = behaviour
@@ -480,8 +480,8 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
         "__qualname__": cls.__qualname__,
     })
     if node_id is None:
-        _CLASSES[cls] = wrapper  # type: ignore[assignment]
-    return wrapper  # type: ignore[return-value]
+        _CLASSES[cls] = wrapper
+    return wrapper
 
 
 def _port_info(p: Param) -> PortInformation:
@@ -518,7 +518,8 @@ def wrap(behaviour: Behaviour) -> LeafNode:
     """A bt-manip leaf running ``behaviour`` (the object itself, not a copy)."""
     counterpart = _clock_counterparts().get(type(behaviour))
     if counterpart is not None:
-        return counterpart(behaviour.name, duration=behaviour.duration)  # type: ignore
+        timer = cast(py_trees.timers.Timer, behaviour)  # the only class with a counterpart
+        return counterpart(timer.name, duration=timer.duration)
     return leaf_class_for(type(behaviour))(behaviour=behaviour)
 
 

@@ -16,13 +16,13 @@ too: it is wrapped as a leaf (see :mod:`bt_manip.bt.pytrees_leaf`) under its cla
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar, overload
 
 import py_trees
 
 from bt_manip.bt.node import BtNode
 
-N = TypeVar("N", bound=type[BtNode])
+N = TypeVar("N", bound=type[Any])  # a BtNode or py_trees Behaviour subclass
 
 SUBTREE_ID = "SubTree"
 
@@ -34,6 +34,12 @@ class NodeRegistry:
         self._classes: dict[str, type[BtNode]] = {}
         self._builtin: set[str] = set()
 
+    @overload
+    def register(self, cls: N, *, builtin: bool = False) -> N: ...
+
+    @overload
+    def register(self, cls: None = None, *, builtin: bool = False) -> Callable[[N], N]: ...
+
     def register(
         self, cls: N | None = None, *, builtin: bool = False
     ) -> N | Callable[[N], N]:
@@ -44,7 +50,7 @@ class NodeRegistry:
                     and not issubclass(node_cls, BtNode):
                 from bt_manip.bt.pytrees_leaf import leaf_class_for
 
-                add(leaf_class_for(node_cls))  # type: ignore[arg-type]
+                self.register(leaf_class_for(node_cls), builtin=builtin)
                 return node_cls  # the user's class stays as it is
             if not (isinstance(node_cls, type) and issubclass(node_cls, BtNode)):
                 raise TypeError(f"{node_cls!r} is neither a bt-manip node class nor a "

@@ -22,7 +22,8 @@ from __future__ import annotations
 import math
 import sys
 from dataclasses import dataclass
-from typing import Any, Protocol
+from types import FrameType
+from typing import Any, Protocol, TypeGuard, cast
 
 FLOAT_EPS = 1.1920928955078125e-07  # float epsilon, the tolerance BT.CPP uses for ==
 
@@ -346,7 +347,7 @@ class Script:
 # Value semantics
 
 
-def _is_number(v: Any) -> bool:
+def _is_number(v: Any) -> TypeGuard[int | float]:
     return isinstance(v, (int, float)) and not isinstance(v, str)
 
 
@@ -454,20 +455,20 @@ def binary(op: str, lhs: Any, rhs: Any) -> Any:
         return lhs + rhs
     if isinstance(lhs, str) or isinstance(rhs, str):
         raise ScriptRuntimeError(f"operation [{op}] is not permitted between {lhs!r} and {rhs!r}")
-    a, b = to_number(lhs, op), to_number(rhs, op)
+    x, y = to_number(lhs, op), to_number(rhs, op)
     if op in ("&", "|", "^"):
-        if float(a) != int(a) or float(b) != int(b):
+        if float(x) != int(x) or float(y) != int(y):
             raise ScriptRuntimeError(f"bitwise operator [{op}] needs integers")
-        ia, ib = int(a), int(b)
+        ia, ib = int(x), int(y)
         return ia & ib if op == "&" else (ia | ib if op == "|" else ia ^ ib)
-    return _arith(op, a, b)
+    return _arith(op, x, y)
 
 
 def compare(op: str, lhs: Any, rhs: Any) -> bool:
     if isinstance(lhs, str) and isinstance(rhs, str):
         a: Any = lhs
         b: Any = rhs
-        eq = a == b
+        eq: bool = a == b
     else:
         a = to_number(lhs, op)
         b = to_number(rhs, op)
@@ -476,13 +477,14 @@ def compare(op: str, lhs: Any, rhs: Any) -> bool:
         return eq
     if op == "!=":
         return not eq
+    # two strs or two numbers: the comparison gives a bool
     if op == "<":
-        return a < b
+        return cast(bool, a < b)
     if op == ">":
-        return a > b
+        return cast(bool, a > b)
     if op == "<=":
-        return a <= b
-    return a >= b
+        return cast(bool, a <= b)
+    return cast(bool, a >= b)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -641,7 +643,8 @@ or refused the same way in every process)."""
 
 
 def _parse_in_budget(code: str) -> list[Expr]:
-    depth, frame = 0, sys._getframe()
+    depth = 0
+    frame: FrameType | None = sys._getframe()
     while frame is not None:
         depth, frame = depth + 1, frame.f_back
     old = sys.getrecursionlimit()

@@ -65,7 +65,8 @@ STATUS_OF_PY_TREES = {
     Status.FAILURE: NodeStatus.FAILURE,
 }
 """The status of each py_trees status (INVALID is IDLE)."""
-RESULT_OF_PY_TREES = {p: b for p, b in STATUS_OF_PY_TREES.items() if p is not Status.INVALID}
+RESULT_OF_PY_TREES: dict[Status, NodeStatus] = {
+    p: b for p, b in STATUS_OF_PY_TREES.items() if p is not Status.INVALID}
 """What a py_trees tick result means as a node's result (INVALID is no result)."""
 
 

@@ -15,7 +15,7 @@ from bt_manip.bt.ports import Ref
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.walk import walk_nodes
-from bt_manip.errors import InputError
+from bt_manip.errors import InputError, Problem
 
 INVALID = Status.INVALID
 
@@ -49,6 +49,9 @@ class Tree:
     ``halt()`` is ``haltTree()``: every RUNNING node's ``terminate(INVALID)`` runs once, and
     every node's ``_onHalted`` script runs.
     """
+
+    warnings: list[Problem]
+    """The loader's warnings, set on trees loaded from a file (no attribute otherwise)."""
 
     def __init__(
         self,

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable
-from typing import Any
+from typing import Any, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -153,7 +153,7 @@ class _Checker:
         n = len(element.children)
         lo, hi = spec.min_children, spec.max_children
         if n < lo or (hi is not None and n > hi):
-            rule = children_rule(_Rule(lo, hi))  # type: ignore[arg-type]
+            rule = children_rule(_Rule(lo, hi))
             self.add(file, element, f"{spec.node_id} {rule}, found {n}")
         if spec.node_id == "ReactiveSequence":  # BT.CPP's VerifyXML refuses these trees
             async_children = [c for c in element.children if c.tag == "AsyncSequence"]
@@ -248,7 +248,7 @@ class _Checker:
                 continue
             chain = [tree_id]
             while below.get(chain[-1]) is not None and len(chain) <= depth[tree_id]:
-                chain.append(below[chain[-1]])  # type: ignore[arg-type]
+                chain.append(cast(str, below[chain[-1]]))  # not None: the loop test
             shown = " -> ".join(chain[:3]) + " -> ... -> " + " -> ".join(chain[-2:])
             tree = self.doc.trees[tree_id]
             element = next(e for t, e, _f in self.edges[tree_id] if t == chain[1])
@@ -257,11 +257,11 @@ class _Checker:
                      f"allows at most {MAX_SUBTREE_DEPTH} levels of SubTree nesting")
         if deep:
             return
-        tree_id = max(self.doc.trees, key=lambda t: nodes.get(t, 0), default=None)
-        if tree_id is not None and nodes.get(tree_id, 0) > MAX_NODE_DEPTH:
-            tree = self.doc.trees[tree_id]
+        deepest = max(self.doc.trees, key=lambda t: nodes.get(t, 0), default=None)
+        if deepest is not None and nodes.get(deepest, 0) > MAX_NODE_DEPTH:
+            tree = self.doc.trees[deepest]
             self.add(tree.file, tree.element,
-                     f"tree '{tree_id}' nests nodes {nodes[tree_id]} levels deep once its "
+                     f"tree '{deepest}' nests nodes {nodes[deepest]} levels deep once its "
                      f"SubTrees are expanded; bt-manip allows at most {MAX_NODE_DEPTH}")
 
 
@@ -446,9 +446,10 @@ class _Builder:
 
 def make_stand_in(spec: NodeSpec) -> type[BtNode]:
     """A class standing for a node known only from a model (for ``show``); ticking it fails."""
-    base: type[BtNode] = {"Action": ActionNode, "Condition": ConditionNode,
-                          "Control": ControlNode, "Decorator": DecoratorNode}.get(
-                              spec.kind, ActionNode)
+    # abstract node classes, only subclassed here (type[BtNode] would promise instances)
+    bases: dict[str, type] = {"Action": ActionNode, "Condition": ConditionNode,
+                              "Control": ControlNode, "Decorator": DecoratorNode}
+    base = bases.get(spec.kind, ActionNode)
     inputs = {name: PortInformation(object, required=False, description=p.description)
               for name, p in spec.ports.items() if p.direction != "output"}
     outputs = {name: PortInformation(object, required=False, description=p.description)
@@ -488,7 +489,7 @@ def load_tree(
     allow_depth(_Builder.depth_of(doc, main))
     root = _Builder(doc, reg, placeholders).tree_root(main)
     tree = Tree(root, context=context, blackboard=blackboard, tree_id=main, source=path)
-    tree.warnings = doc.warnings  # type: ignore[attr-defined]
+    tree.warnings = doc.warnings
     return tree
 
 
