@@ -39,8 +39,10 @@ demo: $(RUNTIME_STAMP)
 test: $(EXTRAS_STAMP)
 	$(BIN)/python -m pytest -n 2 -q
 
+## lint: ruff, and mypy over bt_manip/ (settings in pyproject.toml)
 lint: $(EXTRAS_STAMP)
 	$(BIN)/ruff check .
+	$(BIN)/mypy
 
 bench: $(EXTRAS_STAMP)
 	$(BIN)/python benchmarks/astar.py
