@@ -8,7 +8,7 @@ runs once), then every child goes back to IDLE.
 from __future__ import annotations
 
 import re
-from typing import Any, ClassVar, cast
+from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
@@ -24,16 +24,7 @@ FAILURE = NodeStatus.FAILURE
 SKIPPED = NodeStatus.SKIPPED
 
 
-class _Control(ControlNode):
-    def _start(self) -> None:
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
-
-    def _kids(self) -> list[BtNode]:
-        return cast("list[BtNode]", self.children)  # the children of a bt-manip node
-
-
-class _OrderedControl(_Control):
+class _OrderedControl(ControlNode):
     """Shared logic of Sequence, SequenceWithMemory, Fallback and their Async variants."""
 
     STOP_ON = FAILURE  # child status that ends the loop early
@@ -51,11 +42,11 @@ class _OrderedControl(_Control):
         self.current = 0
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         n = len(kids)
         if self.bt_status is IDLE:  # BT.CPP keeps the count while the node is not reset
             self._skipped = 0
-        self._start()
+        self.set_running()
         while self.current < n:
             child = kids[self.current]
             before = child.bt_status
@@ -163,14 +154,14 @@ class AsyncFallback(Fallback):
     YIELDS = True
 
 
-class _ReactiveControl(_Control):
+class _ReactiveControl(ControlNode):
     STOP_ON = FAILURE
     DONE = SUCCESS
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         all_skipped = True
-        self._start()
+        self.set_running()
         for index, child in enumerate(kids):
             status = child.execute_tick()
             all_skipped = all_skipped and status is SKIPPED
@@ -222,7 +213,7 @@ def _threshold(value: int, n: int) -> int:
 
 
 @registry.register(builtin=True)
-class Parallel(_Control):
+class Parallel(ControlNode):
     """Ticks every child that has not finished yet, at each tick.
 
     Succeeds as soon as ``success_count`` children succeeded, fails as soon as
@@ -251,7 +242,7 @@ class Parallel(_Control):
         self._failures = 0
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         n = len(kids)
         success_needed = _threshold(self.get_input("success_count"), n)
         failure_needed = _threshold(self.get_input("failure_count"), n)
@@ -261,7 +252,7 @@ class Parallel(_Control):
         if n < failure_needed:
             raise TreeRuntimeError(
                 f"{self.describe()}: failure_count {failure_needed} is more than its {n} children")
-        self._start()
+        self.set_running()
         skipped = 0
         negative_success = self.get_input("success_count") < 0
         for index, child in enumerate(kids):
@@ -293,7 +284,7 @@ class Parallel(_Control):
 
 
 @registry.register(builtin=True)
-class ParallelAll(_Control):
+class ParallelAll(ControlNode):
     """Ticks every unfinished child at each tick until all of them finished.
 
     Then returns FAILURE if at least ``max_failures`` children failed (negative: counted from
@@ -313,14 +304,14 @@ class ParallelAll(_Control):
         self._failures = 0
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         n = len(kids)
         failure_threshold = _threshold(self.get_input("max_failures"), n)
         if n < failure_threshold:
             raise TreeRuntimeError(
                 f"{self.describe()}: max_failures {failure_threshold} is more than its "
                 f"{n} children")
-        self._start()
+        self.set_running()
         skipped = 0
         for index, child in enumerate(kids):
             if index in self._completed:
@@ -350,7 +341,7 @@ class ParallelAll(_Control):
 
 
 @registry.register(builtin=True)
-class IfThenElse(_Control):
+class IfThenElse(ControlNode):
     """``<IfThenElse> condition, then [, else]``.
 
     The first child is ticked until it finishes (it is not re-checked while a branch runs):
@@ -368,8 +359,8 @@ class IfThenElse(_Control):
         self._branch = 0
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
-        self._start()
+        kids = self.bt_children()
+        self.set_running()
         if self._branch == 0:
             condition = kids[0].execute_tick()
             if condition is RUNNING:
@@ -396,7 +387,7 @@ class IfThenElse(_Control):
 
 
 @registry.register(builtin=True)
-class WhileDoElse(_Control):
+class WhileDoElse(ControlNode):
     """``<WhileDoElse> condition, do [, else]``: the condition is re-checked at every tick.
 
     Condition SUCCESS: halt the else branch and tick the second child; FAILURE: halt the do
@@ -408,8 +399,8 @@ class WhileDoElse(_Control):
     MAX_CHILDREN = 3
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
-        self._start()
+        kids = self.bt_children()
+        self.set_running()
         condition = kids[0].execute_tick()
         if condition is RUNNING:
             return RUNNING
@@ -458,7 +449,7 @@ def _switch_equal(a: str, b: str) -> bool:
     return bool(ra and rb and abs(float(ra.group(0)) - float(rb.group(0))) <= FLOAT_EPS)
 
 
-class _Switch(_Control):
+class _Switch(ControlNode):
     """``<SwitchN variable="{v}" case_1=".." ...>``: N case children plus a default (last).
 
     At each tick the variable is compared with every case (as text, then as numbers); the
@@ -476,7 +467,7 @@ class _Switch(_Control):
         self._running = -1
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         match = self.CASES
         variable = self.get_input("variable", None)
         if variable is not None:

@@ -24,18 +24,12 @@ FAILURE = NodeStatus.FAILURE
 SKIPPED = NodeStatus.SKIPPED
 
 
-class _Decorator(DecoratorNode):
-    def _start(self) -> None:
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
-
-
 @registry.register(builtin=True)
-class Inverter(_Decorator):
+class Inverter(DecoratorNode):
     """Child SUCCESS gives FAILURE and FAILURE gives SUCCESS; RUNNING and SKIPPED pass through."""
 
     def tick_node(self) -> NodeStatus:
-        self._start()
+        self.set_running()
         status = self.child.execute_tick()
         if status is SUCCESS:
             self.reset_child()
@@ -46,11 +40,11 @@ class Inverter(_Decorator):
         return status
 
 
-class _Force(_Decorator):
+class _Force(DecoratorNode):
     RESULT = SUCCESS
 
     def tick_node(self) -> NodeStatus:
-        self._start()
+        self.set_running()
         status = self.child.execute_tick()
         if status.completed:
             self.reset_child()
@@ -71,7 +65,7 @@ class ForceFailure(_Force):
 
 
 @registry.register(builtin=True)
-class Repeat(_Decorator):
+class Repeat(DecoratorNode):
     """Ticks the child up to ``num_cycles`` times in a row (-1: forever) while it succeeds.
 
     A child that started and succeeded within this tick, with cycles left, makes it return
@@ -95,7 +89,7 @@ class Repeat(_Decorator):
     def tick_node(self) -> NodeStatus:
         cycles = self.get_input("num_cycles")
         loop = self.count < cycles or cycles == -1
-        self._start()
+        self.set_running()
         while loop:
             child = self.child
             before = child.bt_status
@@ -125,7 +119,7 @@ class Repeat(_Decorator):
 
 
 @registry.register(builtin=True)
-class RetryUntilSuccessful(_Decorator):
+class RetryUntilSuccessful(DecoratorNode):
     """Ticks the child again after a FAILURE, up to ``num_attempts`` times (-1: forever).
 
     A child that started and failed within this tick, with attempts left, makes it return
@@ -148,7 +142,7 @@ class RetryUntilSuccessful(_Decorator):
     def tick_node(self) -> NodeStatus:
         attempts = self.get_input("num_attempts")
         loop = self.tries < attempts or attempts == -1
-        self._start()
+        self.set_running()
         while loop:
             child = self.child
             before = child.bt_status
@@ -179,11 +173,11 @@ class RetryUntilSuccessful(_Decorator):
 
 
 @registry.register(builtin=True)
-class KeepRunningUntilFailure(_Decorator):
+class KeepRunningUntilFailure(DecoratorNode):
     """Returns RUNNING while the child succeeds or runs (restarting it), FAILURE when it fails."""
 
     def tick_node(self) -> NodeStatus:
-        self._start()
+        self.set_running()
         status = self.child.execute_tick()
         if status is FAILURE:
             self.reset_child()
@@ -194,7 +188,7 @@ class KeepRunningUntilFailure(_Decorator):
 
 
 @registry.register(builtin=True)
-class Timeout(_Decorator):
+class Timeout(DecoratorNode):
     """Halts the child and returns FAILURE when it has been RUNNING for ``msec`` milliseconds.
 
     The time starts at the first tick; a child that finishes earlier returns its status. With
@@ -235,7 +229,7 @@ class Timeout(_Decorator):
             return FAILURE
         if not self._started:
             self._started = True
-            self._start()
+            self.set_running()
             self._child_halted = False
             self._msec = msec
             if msec > 0:
@@ -257,7 +251,7 @@ class Timeout(_Decorator):
 
 
 @registry.register(builtin=True)
-class Delay(_Decorator):
+class Delay(DecoratorNode):
     """Waits ``delay_msec`` milliseconds (returning RUNNING), then ticks the child.
 
     The wait starts at the first tick, which always returns RUNNING (even with 0 ms: BT.CPP
@@ -288,7 +282,7 @@ class Delay(_Decorator):
             return FAILURE
         if not self._started:
             self._started = True
-            self._start()
+            self.set_running()
             self._start_time = self.now()
             self._timer = self.context.start_timer(delay / 1000.0)
             return RUNNING
@@ -307,7 +301,7 @@ class Delay(_Decorator):
 
 
 @registry.register(builtin=True)
-class RunOnce(_Decorator):
+class RunOnce(DecoratorNode):
     """Ticks the child until it finishes once; afterwards never ticks it again.
 
     After that first run the node is SKIPPED if ``then_skip`` is true (default), otherwise it
@@ -334,7 +328,7 @@ class RunOnce(_Decorator):
             skip = True
         if self._done:
             return SKIPPED if skip else self._returned
-        self._start()
+        self.set_running()
         status = self.child.execute_tick()
         if status.completed:
             self._done = True
@@ -369,7 +363,7 @@ class _ScriptHolder:
 
 
 @registry.register(builtin=True)
-class Precondition(_Decorator):
+class Precondition(DecoratorNode):
     """Ticks the child only if the script ``if`` is true; otherwise returns ``else``.
 
     The condition is evaluated when the child is not already running; once the child started

@@ -70,8 +70,7 @@ class _Loop(DecoratorNode):
         if not popped and not self._child_running:
             return cast(NodeStatus, self.get_input("if_empty"))  # a NodeStatus port
         if self.bt_status is IDLE:
-            self.bt_status = RUNNING
-            self.status = RUNNING.to_py_trees()
+            self.set_running()
         status = self.child.execute_tick()
         self._child_running = status is RUNNING
         if status.completed:

@@ -387,6 +387,11 @@ class BtNode(PortsMixin):
         if script is not None:
             self._run_script("_onHalted", script)
 
+    def set_running(self) -> None:
+        """Mark the node RUNNING (as a control or decorator does before ticking a child)."""
+        self.bt_status = NodeStatus.RUNNING
+        self.status = _RUNNING
+
     def reset_status(self) -> None:
         """Make the node IDLE. py_trees' ``status`` keeps a finished node's SUCCESS or FAILURE
         for py_trees tools (``py_trees.display``) until the next ``Tree.tick()`` clears it."""
@@ -421,8 +426,9 @@ class BtNode(PortsMixin):
             self.bt_status = STATUS_OF_PY_TREES[new_status]
 
     def bt_children(self) -> list[BtNode]:
-        # the children of a bt-manip node are bt-manip nodes (the XML loader builds them)
-        return cast("list[BtNode]", list(self.children))
+        """The node's children (the list itself: read it, do not change it). The children of a
+        bt-manip node are bt-manip nodes (the XML loader and ``as_bt_node`` build them)."""
+        return cast("list[BtNode]", self.children)
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:

@@ -7,7 +7,7 @@ that finished is only set back to IDLE.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, cast
+from typing import Any, ClassVar
 
 from py_trees.ports import PortInformation
 
@@ -22,17 +22,8 @@ FAILURE = NodeStatus.FAILURE
 SKIPPED = NodeStatus.SKIPPED
 
 
-class _Nav2Control(ControlNode):
-    def _start(self) -> None:
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
-
-    def _kids(self) -> list[BtNode]:
-        return cast(list[BtNode], self.children)  # a control's children are BtNodes
-
-
 @registry.register
-class PipelineSequence(_Nav2Control):
+class PipelineSequence(ControlNode):
     """Ticks its children in order, re-ticking every child it has already reached.
 
     Each tick starts at the first child and goes on while children succeed, or are RUNNING but
@@ -53,9 +44,9 @@ class PipelineSequence(_Nav2Control):
         self.last_child_ticked = 0
 
     def tick_node(self) -> NodeStatus:
-        self._start()
+        self.set_running()
         skipped = 0
-        for index, child in enumerate(self._kids()):
+        for index, child in enumerate(self.bt_children()):
             status = child.execute_tick()
             if status is FAILURE:
                 self.halt()
@@ -75,7 +66,7 @@ class PipelineSequence(_Nav2Control):
 
 
 @registry.register
-class RecoveryNode(_Nav2Control):
+class RecoveryNode(ControlNode):
     """Runs its first child; when it fails, runs the second (the recovery) and tries again.
 
     Exactly two children. First child:
@@ -110,9 +101,9 @@ class RecoveryNode(_Nav2Control):
 
     def tick_node(self) -> NodeStatus:
         allowed = int(self.get_input("number_of_retries"))
-        self._start()
+        self.set_running()
         while self.retries <= allowed:
-            status = self._kids()[self.current].execute_tick()
+            status = self.bt_children()[self.current].execute_tick()
             if self.current == 0:
                 if status is RUNNING:
                     return RUNNING
@@ -147,7 +138,7 @@ class RecoveryNode(_Nav2Control):
 
 
 @registry.register
-class RoundRobin(_Nav2Control):
+class RoundRobin(ControlNode):
     """Ticks one child per activation, moving to the next child each time one finishes.
 
     - child SUCCESS: the next activation starts at the following child (wrapping round);
@@ -167,9 +158,9 @@ class RoundRobin(_Nav2Control):
         self.failed = 0
 
     def tick_node(self) -> NodeStatus:
-        kids = self._kids()
+        kids = self.bt_children()
         n = len(kids)
-        self._start()
+        self.set_running()
         skipped = 0
         while self.failed + skipped < n:
             status = kids[self.current].execute_tick()

@@ -51,8 +51,7 @@ class RateController(DecoratorNode):
         if self.bt_status is IDLE:
             self.started = now
             self.first_time = True
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
+        self.set_running()
         due = now - self.started >= period - 1e-9
         if self.first_time or self.child.bt_status is RUNNING or due:
             self.first_time = False
@@ -96,8 +95,7 @@ class DistanceController(WorldAccess, DecoratorNode):
         if self.bt_status is IDLE:
             self.start = (x, y)
             self.first_time = True
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
+        self.set_running()
         travelled = math.hypot(x - self.start[0], y - self.start[1])
         due = travelled >= float(self.get_input("distance"))
         if self.first_time or self.child.bt_status is RUNNING or due:
@@ -126,8 +124,7 @@ class SingleTrigger(DecoratorNode):
     def tick_node(self) -> NodeStatus:
         if self.bt_status is IDLE:
             self.first_time = True
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
+        self.set_running()
         if self.first_time:
             status = self.child.execute_tick()
             if status is not RUNNING:
@@ -158,8 +155,7 @@ class GoalUpdatedController(GoalsReader, DecoratorNode):
         if self.bt_status in (IDLE, NodeStatus.SKIPPED):
             self.recorded = self.current_goals()
             self.updated = True
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
+        self.set_running()
         now = self.current_goals()
         if now != self.recorded:
             self.recorded = now
@@ -225,8 +221,7 @@ class SpeedController(GoalsReader, WorldAccess, DecoratorNode):
         if goals != self.recorded:
             self.recorded = goals
             self._restart(now)
-        self.bt_status = RUNNING
-        self.status = RUNNING.to_py_trees()
+        self.set_running()
         due = now - self.started >= self.period - 1e-9
         if self.first_tick or self.child.bt_status is RUNNING or due:
             self.first_tick = False
