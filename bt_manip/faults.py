@@ -10,6 +10,12 @@ Specifications (``--inject``, repeatable):
                     when they start and call :func:`slip_out` when the slip is due.
 ``block:P``         with probability P per navigation, an obstacle is dropped on the planned
                     route; the Navigate behaviour calls :func:`block_route`.
+``pose_noise:SIGMA_M[:SIGMA_DEG]``
+                    the pose the robot perceives of each object is off by an offset drawn once
+                    per object and episode: x and y normal with sigma SIGMA_M (m), yaw normal
+                    with sigma SIGMA_DEG (deg, default 2). Nodes that plan from an object's pose
+                    read it through :func:`bt_manip.perception.perceived_pose`; checks and
+                    physics keep the ground truth.
 
 This module is the whole fault layer. Node failures are wrapped around the targeted nodes when
 the tree is loaded (:func:`inject_node_failures`), invisibly: the tree's nodes, their order,
@@ -24,6 +30,8 @@ run report.
 from __future__ import annotations
 
 import difflib
+import math
+import zlib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -38,6 +46,14 @@ if TYPE_CHECKING:
     from bt_manip.bt.tree import Tree
 
 WORLD_FAULTS = ("slip", "block")
+POSE_NOISE = "pose_noise"
+EXPECTED = "expected NAME:failure:P, slip:P, block:P or pose_noise:SIGMA_M[:SIGMA_DEG]"
+MAX_SIGMA_M = 0.5
+"""Largest position sigma (m) of ``pose_noise``: beyond, the object is not where it was seen."""
+MAX_SIGMA_DEG = 90.0
+"""Largest yaw sigma (deg) of ``pose_noise``."""
+DEFAULT_SIGMA_DEG = 2.0
+"""Yaw sigma (deg) of ``pose_noise`` when only the position sigma is given."""
 INJECTED_REASON = "injected failure (--inject)"
 """The reason a node gives when an injected failure stops it."""
 
@@ -59,29 +75,32 @@ CRATE_FRICTION = 0.9
 class FaultSpec:
     """One ``--inject`` argument."""
 
-    kind: str  # "failure" | "slip" | "block"
+    kind: str  # "failure" | "slip" | "block" | "pose_noise"
     probability: float
     target: str = ""  # node name or ID, for "failure"
+    sigma_m: float = 0.0
+    """Position sigma (m), for "pose_noise"."""
+    sigma_deg: float = 0.0
+    """Yaw sigma (deg), for "pose_noise"."""
 
     def text(self) -> str:
         if self.kind == "failure":
             return f"{self.target}:failure:{self.probability:g}"
+        if self.kind == POSE_NOISE:
+            return f"{POSE_NOISE}:{self.sigma_m:g}:{self.sigma_deg:g}"
         return f"{self.kind}:{self.probability:g}"
 
 
 def parse_fault(text: str) -> FaultSpec:
-    """Read ``NAME:failure:P``, ``slip:P`` or ``block:P``; InputError when malformed."""
+    """Read ``NAME:failure:P``, ``slip:P``, ``block:P`` or ``pose_noise:SIGMA_M[:SIGMA_DEG]``;
+    InputError when malformed."""
     parts = text.split(":")
 
     def bad(why: str) -> InputError:
-        return InputError(
-            [
-                Problem(
-                    "--inject", None, f"'{text}': {why}; expected NAME:failure:P, slip:P or block:P"
-                )
-            ]
-        )
+        return InputError([Problem("--inject", None, f"'{text}': {why}; {EXPECTED}")])
 
+    if parts[0] == POSE_NOISE:
+        return _parse_pose_noise(parts[1:], bad)
     if len(parts) == 2 and parts[0] in WORLD_FAULTS:
         kind, target, p_text = parts[0], "", parts[1]
     elif len(parts) == 3 and parts[1] == "failure" and parts[0]:
@@ -89,7 +108,7 @@ def parse_fault(text: str) -> FaultSpec:
     elif len(parts) == 3 and parts[0]:
         raise bad(f"unknown fault kind '{parts[1]}'{_close(parts[1], ['failure'])}")
     elif len(parts) == 2 and parts[0]:
-        hint = _close(parts[0], list(WORLD_FAULTS))
+        hint = _close(parts[0], [*WORLD_FAULTS, POSE_NOISE])
         if not hint:
             hint = f" (for a node, write {parts[0]}:failure:{parts[1]})"
         raise bad(f"unknown fault kind '{parts[0]}'{hint}")
@@ -102,6 +121,23 @@ def parse_fault(text: str) -> FaultSpec:
     if not 0.0 <= p <= 1.0:
         raise bad(f"probability {p} is not within 0..1")
     return FaultSpec(kind, p, target)
+
+
+def _parse_pose_noise(values: list[str], bad: Callable[[str], InputError]) -> FaultSpec:
+    """The sigmas of ``pose_noise:SIGMA_M[:SIGMA_DEG]`` (``values`` after the kind)."""
+    if len(values) not in (1, 2):
+        raise bad("pose_noise takes a position sigma in metres and optionally a yaw sigma in deg")
+    sigmas = []
+    for v, (unit, top) in zip(values, (("m", MAX_SIGMA_M), ("deg", MAX_SIGMA_DEG)), strict=False):
+        try:
+            sigma = float(v)
+        except ValueError:
+            raise bad(f"sigma '{v}' is not a number") from None
+        if not 0.0 <= sigma <= top:  # also refuses nan
+            raise bad(f"sigma {v} {unit} is not within 0..{top:g} {unit}")
+        sigmas.append(sigma)
+    sigma_deg = sigmas[1] if len(sigmas) == 2 else DEFAULT_SIGMA_DEG
+    return FaultSpec(POSE_NOISE, 0.0, sigma_m=sigmas[0], sigma_deg=sigma_deg)
 
 
 def _close(word: str, choices: list[str]) -> str:
@@ -139,6 +175,22 @@ class FaultEvent:
     """What became of the fault when it could not act as drawn (for instance no crate fell)."""
 
 
+@dataclass(frozen=True)
+class PoseOffset:
+    """The error of the perceived pose of one object: a shift in the world's x and y (m) and a
+    turn about the vertical through the object's centre (rad)."""
+
+    dx: float
+    dy: float
+    dyaw: float
+
+    def text(self) -> str:
+        return (
+            f"dx={self.dx * 1000:+.1f} mm, dy={self.dy * 1000:+.1f} mm, "
+            f"dyaw={math.degrees(self.dyaw):+.2f} deg"
+        )
+
+
 @dataclass
 class FaultInjector:
     """Draws the faults of one run from a generator seeded by the run's seed."""
@@ -150,6 +202,7 @@ class FaultInjector:
 
     def __post_init__(self) -> None:
         self._rng = np.random.default_rng([int(self.seed) & 0xFFFFFFFF, 0xFA17])
+        self._offsets: dict[str, PoseOffset] = {}
 
     def _now(self) -> float:
         return float(self.clock.now()) if self.clock is not None else 0.0
@@ -186,6 +239,26 @@ class FaultInjector:
     def block(self, route: str) -> bool:
         """Called once per navigation; True when an obstacle must fall on the route."""
         return self._world_fault("block", route)
+
+    def pose_offset(self, object_name: str) -> PoseOffset | None:
+        """The perception error of ``object_name`` for this episode (None without
+        ``pose_noise``). Drawn the first time it is asked for, from a generator of its own
+        seeded by the run's seed and the object's name (so the draw does not depend on what
+        else was drawn before), and kept for the rest of the episode."""
+        spec = next((s for s in self.specs if s.kind == POSE_NOISE), None)
+        if spec is None:
+            return None
+        offset = self._offsets.get(object_name)
+        if offset is None:
+            rng = np.random.default_rng(
+                [int(self.seed) & 0xFFFFFFFF, 0x9053, zlib.crc32(object_name.encode())]
+            )
+            dx, dy = rng.normal(0.0, spec.sigma_m, size=2) if spec.sigma_m > 0 else (0.0, 0.0)
+            dyaw = rng.normal(0.0, math.radians(spec.sigma_deg)) if spec.sigma_deg > 0 else 0.0
+            offset = PoseOffset(float(dx), float(dy), float(dyaw))
+            self._offsets[object_name] = offset
+            self.events.append(FaultEvent(POSE_NOISE, object_name, self._now(), offset.text()))
+        return offset
 
     def report(self) -> list[dict[str, Any]]:
         out: list[dict[str, Any]] = []

@@ -20,7 +20,7 @@ from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
-from bt_manip.geometry import pose_matrix, yaw_of
+from bt_manip.geometry import pose_matrix
 
 if TYPE_CHECKING:
     from bt_manip.sim.robot import Robot
@@ -306,7 +306,11 @@ class MoveToPose(JointMove):
     """Moves the gripper (or ``frame``) to a pose in the world, found by inverse kinematics.
 
     The target position is ``position`` (x;y;z) or the centre of ``object``, plus ``offset``
-    (x;y;z, world frame). The orientation is ``orientation`` (quaternion x;y;z;w, world frame;
+    (x;y;z, world frame); an object's pose is the one the robot perceives (ground truth plus
+    any ``--inject pose_noise``). With ``grasp="top"`` the target is the object's top grasp
+    frame instead (:mod:`bt_manip.grasps`: from above, at the middle of its top face, the
+    fingers closing across its thinner side; ``orientation`` and ``match_object_yaw`` are then
+    not used). The orientation is ``orientation`` (quaternion x;y;z;w, world frame;
     default ``0;1;0;0``: the tool pointing straight down). With ``match_object_yaw`` the
     orientation is turned about the vertical to the object's yaw (modulo 90 deg, the turn
     nearest the current wrist), so a parallel gripper closes on two faces of a box; with
@@ -327,6 +331,10 @@ class MoveToPose(JointMove):
         **JointMove.INPUT_PORTS,
         "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),
+        "grasp": Port(
+            str, False, "target this grasp of object instead of its centre: top (see grasps)", "",
+            Accepts(choices=("", "top")),
+        ),
         "offset": Port(
             list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0], count_of(3)
         ),
@@ -351,8 +359,6 @@ class MoveToPose(JointMove):
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
-        import pybullet as pb
-
         from bt_manip.behaviours import cartesian
 
         robot = self.robot()
@@ -361,18 +367,25 @@ class MoveToPose(JointMove):
         name = self.get_input("object")
         if bool(position) == bool(name):
             raise ActionFailed('give exactly one of position="x;y;z" or object="name"')
+        grasp = self.get_input("grasp")
+        if grasp and not name:
+            raise ActionFailed(f'grasp="{grasp}" needs object="name"')
         yaw = None
         if name:
-            pos, quat = pb.getBasePositionAndOrientation(
-                self.object_body(name), physicsClientId=self.world.client
-            )
-            position = list(pos)
-            yaw = yaw_of(quat)
+            seen = self.perceived_pose(name)  # what the robot sees: ground truth + pose noise
+            position = list(seen[:3, 3])
+            yaw = math.atan2(seen[1, 0], seen[0, 0])
         offset = self.get_input("offset")
         if len(position) != 3 or len(offset) != 3:
             raise ActionFailed("position and offset take three numbers x;y;z")
-        target = pose_matrix(np.add(position, offset), self.get_input("orientation"))
-        if self.get_input("match_object_yaw") and yaw is not None:
+        if grasp:
+            from bt_manip.behaviours.base_placement import object_grasp
+
+            target = object_grasp(self, robot, name, grasp, robot.base_pose2d()[2])
+            target[:3, 3] += np.asarray(offset, dtype=float)
+        else:
+            target = pose_matrix(np.add(position, offset), self.get_input("orientation"))
+        if self.get_input("match_object_yaw") and yaw is not None and not grasp:
             target = self._turned_to(robot, tip, target, yaw)
         self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on
         services = self.services()

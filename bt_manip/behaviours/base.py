@@ -12,12 +12,14 @@ from __future__ import annotations
 
 from typing import Any, ClassVar, Protocol, cast
 
+import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
 from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
 from bt_manip.overlay import Overlay
+from bt_manip.perception import perceived_pose
 from bt_manip.run_context import RobotServices, RunContext
 
 ROBOT_PORT = PortInformation(
@@ -116,6 +118,13 @@ class WorldAccess:
         """The run's fault injector, when faults are injected."""
         context = cast(_Node, self).context
         return context.faults if isinstance(context, RunContext) else None
+
+    def perceived_pose(self, name: str) -> np.ndarray:
+        """The pose (4x4) at which the robot sees the movable object ``name``, for planning:
+        the ground truth plus the episode's ``pose_noise`` offset of that object (see
+        :func:`bt_manip.perception.perceived_pose`)."""
+        self.object_body(name)
+        return perceived_pose(self.world, self.faults(), name)
 
 
 class RobotAction(WorldAccess, ActionNode):

@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
+import math
 from typing import ClassVar
 
+import numpy as np
 import pybullet as pb
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
 from bt_manip.behaviours.gripper import grasped_object
 from bt_manip.bt import registry
-from bt_manip.bt.ports import NON_NEGATIVE, Port, count_of
+from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port, count_of
+from bt_manip.geometry import rotation_matrix
 from bt_manip.sim import pybullet_queries as pbq
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")
@@ -125,3 +128,38 @@ class CarriedClear(WorldCondition):
         if touched:
             return False, f"'{name}' touched {', '.join(touched)} while carried"
         return True, ""
+
+
+@registry.register
+class ObjectUpright(WorldCondition):
+    """SUCCESS when ``object`` stands as it was placed in the world file, within ``max_tilt``
+    degrees; FAILURE (the reason gives the tilt) when it has fallen over.
+
+    The tilt is the angle between the world's vertical and the object's axis that pointed most
+    upwards in the world file's pose (a panel standing on its long edge: its height axis), taken
+    from the ground truth. A panel lying flat has a tilt near 90 deg: its top edge is not up
+    any more and a gripper coming from above cannot take it.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "object": OBJECT,
+        "max_tilt": Port(float, False, "largest tilt that counts as upright (deg)", 30.0,
+                         Accepts(0.0, 90.0)),
+    }
+
+    def check(self) -> tuple[bool, str]:
+        name = self.get_input("object")
+        body = self.object_body(name)
+        world = self.world
+        placed = rotation_matrix(world.infos[name].spec.pose.quat)
+        axis = int(np.argmax(np.abs(placed[2, :])))
+        _, quat = pb.getBasePositionAndOrientation(body, physicsClientId=world.client)
+        up = rotation_matrix(quat)[:, axis]
+        tilt = math.degrees(math.acos(min(1.0, abs(float(up[2])))))
+        limit = float(self.get_input("max_tilt"))
+        if tilt <= limit:
+            return True, ""
+        return False, (
+            f"'{name}' fell over: it is tilted {tilt:.0f} deg from upright (more than "
+            f"{limit:g} deg), and the gripper cannot take it from above"
+        )

@@ -1,0 +1,436 @@
+"""PlanBaseForGrasp: where to park a mobile manipulator so that its arm can take an object.
+
+The planner (:func:`plan_base`) samples base poses around the object's grasp point, in rings:
+for each distance ``d`` of :attr:`PlacementOptions.distances` (from the arm's base to the grasp
+point, horizontally) and each of :attr:`PlacementOptions.bearings` directions around the grasp
+point, the arm's base is put at that distance and the robot is turned to face the grasp point,
+then turned further by each of :attr:`PlacementOptions.heading_offsets`. A pose is kept when:
+
+1. the robot's footprint (as the navigator plans with it) is at least ``clearance`` from every
+   obstacle of the navigator's occupancy grid (walls, furniture, movable objects where they are);
+2. the way from the arm's base to the grasp point crosses no obstacle of the grid (farther than
+   :data:`NEAR_GRASP` from the grasp point: the object and its support are there), so the arm
+   does not reach over a wall or a cabinet;
+3. the arm's IK, solved for the arm's base at that pose, reaches the pre-grasp point
+   (``approach`` metres back from the grasp along the approach axis) from the named arm state
+   ``arm_state`` (``home`` by default: the tree moves the arm there before reaching), and
+   every point of the straight line from there to the grasp frame (the waypoints a
+   straight-line move takes, each seeded by the one before, as MoveToPose does);
+4. the robot can line up at the staging pose, :attr:`PlacementOptions.staging` behind it and
+   facing the same way (room to turn on the spot there), and drive straight in from there
+   (its footprint clear all the way): turning on the spot next to the object would sweep
+   into it;
+5. the navigator finds a path from where the robot is to the staging pose.
+
+The best pose is the kept one with the lowest score (see :meth:`Candidate.score`)::
+
+    score = |d - preferred_distance| / 0.1 m + |heading offset| / 0.5 rad
+            + (straight distance from the robot) / 10 m
+
+that is: the arm at mid reach first (a base that stops a few centimetres off still reaches),
+then facing the object, then near the robot. Candidates are checked in order of their score and
+the first that passes every check is taken, so the work is bounded: at most
+``len(distances) x bearings x len(heading_offsets)`` footprint checks,
+:attr:`PlacementOptions.max_ik_candidates` IK checks (each at most ``2 + approach / 0.02``
+solves) and :attr:`PlacementOptions.max_path_checks` path plans. Everything is deterministic:
+the same world and robot pose give the same base pose.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess
+from bt_manip.behaviours.cartesian import STEP, arm_ik
+from bt_manip.bt import registry
+from bt_manip.bt.ports import Accepts, Port
+from bt_manip.geometry import quat_from_matrix
+from bt_manip.grasps import GRASPS, GraspError, box_size, grasp_frame
+from bt_manip.navigation.lattice import outline_samples
+
+SWEEP_STEP = 0.1
+"""Spacing (m) of the footprint checks along the straight drive from the staging pose."""
+NEAR_GRASP = 0.1
+"""Obstacles within this distance (m) of the grasp point do not block the arm's way (the
+object itself and what it stands in are there)."""
+
+
+@dataclass(frozen=True)
+class PlacementOptions:
+    """How :func:`plan_base` samples and checks base poses."""
+
+    distances: tuple[float, ...] = (0.26, 0.30, 0.34, 0.38)
+    """Distances (m) from the arm's base to the grasp point, horizontally."""
+    bearings: int = 24
+    """Directions around the grasp point (evenly spaced, the first along world +x)."""
+    heading_offsets: tuple[float, ...] = (0.0, -0.35, 0.35)
+    """Turns (rad) of the robot away from facing the grasp point."""
+    preferred_distance: float = 0.32
+    """The distance (m) the score prefers: the arm at mid reach."""
+    approach: float = 0.12
+    """Pre-grasp point: this far (m) back from the grasp along the approach axis."""
+    clearance: float = 0.05
+    """Footprint clearance (m) from every obstacle of the grid."""
+    max_ik_candidates: int = 48
+    """At most this many poses get the IK check."""
+    max_path_checks: int = 6
+    """At most this many poses get the path check."""
+    staging: float = 0.7
+    """The robot lines up this far (m) behind the base pose, facing the same way, and drives
+    straight in from there: turning on the spot next to the object would sweep into it."""
+    arm_state: str = "home"
+    """Named arm state the reach starts from (the IK's seed); empty: the arm's posture now."""
+    pivot: float = 0.0
+    """Where the base turns on the spot (m ahead of its frame; the navigator's)."""
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One sampled base pose."""
+
+    x: float
+    y: float
+    yaw: float
+    distance: float
+    heading_offset: float
+    travel: float
+
+    def score(self, preferred_distance: float) -> float:
+        """Lower is better (see the module docstring)."""
+        return (
+            abs(self.distance - preferred_distance) / 0.1
+            + abs(self.heading_offset) / 0.5
+            + self.travel / 10.0
+        )
+
+
+@dataclass
+class Placement:
+    """What :func:`plan_base` found: a base pose and the grasp frame for it, or why none."""
+
+    ok: bool
+    reason: str
+    base_pose: tuple[float, float, float] | None = None
+    staging_pose: tuple[float, float, float] | None = None
+    grasp: np.ndarray | None = None
+    q_grasp: np.ndarray | None = None
+    counts: dict[str, int] = field(default_factory=dict)
+
+
+def planar(x: float, y: float, yaw: float) -> np.ndarray:
+    """4x4 transform of a planar pose (z = 0)."""
+    t = np.eye(4)
+    c, s = math.cos(yaw), math.sin(yaw)
+    t[:2, :2] = [[c, -s], [s, c]]
+    t[0, 3], t[1, 3] = x, y
+    return t
+
+
+def left_of(yaw: float) -> tuple[float, float]:
+    """The horizontal direction to the left of a heading."""
+    return (-math.sin(yaw), math.cos(yaw))
+
+
+def object_grasp(node: WorldAccess, robot: Any, name: str, kind: str, heading: float) -> np.ndarray:
+    """The grasp frame ``kind`` of object ``name`` as the robot perceives it, for a robot base
+    heading ``heading``; ActionFailed with the reason when the object cannot be grasped so."""
+    try:
+        size = box_size(node.world, name)
+        pose = node.perceived_pose(name)
+        return grasp_frame(
+            kind, size, pose, left_of(heading), robot.description.gripper.max_opening
+        )
+    except GraspError as exc:
+        raise ActionFailed(f"cannot grasp '{name}': {exc}") from None
+
+
+def sample(
+    grasp_xy: np.ndarray,
+    arm_offset: np.ndarray,
+    robot_xy: np.ndarray,
+    options: PlacementOptions,
+) -> list[Candidate]:
+    """The base poses of the rings around ``grasp_xy``, best score first. ``arm_offset`` is
+    where the arm's base sits in the robot's planar frame (x forward, y left)."""
+    out = []
+    for d in options.distances:
+        for k in range(options.bearings):
+            bearing = 2.0 * math.pi * k / options.bearings
+            ax = grasp_xy[0] + d * math.cos(bearing)
+            ay = grasp_xy[1] + d * math.sin(bearing)
+            facing = bearing + math.pi
+            for off in options.heading_offsets:
+                yaw = math.atan2(math.sin(facing + off), math.cos(facing + off))
+                c, s = math.cos(yaw), math.sin(yaw)
+                x = ax - (c * arm_offset[0] - s * arm_offset[1])
+                y = ay - (s * arm_offset[0] + c * arm_offset[1])
+                travel = math.hypot(x - robot_xy[0], y - robot_xy[1])
+                out.append(Candidate(x, y, yaw, d, off, travel))
+    out.sort(key=lambda cand: cand.score(options.preferred_distance))
+    return out
+
+
+def footprint_free(
+    clear: np.ndarray, origin: np.ndarray, res: float, pts: np.ndarray, cand: Candidate,
+    need: float,
+) -> bool:
+    """Whether every footprint point (robot frame) at ``cand`` has ``need`` clearance."""
+    c, s = math.cos(cand.yaw), math.sin(cand.yaw)
+    px = cand.x + c * pts[:, 0] - s * pts[:, 1]
+    py = cand.y + s * pts[:, 0] + c * pts[:, 1]
+    cols = np.floor((px - origin[0]) / res).astype(int)
+    rows = np.floor((py - origin[1]) / res).astype(int)
+    if rows.min() < 0 or cols.min() < 0 or rows.max() >= clear.shape[0]:
+        return False
+    if cols.max() >= clear.shape[1]:
+        return False
+    return bool(np.all(clear[rows, cols] >= need))
+
+
+def staging(cand: Candidate, options: PlacementOptions) -> tuple[float, float, float]:
+    """The staging pose of a candidate: :attr:`PlacementOptions.staging` behind it, facing
+    the same way."""
+    back = options.staging
+    return (cand.x - back * math.cos(cand.yaw), cand.y - back * math.sin(cand.yaw), cand.yaw)
+
+
+def staging_free(
+    clear: np.ndarray, origin: np.ndarray, res: float, pts: np.ndarray, cand: Candidate,
+    options: PlacementOptions, turning: float,
+) -> bool:
+    """Whether the robot can line up at the staging pose (room to turn on the spot there:
+    ``turning`` m of clearance around its pivot) and drive straight from there to the
+    candidate (the footprint clear every :data:`SWEEP_STEP` metres of the way)."""
+    sx, sy, yaw = staging(cand, options)
+    pivot = (sx + options.pivot * math.cos(yaw), sy + options.pivot * math.sin(yaw))
+    col = math.floor((pivot[0] - origin[0]) / res)
+    row = math.floor((pivot[1] - origin[1]) / res)
+    if not (0 <= row < clear.shape[0] and 0 <= col < clear.shape[1]):
+        return False
+    if clear[row, col] < turning:
+        return False
+    n = max(1, math.ceil(options.staging / SWEEP_STEP))
+    for i in range(n):
+        t = i / n
+        x = sx + (cand.x - sx) * t
+        y = sy + (cand.y - sy) * t
+        if not footprint_free(
+            clear, origin, res, pts, Candidate(x, y, yaw, 0.0, 0.0, 0.0), options.clearance
+        ):
+            return False
+    return True
+
+
+def way_clear(
+    occupied: np.ndarray, origin: np.ndarray, res: float, start: np.ndarray, grasp: np.ndarray
+) -> bool:
+    """Whether the straight way from ``start`` to ``grasp`` (x, y) crosses no occupied cell
+    farther than :data:`NEAR_GRASP` from the grasp point."""
+    length = float(np.hypot(*(grasp - start)))
+    if length <= NEAR_GRASP:
+        return True
+    n = max(2, math.ceil((length - NEAR_GRASP) / (res / 2.0)) + 1)
+    t = np.linspace(0.0, (length - NEAR_GRASP) / length, n)
+    pts = start[None, :] + t[:, None] * (grasp - start)[None, :]
+    cols = np.clip(np.floor((pts[:, 0] - origin[0]) / res).astype(int), 0, occupied.shape[1] - 1)
+    rows = np.clip(np.floor((pts[:, 1] - origin[1]) / res).astype(int), 0, occupied.shape[0] - 1)
+    return not bool(np.any(occupied[rows, cols]))
+
+
+def reach(
+    ik: Any, arm_in_world: np.ndarray, grasp: np.ndarray, approach: float, seed: np.ndarray
+) -> tuple[np.ndarray | None, str]:
+    """Joint values at the grasp frame when the arm (its base at ``arm_in_world``) reaches
+    the pre-grasp point and then every waypoint of the straight line to the grasp; else None
+    and IK's reason."""
+    to_arm = np.linalg.inv(arm_in_world)
+    pre = grasp.copy()
+    pre[:3, 3] -= approach * grasp[:3, 2]
+    result = ik.full.solve(to_arm @ pre, q_seed=seed)
+    if not result.success:
+        return None, f"pre-grasp point: {result.reason}"
+    q = result.q
+    n = max(1, math.ceil(approach / STEP))
+    for i in range(1, n + 1):
+        point = grasp.copy()
+        point[:3, 3] = pre[:3, 3] + (grasp[:3, 3] - pre[:3, 3]) * (i / n)
+        result = ik.full.solve(to_arm @ point, q_seed=q)
+        if not result.success:
+            return None, f"approach line: {result.reason}"
+        q = result.q
+    return np.asarray(q, dtype=float), ""
+
+
+def plan_base(
+    node: WorldAccess,
+    robot: Any,
+    name: str,
+    kind: str,
+    options: PlacementOptions,
+) -> Placement:
+    """A base pose from which ``robot``'s arm takes object ``name`` with grasp ``kind`` (see
+    the module docstring)."""
+    from bt_manip.behaviours.navigate import synced_navigator
+
+    nav = synced_navigator(node, robot)
+    nav.refresh()
+    options = dataclasses.replace(options, pivot=float(nav.pivot))
+    grid = nav.costmap.grid
+    clear = nav.costmap.clear
+    origin = np.asarray(grid.origin, dtype=float)
+    res = float(grid.resolution)
+    pts = outline_samples(nav.footprint)
+    x0, y0, yaw0 = robot.base_pose2d()
+    arm = robot.link_transform(robot.description.arm.base_link)
+    arm_in_base = np.linalg.inv(planar(x0, y0, yaw0)) @ arm
+    services = node.run_context.robot_services(node.robot_name_of(robot))
+    ik = arm_ik(services, robot.description.grasp_frame)
+    seed = robot.arm_positions()
+    if options.arm_state:
+        states = robot.description.states
+        if options.arm_state not in states:
+            raise ActionFailed(
+                f"unknown arm state '{options.arm_state}'; known: {', '.join(states)}"
+            )
+        seed = np.asarray(states[options.arm_state], dtype=float)
+    grasp0 = object_grasp(node, robot, name, kind, yaw0)
+    grasp_xy = grasp0[:2, 3]
+    candidates = sample(grasp_xy, arm_in_base[:2, 3], np.array([x0, y0]), options)
+    counts = {
+        "sampled": len(candidates), "collide": 0, "no room to line up": 0, "reach over": 0,
+        "IK": 0, "no path": 0,
+    }
+    turning = float(nav.footprint.circumradius)
+    ik_checks = path_checks = 0
+    last_ik = ""
+    pivot = float(nav.pivot)
+    for cand in candidates:
+        if not footprint_free(clear, origin, res, pts, cand, options.clearance):
+            counts["collide"] += 1
+            continue
+        if not staging_free(clear, origin, res, pts, cand, options, turning):
+            counts["no room to line up"] += 1
+            continue
+        arm_world = planar(cand.x, cand.y, cand.yaw) @ arm_in_base
+        if not way_clear(grid.occupied, origin, res, arm_world[:2, 3], grasp_xy):
+            counts["reach over"] += 1
+            continue
+        if ik_checks >= options.max_ik_candidates:
+            break
+        ik_checks += 1
+        grasp = object_grasp(node, robot, name, kind, cand.yaw)
+        q, why = reach(ik, arm_world, grasp, options.approach, seed)
+        if q is None:
+            counts["IK"] += 1
+            last_ik = why
+            continue
+        if path_checks >= options.max_path_checks:
+            break
+        path_checks += 1
+        sx, sy, syaw = staging(cand, options)
+        start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
+        goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
+        if not nav.plan_to(start, goal).ok:
+            counts["no path"] += 1
+            continue
+        return Placement(
+            True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), grasp, q, counts
+        )
+    parts = [f"{counts['sampled']} poses sampled"]
+    labels = {
+        "collide": "too close to an obstacle",
+        "no room to line up": "with no room to line up behind them",
+        "reach over": "would reach over an obstacle",
+        "IK": "out of the arm's reach",
+        "no path": "with no path to them",
+    }
+    parts += [f"{counts[k]} {text}" for k, text in labels.items() if counts[k]]
+    if ik_checks >= options.max_ik_candidates or path_checks >= options.max_path_checks:
+        parts.append("check budget spent")
+    if last_ik:
+        parts.append(f"last IK failure: {last_ik}")
+    return Placement(False, "; ".join(parts), counts=counts)
+
+
+def pose_text(values: Any) -> str:
+    return ";".join(f"{float(v):.4f}" for v in values)
+
+
+@registry.register
+class PlanBaseForGrasp(RobotAction):
+    """Finds a base pose from which the arm takes ``object`` with grasp ``grasp`` (``top``).
+
+    The object's pose is the one the robot perceives (ground truth plus any ``--inject
+    pose_noise``); base poses are sampled around it, checked against the navigator's occupancy
+    grid, the arm's IK (pre-grasp point and straight approach) and a path from where the robot
+    is, and the best by score is taken (see :mod:`bt_manip.behaviours.base_placement`).
+
+    - SUCCESS with ``base_pose`` set to ``x;y;yaw`` (what ``Navigate goal="{base_pose}"``
+      reads), ``staging_pose`` to the pose to line up at first (``staging`` m behind, facing
+      the same way: drive there, then straight in to ``base_pose``) and ``grasp_pose`` to the
+      grasp frame ``x;y;z;qx;qy;qz;qw`` (world);
+    - FAILURE when the object cannot be grasped so (not a box, too wide for the fingers) or no
+      sampled pose passes every check: the reason starts "no base pose from which the arm
+      reaches OBJECT" and counts what each check rejected.
+    It does its work in the tick it starts (bounded, see the module), so it is never RUNNING
+    and halting has nothing to undo.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        **RobotAction.INPUT_PORTS,
+        "object": PortInformation(str, True, "name of a movable object of the world"),
+        "grasp": Port(str, False, "grasp of the object: top", "top", Accepts(choices=GRASPS)),
+        "approach": Port(
+            float, False, "pre-grasp distance back along the approach axis (m)",
+            PlacementOptions.approach, Accepts(0.0, 0.3),
+        ),
+        "clearance": Port(
+            float, False, "footprint clearance from obstacles (m)", PlacementOptions.clearance,
+            Accepts(0.0, 0.5),
+        ),
+        "arm_state": PortInformation(
+            str, False, "named arm state the reach starts from (empty: the posture now)",
+            PlacementOptions.arm_state,
+        ),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "base_pose": PortInformation(str, False, "base pose x;y;yaw for Navigate goal"),
+        "staging_pose": PortInformation(
+            str, False, "pose x;y;yaw to line up at before driving straight to base_pose"
+        ),
+        "grasp_pose": PortInformation(str, False, "grasp frame x;y;z;qx;qy;qz;qw (world)"),
+    }
+
+    def start(self) -> None:
+        robot = self.robot()
+        if robot.description.base.type != "skid_steer":
+            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        name = self.get_input("object")
+        options = PlacementOptions(
+            approach=float(self.get_input("approach")),
+            clearance=float(self.get_input("clearance")),
+            arm_state=self.get_input("arm_state"),
+        )
+        placement = plan_base(self, robot, name, self.get_input("grasp"), options)
+        if not placement.ok:
+            raise ActionFailed(
+                f"no base pose from which the arm reaches {name}: {placement.reason}"
+            )
+        assert placement.base_pose is not None and placement.grasp is not None
+        self.set_output("base_pose", pose_text(placement.base_pose))
+        self.set_output("staging_pose", pose_text(placement.staging_pose or ()))
+        grasp = placement.grasp
+        self.set_output(
+            "grasp_pose", pose_text([*grasp[:3, 3], *quat_from_matrix(grasp[:3, :3])])
+        )
+        self.overlay.show_frame("ik_target", grasp)
+
+    def step(self) -> Status:
+        return Status.SUCCESS
