@@ -24,12 +24,16 @@ then turned further by each of :attr:`PlacementOptions.heading_offsets`. A pose 
 
 The best pose is the kept one with the lowest score (see :meth:`Candidate.score`)::
 
-    score = |d - preferred_distance| / 0.1 m + |heading offset| / 0.5 rad
+    score = carried / 0.1 m + |d - preferred_distance| / 0.1 m + |heading offset| / 0.5 rad
             + (straight distance from the robot) / 10 m
 
-that is: the arm at mid reach first (a base that stops a few centimetres off still reaches),
-then facing the object, then near the robot. Candidates are checked in order of their score and
-the first that passes every check is taken, so the work is bounded: at most
+where ``carried`` is how far the object will stick out to each side of the robot once it is
+held as grasped from that pose (half its longest horizontal side times the sine of the angle
+between that side and the robot's heading). That is: first the narrowest robot-and-load to
+carry through doorways (a 1.2 m panel held square across the robot makes it 1.2 m wide, held
+at 45 deg 0.85 m), then the arm at mid reach (a base that stops a few centimetres off still
+reaches), then facing the object, then near the robot. Candidates are checked in order of
+their score and the first that passes every check is taken, so the work is bounded: at most
 ``len(distances) x bearings x len(heading_offsets)`` footprint checks,
 :attr:`PlacementOptions.max_ik_candidates` IK checks (each at most ``2 + approach / 0.02``
 solves) and :attr:`PlacementOptions.max_path_checks` path plans. Everything is deterministic:
@@ -52,7 +56,7 @@ from bt_manip.behaviours.cartesian import STEP, arm_ik
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
 from bt_manip.geometry import quat_from_matrix
-from bt_manip.grasps import GRASPS, GraspError, box_size, grasp_frame
+from bt_manip.grasps import GRASPS, GraspError, box_size, grasp_frame, top_face
 from bt_manip.navigation.lattice import outline_samples
 
 SWEEP_STEP = 0.1
@@ -70,7 +74,7 @@ class PlacementOptions:
     """Distances (m) from the arm's base to the grasp point, horizontally."""
     bearings: int = 24
     """Directions around the grasp point (evenly spaced, the first along world +x)."""
-    heading_offsets: tuple[float, ...] = (0.0, -0.35, 0.35)
+    heading_offsets: tuple[float, ...] = (0.0, -0.35, 0.35, -0.7, 0.7)
     """Turns (rad) of the robot away from facing the grasp point."""
     preferred_distance: float = 0.32
     """The distance (m) the score prefers: the arm at mid reach."""
@@ -101,11 +105,16 @@ class Candidate:
     distance: float
     heading_offset: float
     travel: float
+    carried: float = 0.0
+    """How far (m) the object reaches out to each side of the robot's heading once it is
+    held as grasped here: half its long side times the sine of the angle between that side
+    and the heading."""
 
     def score(self, preferred_distance: float) -> float:
         """Lower is better (see the module docstring)."""
         return (
-            abs(self.distance - preferred_distance) / 0.1
+            self.carried / 0.1
+            + abs(self.distance - preferred_distance) / 0.1
             + abs(self.heading_offset) / 0.5
             + self.travel / 10.0
         )
@@ -151,14 +160,31 @@ def object_grasp(node: WorldAccess, robot: Any, name: str, kind: str, heading: f
         raise ActionFailed(f"cannot grasp '{name}': {exc}") from None
 
 
+def long_side(node: WorldAccess, name: str) -> np.ndarray:
+    """Half the longest horizontal side of the box ``name`` as the robot sees it, as a world
+    vector (x, y)."""
+    try:
+        size = box_size(node.world, name)
+    except GraspError as exc:
+        raise ActionFailed(f"cannot grasp '{name}': {exc}") from None
+    pose = node.perceived_pose(name)
+    up_axis, _ = top_face(size, pose)
+    axis = max((i for i in range(3) if i != up_axis), key=lambda i: (size[i], -i))
+    return np.asarray(pose[:2, axis] * size[axis] / 2.0, dtype=float)
+
+
 def sample(
     grasp_xy: np.ndarray,
     arm_offset: np.ndarray,
     robot_xy: np.ndarray,
     options: PlacementOptions,
+    long_side: np.ndarray | None = None,
 ) -> list[Candidate]:
     """The base poses of the rings around ``grasp_xy``, best score first. ``arm_offset`` is
-    where the arm's base sits in the robot's planar frame (x forward, y left)."""
+    where the arm's base sits in the robot's planar frame (x forward, y left); ``long_side``
+    is the object's longest horizontal half side (x, y in the world; m), for the
+    ``carried`` width of each pose."""
+    half = np.zeros(2) if long_side is None else np.asarray(long_side, dtype=float)
     out = []
     for d in options.distances:
         for k in range(options.bearings):
@@ -172,7 +198,8 @@ def sample(
                 x = ax - (c * arm_offset[0] - s * arm_offset[1])
                 y = ay - (s * arm_offset[0] + c * arm_offset[1])
                 travel = math.hypot(x - robot_xy[0], y - robot_xy[1])
-                out.append(Candidate(x, y, yaw, d, off, travel))
+                carried = abs(float(half[0] * -s + half[1] * c))
+                out.append(Candidate(x, y, yaw, d, off, travel, carried))
     out.sort(key=lambda cand: cand.score(options.preferred_distance))
     return out
 
@@ -302,7 +329,10 @@ def plan_base(
         seed = np.asarray(states[options.arm_state], dtype=float)
     grasp0 = object_grasp(node, robot, name, kind, yaw0)
     grasp_xy = grasp0[:2, 3]
-    candidates = sample(grasp_xy, arm_in_base[:2, 3], np.array([x0, y0]), options)
+    candidates = sample(
+        grasp_xy, arm_in_base[:2, 3], np.array([x0, y0]), options,
+        long_side(node, name),
+    )
     counts = {
         "sampled": len(candidates), "collide": 0, "no room to line up": 0, "reach over": 0,
         "IK": 0, "no path": 0,

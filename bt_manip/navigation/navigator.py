@@ -15,8 +15,10 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
   :class:`PathFollower`. While the robot drives, the follower asks every ``replan_period``
   seconds whether a movable object now blocks the rest of the path; if so the navigator plans
   again from where the robot is.
-- Carrying something: the grid plan first tells whether any way is wide enough (if not, the
-  plan fails with the footprint as the reason); then a search over poses
+- Carrying something: the grid plan first tells whether any way is wide enough for the whole
+  footprint against every obstacle; when none is, the search over poses below still may find
+  one (the load is carried over low obstacles), and the plan fails with the footprint as the
+  reason only when it does not either. Then a search over poses
   (:mod:`bt_manip.navigation.lattice`) finds moves, backing up where needed, that keep the whole
   robot and its load clear, and a :class:`SegmentFollower` drives them. No replanning is done
   in this mode yet.
@@ -302,6 +304,14 @@ class Navigator:
                     grid = self.costmap.grid
                     clear = lattice_clearance(grid, self.costmap.d2)
                     return self._follow_poses(pose, goal, self.footprint, grid, clear)
+                if self.plan.outcome is PlanOutcome.FOOTPRINT:
+                    # the grid holds the whole load against every obstacle, also the low ones
+                    # it is carried over (the stand it was lifted out of); over poses the
+                    # chassis and the load are checked in their own height slabs
+                    grid_plan = self.plan
+                    if self._start_carrying(pose, goal).ok:
+                        return self.plan
+                    self.plan = grid_plan  # the grid's reason says what is too wide
                 return self.plan
         if self._carry is not None:
             return self._start_carrying(pose, goal)
