@@ -35,7 +35,13 @@ CHECK = PortInformation(bool, False, "fail when the arm touches walls, furniture
 SETTLE_SPEED = 0.05
 """A joint counts as arrived when within tolerance and slower than this (rad/s)."""
 VIA_TOLERANCE = 0.05
-"""A pass-through waypoint counts as reached within this (rad), without stopping there."""
+"""A pass-through waypoint counts as reached within this (rad), without stopping there (the
+default of the ``via_tolerance`` port of the moves through waypoints)."""
+VIA = Port(
+    float, False,
+    "how close each joint must get to a pass-through waypoint (rad); smaller: the tool keeps "
+    "closer to a straight line, and moves slower", VIA_TOLERANCE, POSITIVE,
+)
 CORRECTION_SPEED = 0.2
 """Every joint may correct at no less than this fraction of its allowed speed."""
 
@@ -89,6 +95,10 @@ class JointMove(RobotAction):
         self.speed = speed
         self.timeout = float(self.get_input("joint_timeout"))
         self.check = bool(self.get_input("check_collisions"))
+        self.via_tol = (
+            float(self.get_input("via_tolerance")) if "via_tolerance" in self.INPUT_PORTS
+            else VIA_TOLERANCE
+        )
         arm = robot.description.arm
         q_now = robot.arm_positions()
         stages = [st for st in self.plan(q_now) if st.joints]
@@ -154,7 +164,7 @@ class JointMove(RobotAction):
         qd = robot.arm_velocities()
         err = np.abs(q - self.command)
         if self.stages[self.stage].via:
-            arrived = bool(np.all(err < VIA_TOLERANCE))
+            arrived = bool(np.all(err < self.via_tol))
         else:
             arrived = bool(np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED))
         if arrived:
@@ -253,6 +263,10 @@ class Lift(JointMove):
     """Lifts what the gripper holds: by joint ``deltas`` (one joint at a time), or straight up
     by ``height`` metres (a vertical line of IK waypoints, orientation kept).
 
+    The straight lift passes its waypoints within ``via_tolerance`` per joint: 0.01 rad keeps
+    the tool within about a millimetre of the vertical, to slide a board out of a slot that
+    leaves it 3 mm on each side.
+
     Scenario A's lift is ``deltas="0;-50;-30;0;0;0"`` (deg): joint 1 up by 50 deg, then joint 2
     by 30 deg. ``order`` picks the sequence (default: joints with a non-zero delta, in index
     order).
@@ -268,6 +282,7 @@ class Lift(JointMove):
         "deltas": PortInformation(list[float], False, "change of each arm joint", []),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
         "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
+        "via_tolerance": VIA,
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
@@ -356,6 +371,7 @@ class MoveToPose(JointMove):
             str, False, "joint: interpolate joints; line: straight line from where it is", "joint",
             Accepts(choices=("joint", "line")),
         ),
+        "via_tolerance": VIA,
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
