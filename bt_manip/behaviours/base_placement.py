@@ -80,8 +80,9 @@ class PlacementOptions:
     """The distance (m) the score prefers: the arm at mid reach."""
     approach: float = 0.12
     """Pre-grasp point: this far (m) back from the grasp along the approach axis."""
-    clearance: float = 0.05
-    """Footprint clearance (m) from every obstacle of the grid."""
+    clearance: float = 0.1
+    """Footprint clearance (m) from every obstacle of the grid: the base stops a few
+    centimetres off, and the carry that follows plans with 5 cm of clearance."""
     max_ik_candidates: int = 48
     """At most this many poses get the IK check."""
     max_path_checks: int = 6
