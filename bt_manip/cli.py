@@ -156,7 +156,9 @@ def _add_inject(parser: argparse.ArgumentParser) -> None:
         default=[],
         metavar="FAULT",
         help="inject faults, seeded: NAME:failure:P (node NAME fails with probability P), "
-        "slip:P (a held object slips), block:P (an obstacle falls on the route)",
+        "slip:P (a held object slips), block:P (an obstacle falls on the route), "
+        "pose_noise:SIGMA_M[:SIGMA_DEG] (the robot sees each object off by an offset drawn once "
+        "per episode: x, y with sigma SIGMA_M metres, yaw with sigma SIGMA_DEG, default 2 deg)",
     )
 
 

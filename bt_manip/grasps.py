@@ -47,12 +47,6 @@ def top_face(size: Sequence[float], pose: np.ndarray) -> tuple[int, np.ndarray]:
     return up_axis, normal
 
 
-def tilt(size: Sequence[float], pose: np.ndarray) -> float:
-    """Angle (rad) between the top face's normal and the world vertical."""
-    _, normal = top_face(size, pose)
-    return float(np.arccos(np.clip(normal[2], -1.0, 1.0)))
-
-
 def top_grasp(
     size: Sequence[float],
     pose: np.ndarray,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from bt_manip.bench import EpisodeResult, summarise, wilson_interval
@@ -21,6 +22,9 @@ from bt_manip.faults import FaultInjector, FaultSpec, parse_fault
         ("grasp_panel:failure:1", FaultSpec("failure", 1.0, "grasp_panel")),
         ("slip:0.2", FaultSpec("slip", 0.2)),
         ("block:0", FaultSpec("block", 0.0)),
+        ("pose_noise:0.01", FaultSpec("pose_noise", 0.0, sigma_m=0.01, sigma_deg=2.0)),
+        ("pose_noise:0.02:5", FaultSpec("pose_noise", 0.0, sigma_m=0.02, sigma_deg=5.0)),
+        ("pose_noise:0:0", FaultSpec("pose_noise", 0.0)),
     ],
 )
 def test_parse_fault(text: str, spec: FaultSpec) -> None:
@@ -37,13 +41,23 @@ def test_parse_fault(text: str, spec: FaultSpec) -> None:
         ("rain:0.3", "unknown fault kind 'rain' (for a node, write rain:failure:0.3)"),
         ("slp:0.3", "unknown fault kind 'slp' (did you mean 'slip'?)"),
         ("Attach:failur:0.3", "unknown fault kind 'failur' (did you mean 'failure'?)"),
+        ("pose_nois:0.01", "unknown fault kind 'pose_nois' (did you mean 'pose_noise'?)"),
+        ("pose_noise:abc", "sigma 'abc' is not a number"),
+        ("pose_noise:-0.01", "sigma -0.01 m is not within 0..0.5 m"),
+        ("pose_noise:0.6", "sigma 0.6 m is not within 0..0.5 m"),
+        ("pose_noise:nan", "sigma nan m is not within 0..0.5 m"),
+        ("pose_noise:0.01:91", "sigma 91 deg is not within 0..90 deg"),
+        ("pose_noise:0.01:2:3", "pose_noise takes a position sigma in metres"),
+        ("pose_noise", "pose_noise takes a position sigma in metres"),
     ],
 )
 def test_bad_fault_is_an_input_error(text: str, why: str) -> None:
     with pytest.raises(InputError) as err:
         parse_fault(text)
     assert why in str(err.value)
-    assert "expected NAME:failure:P, slip:P or block:P" in str(err.value)
+    assert "expected NAME:failure:P, slip:P, block:P or pose_noise:SIGMA_M[:SIGMA_DEG]" in str(
+        err.value
+    )
 
 
 def test_fault_draws_are_seeded_and_match_probability() -> None:
@@ -294,3 +308,33 @@ def test_the_block_fault_drops_a_crate_mid_route_or_says_why_not() -> None:
     why = "'dropped_crate_0' would start 40 mm inside 'sofa'"
     assert block_route(_Room(refuse=why), refused, route, "goal") is None
     assert refused.report()[0]["note"] == f"no crate fell: {why}"
+
+
+def test_pose_noise_is_drawn_once_per_object_and_seed() -> None:
+    spec = parse_fault("pose_noise:0.01")
+    a = FaultInjector([spec], seed=3)
+    b = FaultInjector([spec], seed=3)
+    first = a.pose_offset("panel")
+    assert first is not None
+    assert a.pose_offset("panel") == first  # once per episode: asked again, the same
+    # another object's draw does not depend on what was drawn before
+    crate_b = b.pose_offset("crate")
+    assert b.pose_offset("panel") == first
+    assert a.pose_offset("crate") == crate_b != first
+    assert FaultInjector([spec], seed=4).pose_offset("panel") != first
+    assert FaultInjector([], seed=3).pose_offset("panel") is None
+    # the report lists what was drawn, once per object
+    assert [(e["kind"], e["target"]) for e in a.report()] == [
+        ("pose_noise", "panel"), ("pose_noise", "crate")
+    ]
+    assert a.report()[0]["note"].startswith("dx=")
+
+
+def test_pose_noise_sigmas_are_those_asked_for() -> None:
+    spec = parse_fault("pose_noise:0.01:2")
+    draws = [FaultInjector([spec], seed=s).pose_offset("panel") for s in range(400)]
+    dx = np.array([d.dx for d in draws if d is not None])
+    dyaw = np.array([d.dyaw for d in draws if d is not None])
+    assert len(dx) == 400
+    assert 0.008 < float(np.std(dx)) < 0.012
+    assert 0.8 * np.radians(2) < float(np.std(dyaw)) < 1.2 * np.radians(2)
