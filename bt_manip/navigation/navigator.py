@@ -291,6 +291,10 @@ class Navigator:
         """
         self._follower_options = follower if follower is not None else self.options.follower
         self.refresh()
+        if self._carry is not None:
+            # the layers the carrying robot is planned in hold the movable objects where they
+            # are now (a crate may have fallen since the load was attached)
+            self._build_carry_layers()
         self._goal = goal
         self._align = align
         self.follower = None

@@ -1,0 +1,59 @@
+"""Scenario A, adaptive: the grasp is planned from the panel wherever it stands."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pybullet as pb
+import pytest
+
+from bt_manip.episode import Episode, EpisodeSpec
+from bt_manip.faults import parse_fault
+from bt_manip.runner import RunReport
+
+ROOT = Path(__file__).resolve().parents[2]
+TREE = str(ROOT / "trees" / "husky_carry_wall_adaptive.xml")
+HOUSE = str(ROOT / "worlds" / "tb3_house.yaml")
+DEV = str(ROOT / "worlds" / "tb3_house_panel_dev.yaml")
+
+
+def _delivered(episode: Episode, report: RunReport) -> None:
+    """The panel is at the goal, held, off the floor and untouched, in the living room."""
+    world = episode.world
+    assert report.status == "SUCCESS", report.reason
+    x, y, yaw = world.robots["husky"].base_pose2d()
+    goal = world.poses["goal"]
+    assert math.hypot(x - goal.x, y - goal.y) <= 0.15
+    assert abs(math.remainder(yaw - goal.yaw, math.tau)) <= 0.2
+    assert world.attachments.is_attached("panel", "husky")
+    assert world.attachments.touched("panel") == []
+    panel = world.movable["panel"]
+    lo, _ = pb.getAABB(panel, physicsClientId=world.client)
+    assert lo[2] >= 0.1
+    px = pb.getBasePositionAndOrientation(panel, physicsClientId=world.client)[0][0]
+    assert px > 1.8  # through the doorway
+
+
+@pytest.mark.parametrize("world", [HOUSE, DEV], ids=["tb3_house", "panel_moved"])
+def test_the_adaptive_tree_delivers_the_panel(world: str) -> None:
+    with Episode(EpisodeSpec(tree=TREE, world=world, seed=0)) as episode:
+        report = episode.run()
+        _delivered(episode, report)
+
+
+def test_the_adaptive_tree_names_no_pose_of_the_layout() -> None:
+    text = Path(TREE).read_text()
+    assert "pregrasp_panel" not in text
+    assert "MoveJointsSequentially" not in text
+    assert 'goal="goal"' in text
+
+
+def test_the_adaptive_tree_delivers_a_panel_seen_off_by_pose_noise() -> None:
+    spec = EpisodeSpec(tree=TREE, world=HOUSE, seed=1, inject=[parse_fault("pose_noise:0.01")])
+    with Episode(spec) as episode:
+        report = episode.run()
+        _delivered(episode, report)
+        (drawn,) = report.extra["injected"]
+        assert (drawn["kind"], drawn["target"]) == ("pose_noise", "panel")
+        assert drawn["note"] == episode.faults.pose_offset("panel").text()  # type: ignore[union-attr]
