@@ -70,13 +70,13 @@ object itself and what it stands in are there)."""
 class PlacementOptions:
     """How :func:`plan_base` samples and checks base poses."""
 
-    distances: tuple[float, ...] = (0.26, 0.30, 0.34, 0.38)
+    distances: tuple[float, ...] = (0.30, 0.34, 0.38, 0.42)
     """Distances (m) from the arm's base to the grasp point, horizontally."""
     bearings: int = 24
     """Directions around the grasp point (evenly spaced, the first along world +x)."""
     heading_offsets: tuple[float, ...] = (0.0, -0.35, 0.35, -0.7, 0.7)
     """Turns (rad) of the robot away from facing the grasp point."""
-    preferred_distance: float = 0.32
+    preferred_distance: float = 0.36
     """The distance (m) the score prefers: the arm at mid reach."""
     approach: float = 0.12
     """Pre-grasp point: this far (m) back from the grasp along the approach axis."""
