@@ -16,9 +16,10 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
   seconds whether a movable object now blocks the rest of the path; if so the navigator plans
   again from where the robot is.
 - Carrying something: the grid plan first tells whether any way is wide enough for the whole
-  footprint against every obstacle; when none is, the search over poses below still may find
-  one (the load is carried over low obstacles), and the plan fails with the footprint as the
-  reason only when it does not either. Then a search over poses
+  footprint against every obstacle; when none is but one is among the obstacles that reach
+  the load (it is carried over the low ones, such as the stand it was lifted from), the search
+  over poses below decides; otherwise, or when that search finds nothing, the plan fails with
+  the footprint as the reason. Then a search over poses
   (:mod:`bt_manip.navigation.lattice`) finds moves, backing up where needed, that keep the whole
   robot and its load clear, and a :class:`SegmentFollower` drives them. No replanning is done
   in this mode yet.
@@ -149,6 +150,8 @@ class Navigator:
         self.poses: PosePlan | None = None
         self._obstacles = list(obstacles)
         self._carry: tuple | None = None
+        self._carry_high: OccupancyGrid | None = None
+        """The obstacles that reach the carried load's height (None: nothing carried)."""
         self.plan: NavPlan | None = None
         self._goal: Pose2D | None = None
         self._plan_cost: np.ndarray | None = None
@@ -238,6 +241,7 @@ class Navigator:
         that reach above the lowest point of the arm or load (an arm held over a low obstacle
         does not collide with it)."""
         self._carry = None
+        self._carry_high = None
         if not self.attached:
             return
         c = self.client
@@ -270,6 +274,7 @@ class Navigator:
         )
         high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
         self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
+        self._carry_high = high
 
     # -- planning and following ---------------------------------------------------------------
     def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
@@ -310,10 +315,11 @@ class Navigator:
                     return self._follow_poses(pose, goal, self.footprint, grid, clear)
                 if self.plan.outcome is PlanOutcome.FOOTPRINT:
                     # the grid holds the whole load against every obstacle, also the low ones
-                    # it is carried over (the stand it was lifted out of); over poses the
-                    # chassis and the load are checked in their own height slabs
+                    # it is carried over (the stand it was lifted out of): when a way is wide
+                    # enough among the obstacles that reach the load, the search over poses
+                    # checks the chassis and the load in their own height slabs
                     grid_plan = self.plan
-                    if self._start_carrying(pose, goal).ok:
+                    if self._load_fits(pose) and self._start_carrying(pose, goal).ok:
                         return self.plan
                     self.plan = grid_plan  # the grid's reason says what is too wide
                 return self.plan
@@ -328,6 +334,18 @@ class Navigator:
             replan=self._replan,
         )
         return self.plan
+
+    def _load_fits(self, pose: Pose2D) -> bool:
+        """Whether the grid plan finds a way wide enough for the whole footprint among the
+        obstacles that reach up to the load (those of the carrying robot's upper slab)."""
+        if self._carry_high is None:
+            return False
+        costmap = CostMap(self._carry_high, self.options.inflation)
+        plan = plan_path(
+            costmap, self.footprint, self._pivot(pose)[:2], self._pivot_goal()[:2],
+            self.options.planner,
+        )
+        return plan.ok
 
     def _start_carrying(self, pose: Pose2D, goal: Pose2D) -> NavPlan:
         """Plan over poses for the robot with its load; the grid plan said a way may exist."""
