@@ -274,3 +274,39 @@ def test_replans_around_an_object_that_moved_onto_the_path() -> None:
         assert d.status is FollowState.SUCCEEDED, d.reason
         assert d.error_xy <= 0.10 and d.error_yaw <= 0.10
         assert d.touched == set(), f"robot touched {d.touched}"
+
+
+
+def test_a_crate_that_fell_after_the_attach_is_avoided_while_carrying() -> None:
+    """The carrying robot is planned in layers drawn when it starts to drive: a crate that fell
+    on the way after the panel was attached is in them, and the robot drives around it."""
+    from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
+
+    with World(WORLD, seed=0) as world:
+        lift_panel(world)
+        robot = world.robots["husky"]
+        panel = world.movable["panel"]
+        nav = make_nav(world)
+        nav.attach(panel, "panel")
+        goal = (4.8, -1.2, 0.0)  # across the living room
+        first = nav.start(robot.base_pose2d(), goal)
+        assert first.ok, first.reason
+        assert first.polyline is not None
+        # a crate falls on the planned way, in the living room (test setup)
+        pts = np.asarray(first.polyline)[:, :2]
+        along = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        x, y = pts[int(np.searchsorted(along, 0.7 * along[-1]))]
+        crate = world.spawn(BodySpec(
+            name="crate_on_the_way", movable=True,
+            parts=[Part("box", (0.3, 0.3, 0.3), colour=COLOURS["brown"])], urdf=None,
+            pose=Pose3D((float(x), float(y), 0.15)), planar=False, mass=8.0, friction=0.9,
+            colour=COLOURS["brown"], randomize=Range2D(), line=0,
+        ))
+        world.step(24)
+        nav.movable = {b: n for n, b in world.movable.items()}
+        plan = nav.start(robot.base_pose2d(), goal)
+        assert plan.ok, plan.reason
+        d = drive(world, nav, goal, 1.5 * plan.length / 0.2 + 30.0, [robot.body, panel])
+        assert d.status is FollowState.SUCCEEDED, d.reason
+        assert d.touched == set(), f"robot or panel touched {d.touched}"
+        assert crate in world.movable.values()
