@@ -57,3 +57,34 @@ def test_the_adaptive_tree_delivers_a_panel_seen_off_by_pose_noise() -> None:
         (drawn,) = report.extra["injected"]
         assert (drawn["kind"], drawn["target"]) == ("pose_noise", "panel")
         assert drawn["note"] == episode.faults.pose_offset("panel").text()  # type: ignore[union-attr]
+
+
+def test_a_panel_that_slipped_back_into_its_stand_is_grasped_again() -> None:
+    # seed 13 draws a slip while the panel is lifted out of its stand: it drops back in
+    spec = EpisodeSpec(tree=TREE, world=HOUSE, seed=13, inject=[parse_fault("slip:0.2")])
+    with Episode(spec) as episode:
+        report = episode.run()
+        slips = [e for e in report.extra["injected"] if e["kind"] == "slip"]
+        assert len(slips) == 1
+        _delivered(episode, report)
+        assert report.sim_time > slips[0]["sim_time"]
+
+
+def test_a_panel_that_fell_over_ends_the_run_with_the_robot_stopped() -> None:
+    # seed 9 draws a slip while the panel is carried: it falls over
+    spec = EpisodeSpec(tree=TREE, world=HOUSE, seed=9, inject=[parse_fault("slip:0.2")])
+    with Episode(spec) as episode:
+        report = episode.run()
+        world = episode.world
+        assert report.status == "FAILURE"
+        assert [e["kind"] for e in report.extra["injected"]] == ["slip"]
+        assert report.cause is not None and report.cause["name"] == "panel_upright"
+        assert "'panel' fell over" in report.reason
+        assert "the gripper cannot take it from above" in report.reason
+        assert not world.attachments.is_attached("panel")
+        # the robot was left stopped: it stays where it is
+        robot = world.robots["husky"]
+        x0, y0, _ = robot.base_pose2d()
+        world.step(240)
+        x1, y1, _ = robot.base_pose2d()
+        assert math.hypot(x1 - x0, y1 - y0) < 0.02
