@@ -88,3 +88,16 @@ def test_a_panel_that_fell_over_ends_the_run_with_the_robot_stopped() -> None:
         world.step(240)
         x1, y1, _ = robot.base_pose2d()
         assert math.hypot(x1 - x0, y1 - y0) < 0.02
+
+
+def test_a_carry_that_cannot_get_through_ends_the_run_with_the_panel_in_hand() -> None:
+    inject = [parse_fault("carry_to_goal:failure:1"), parse_fault("at_goal:failure:1")]
+    with Episode(EpisodeSpec(tree=TREE, world=HOUSE, seed=0, inject=inject)) as episode:
+        report = episode.run()
+        assert report.status == "FAILURE"
+        assert report.cause is not None and report.cause["name"] == "at_goal"
+        # three carries, no second delivery attempt: the panel was not put down in the way
+        assert [e["target"] for e in report.extra["injected"]] == ["carry_to_goal"] * 3 + [
+            "at_goal"
+        ]
+        assert episode.world.attachments.is_attached("panel", "husky")
