@@ -10,7 +10,8 @@ A world file describes, in metres, radians and kilograms (see ``worlds/README.md
                (SpawnModel) and may remove them (DeleteModel);
 ``robots``     a robot ``description`` (``robots/<name>.yaml``), a start ``pose``, an
                ``arm_state`` and ``randomize``;
-``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees.
+``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees;
+``groups``     entities moved together by one rigid motion (see :mod:`bt_manip.sim.groups`).
 
 Every problem found is collected with its file and line; :func:`parse_world` raises one
 :class:`~bt_manip.errors.InputError` with all of them.
@@ -166,6 +167,8 @@ class WorldSpec:
     robots: list[RobotSpec] = field(default_factory=list)
     poses: dict[str, Pose2D] = field(default_factory=dict)
     pose_lines: dict[str, int] = field(default_factory=dict)
+    groups: list[Any] = field(default_factory=list)
+    """:class:`~bt_manip.sim.groups.GroupSpec` entries: members moved together."""
 
 
 TOP_KEYS = {
@@ -178,6 +181,7 @@ TOP_KEYS = {
     "models",
     "robots",
     "poses",
+    "groups",
 }
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
@@ -574,6 +578,9 @@ def parse_world(path: str | Path) -> WorldSpec:
             if p is not None:
                 spec.poses[name] = p
                 spec.pose_lines[name] = poses.line_of(name)  # type: ignore[union-attr]
+    from bt_manip.sim.groups import parse_groups
+
+    spec.groups = parse_groups(rd, data, spec)
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)
