@@ -38,9 +38,15 @@ STALL_MOVE = 0.01
 """Least translation (m) in :data:`STALL_WINDOW`..."""
 STALL_TURN = 0.02
 """... or least turn (rad) in it; less is a blocked motion."""
-PUSH_LIMIT = 0.02
+PUSH_LIMIT = 0.05
 """A movable obstacle shoved this far (m) blocks the motion: the robot gets clear, it does not
 push things out of its way."""
+TOUCH = 0.01
+"""Points of the robot this close (m) to an obstacle count as touching it: a motion that
+drives one of them into the obstacle is not tried."""
+PUSH_SLOPE = 0.3
+"""A motion that moves a touching point into the obstacle at more than this fraction of the
+point's speed (about 17 deg off sliding along it) would push it."""
 MAX_MOTIONS = 12
 """Motions tried at most before the node gives up."""
 
@@ -69,7 +75,7 @@ class GetClear(RobotAction):
     What it gets clear of: every body but the floor within 5 cm of the robot or its load when
     the node starts. It then drives plain twists (see the module), one after the other, each
     checked as it goes: a motion is blocked when the robot or its load touches anything it was
-    not already up against, shoves a movable obstacle more than 2 cm, or stops moving (less
+    not already up against, shoves a movable obstacle more than 5 cm, or stops moving (less
     than 1 cm or 0.02 rad in 1 s).
 
     - RUNNING while it moves;
@@ -106,6 +112,7 @@ class GetClear(RobotAction):
         movable = set(world.movable.values())
         self.anchors = {b: self._position(b) for b in self.obstacles if b in movable}
         self.blocked: list[str] = []
+        self.motion_started = 0.0
         self.tried = 0
         self.queue: list[Motion] = self._motions() if self.obstacles else []
         self.motion: Motion | None = None
@@ -141,27 +148,43 @@ class GetClear(RobotAction):
             if any(pbq.closest_points(c, m, body, self.distance) for m in self.mine)
         ]
 
-    def _side(self) -> tuple[float, float]:
-        """Mean position (robot frame, x ahead, y left) of the closest points on the robot
-        or its load to the obstacles."""
+    def _touch_points(self, within: float) -> list[tuple[float, float, float, float, str]]:
+        """Where the robot or its load comes within ``within`` of an obstacle: (x, y) of the
+        point and (nx, ny) pointing into the obstacle, in the robot's frame (x ahead, y left),
+        and the obstacle's name."""
         c = self.world.client
         x0, y0, yaw = self.robot().base_pose2d()
-        pts = [
-            p.position_on_a
-            for m in self.mine
-            for body in self.obstacles
-            for p in pbq.closest_points(c, m, body, max(self.distance, UP_AGAINST))
-        ]
-        if not pts:
-            return 1.0, 0.0
-        dx = float(np.mean([p[0] for p in pts])) - x0
-        dy = float(np.mean([p[1] for p in pts])) - y0
         cy, sy = math.cos(yaw), math.sin(yaw)
-        return cy * dx + sy * dy, -sy * dx + cy * dy
+        out = []
+        for m in self.mine:
+            for body, name in self.obstacles.items():
+                for p in pbq.closest_points(c, m, body, within):
+                    dx, dy = p.position_on_a[0] - x0, p.position_on_a[1] - y0
+                    nx, ny = -p.normal_on_b[0], -p.normal_on_b[1]
+                    out.append(
+                        (cy * dx + sy * dy, -sy * dx + cy * dy, cy * nx + sy * ny,
+                         -sy * nx + cy * ny, name)
+                    )
+        return out
+
+    def _pushes_into(
+        self, motion: Motion, points: list[tuple[float, float, float, float, str]]
+    ) -> list[str]:
+        """Obstacles the motion would drive a touching point of the robot into."""
+        hit = set()
+        for px, py, nx, ny, name in points:
+            vx, vy = motion.v - motion.w * py, motion.w * px
+            if vx * nx + vy * ny > PUSH_SLOPE * math.hypot(vx, vy):
+                hit.add(name)
+        return sorted(hit)
 
     def _motions(self) -> list[Motion]:
-        """The motions to try from here, in order (see the module)."""
-        ahead, left = self._side()
+        """The motions to try from here, in order (see the module); the ones that would drive
+        the robot into something it touches are left out and noted in ``self.blocked``."""
+        points = self._touch_points(TOUCH)
+        near = self._touch_points(self.distance)
+        ahead = float(np.mean([p[0] for p in near])) if near else 1.0
+        left = float(np.mean([p[1] for p in near])) if near else 0.0
         away = -1.0 if ahead >= 0.0 else 1.0  # drive away from the obstacles' end
         # turning this way swings the robot's end nearest the obstacles away from their side
         turn = -math.copysign(1.0, left) * math.copysign(1.0, ahead) if left else 1.0
@@ -170,15 +193,28 @@ class GetClear(RobotAction):
         arc = min(straight, (math.pi / 2) / w)
         turning = TURN_ANGLE / w + STALL_WINDOW / 2
         towards = "forwards" if away < 0 else "backwards"
-        return [
+        motions = [
             Motion("backing away" if away < 0 else "driving away", away * v, 0.0, straight),
             Motion("arcing away", away * v, turn * w, arc),
             Motion("arcing away the other side", away * v, -turn * w, arc),
             Motion("turning on the spot", 0.0, turn * w, turning),
             Motion("turning on the spot the other way", 0.0, -turn * w, turning),
+            Motion(f"driving {towards} past", -away * v, 0.0, straight),
             Motion(f"driving {towards} around", -away * v, turn * w, arc),
             Motion(f"driving {towards} around the other side", -away * v, -turn * w, arc),
         ]
+        out = []
+        for motion in motions:
+            into = self._pushes_into(motion, points)
+            if into:
+                self._note(f"{motion.name} would push into " + ", ".join(f"'{n}'" for n in into))
+            else:
+                out.append(motion)
+        return out
+
+    def _note(self, why: str) -> None:
+        if why not in self.blocked:
+            self.blocked.append(why)
 
     # -- ticking -------------------------------------------------------------------------------
     def step(self) -> Status:
@@ -198,7 +234,7 @@ class GetClear(RobotAction):
             why = self._blocked_by()
             if why is not None:
                 robot.stop_base()
-                self.blocked.append(f"{self.motion.name} {why}")
+                self._note(f"{self.motion.name} {why}")
                 self.motion = None
             elif self.now() - self.motion_started > self.motion.duration:
                 self.motion = None
@@ -209,9 +245,10 @@ class GetClear(RobotAction):
                 raise ActionFailed(f"no motion frees it: {self._summary()}")
             self.motion = self.queue.pop(0)
             self.tried += 1
-            self.motion_started: float = self.now()
+            self.motion_started = self.now()
             self.window = (self.now(), robot.base_pose2d())
             self.touching = self._touching()
+            self.anchors = {b: self._position(b) for b in self.anchors}
         robot.set_base_twist(self.motion.v, self.motion.w)
         self.feedback_message = f"{self.motion.name} (from {', '.join(self._still_near())})"
         return Status.RUNNING
