@@ -47,6 +47,9 @@ drives one of them into the obstacle is not tried."""
 PUSH_SLOPE = 0.3
 """A motion that moves a touching point into the obstacle at more than this fraction of the
 point's speed (about 17 deg off sliding along it) would push it."""
+PROGRESS = 0.05
+"""Gap (m) a motion must have opened by the end of its time to be kept on rather than
+replaced by the motions planned afresh."""
 MAX_MOTIONS = 12
 """Motions tried at most before the node gives up."""
 
@@ -113,6 +116,7 @@ class GetClear(RobotAction):
         self.anchors = {b: self._position(b) for b in self.obstacles if b in movable}
         self.blocked: list[str] = []
         self.motion_started = 0.0
+        self.gap_at_start = 0.0
         self.tried = 0
         self.queue: list[Motion] = self._motions() if self.obstacles else []
         self.motion: Motion | None = None
@@ -237,8 +241,13 @@ class GetClear(RobotAction):
                 self._note(f"{self.motion.name} {why}")
                 self.motion = None
             elif self.now() - self.motion_started > self.motion.duration:
+                gained = self._gap() - self.gap_at_start
+                same = self.motion
                 self.motion = None
                 self.queue = self._motions()  # it moved: plan again from here
+                if gained >= PROGRESS and same in self.queue:  # it is working: keep on
+                    self.queue.remove(same)
+                    self.queue.insert(0, same)
         if self.motion is None:
             if not self.queue or self.tried >= MAX_MOTIONS:
                 robot.stop_base()
@@ -249,9 +258,22 @@ class GetClear(RobotAction):
             self.window = (self.now(), robot.base_pose2d())
             self.touching = self._touching()
             self.anchors = {b: self._position(b) for b in self.anchors}
+            self.gap_at_start = self._gap()
         robot.set_base_twist(self.motion.v, self.motion.w)
         self.feedback_message = f"{self.motion.name} (from {', '.join(self._still_near())})"
         return Status.RUNNING
+
+    def _gap(self) -> float:
+        """The smallest gap (m) between the robot or its load and the obstacles, counted up to
+        ``distance``."""
+        c = self.world.client
+        gaps = [
+            p.distance
+            for m in self.mine
+            for body in self.obstacles
+            for p in pbq.closest_points(c, m, body, self.distance)
+        ]
+        return min(gaps, default=self.distance)
 
     def _summary(self) -> str:
         still = ", ".join(f"'{n}'" for n in self._still_near())
