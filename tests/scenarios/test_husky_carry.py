@@ -77,8 +77,7 @@ SOUTH = str(ROOT / "worlds" / "tb3_house_panel_south.yaml")
 
 def test_a_panel_leaning_in_its_slot_is_lifted_out_without_counting_a_touch() -> None:
     # in this world and seed the closing gripper leaves the panel leaning on a rail of its
-    # stand: sliding up
-    # along the rail it leans on is leaving the stand, not hitting it
+    # stand: sliding up along the rail it leans on is leaving the stand, not hitting it
     with Episode(EpisodeSpec(tree=TREE, world=SOUTH, seed=0)) as episode:
         report = episode.run()
         assert report.status == "SUCCESS", report.reason
