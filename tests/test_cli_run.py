@@ -144,6 +144,7 @@ def test_groot_model_lists_the_robot_nodes_with_their_ports(
     robot_nodes = {
         "Navigate",
         "Reverse",
+        "GetClear",
         "MoveJointsSequentially",
         "MoveJoints",
         "MoveToPose",
