@@ -40,7 +40,7 @@ def grasp_panel() -> Fallback:
                 Navigate("to_pregrasp", goal="pregrasp_panel", xy_tolerance=0.03,
                          yaw_tolerance=0.03),
                 Sequence("clear_and_drive_again", children=[
-                    ForceSuccess(child=GetClear("get_clear", distance=0.5)),
+                    ForceSuccess(child=GetClear("get_clear", distance=0.5, near=0.3)),
                     AlwaysFailure("drive_failed"),
                 ]),
             ])),
@@ -75,7 +75,7 @@ def build(context: TreeContext | None = None) -> Tree:
             "carry_or_back_off", children=[
                 Navigate("carry_to_goal", goal="goal"),
                 Sequence("clear_and_retry", children=[
-                    ForceSuccess(child=GetClear("back_up", distance=0.5)),
+                    ForceSuccess(child=GetClear("back_up", distance=0.5, near=0.3)),
                     AlwaysFailure("carry_failed"),
                 ]),
             ])),

@@ -25,9 +25,6 @@ from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
 from bt_manip.sim import pybullet_queries as pbq
 
-UP_AGAINST = 0.05
-"""Bodies within this distance (m) of the robot or its load when the node starts are what it
-gets clear of."""
 TURN_RATE = 0.8
 """Yaw rate (rad/s) of the turning motions."""
 TURN_ANGLE = math.pi / 4
@@ -75,15 +72,16 @@ def _pose_delta(
 class GetClear(RobotAction):
     """Gets the robot's base clear of what it (or the object it carries) is up against.
 
-    What it gets clear of: every body but the floor within 5 cm of the robot or its load when
-    the node starts. It then drives plain twists (see the module), one after the other, each
-    checked as it goes: a motion is blocked when the robot or its load touches anything it was
-    not already up against, shoves a movable obstacle more than 5 cm, or stops moving (less
+    What it gets clear of: every body but the floor within ``near`` (5 cm by default) of the
+    robot or its load when the node starts (a planner that keeps a margin from obstacles may
+    need a larger ``near``). It then drives plain twists (see the module), one after the other,
+    each checked as it goes: a motion is blocked when the robot or its load touches anything it
+    was not already up against, shoves a movable obstacle more than 5 cm, or stops moving (less
     than 1 cm or 0.02 rad in 1 s).
 
     - RUNNING while it moves;
     - SUCCESS once every one of those bodies is at least ``distance`` away (at once, with
-      "nothing to get clear of", when nothing is within 5 cm);
+      "nothing to get clear of", when nothing is within ``near``);
     - FAILURE when every motion is blocked (the reason lists what blocked each), or after
       ``timeout`` s, or the robot has no mobile base; the base is braked.
     Halted: the base is braked where it is.
@@ -96,6 +94,10 @@ class GetClear(RobotAction):
         ),
         "speed": Port(
             float, False, "driving speed (m/s)", 0.2, Accepts(low=0, high=1, low_open=True)
+        ),
+        "near": Port(
+            float, False, "what is this close (m) at the start is got clear of", 0.05,
+            Accepts(low=0, high=1, low_open=True),
         ),
         "timeout": Port(
             float, False, "sim seconds allowed", 30.0, Accepts(low=0, high=600, low_open=True)
@@ -110,7 +112,7 @@ class GetClear(RobotAction):
         self.speed = float(self.get_input("speed"))
         self.timeout = float(self.get_input("timeout"))
         self.mine = self._mine()
-        self.obstacles = self._near(UP_AGAINST)
+        self.obstacles = self._near(float(self.get_input("near")))
         world = self.world
         movable = set(world.movable.values())
         self.anchors = {b: self._position(b) for b in self.obstacles if b in movable}
