@@ -6,7 +6,9 @@ injected faults), in J worker processes, and reports:
 
 - the success rate with a 95 % Wilson score interval;
 - sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
-- failures counted by node and reason (the node whose failure ended each failed episode).
+- failures counted by node and reason (the node whose failure ended each failed episode);
+- the leaves that failed during episodes, and in how many episodes: the failures the tree
+  recovered from (or did not), for instance how often a recovery branch was needed.
 
 It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
 """
@@ -50,6 +52,8 @@ class EpisodeResult:
     injected: list[dict[str, Any]] = field(default_factory=list)
     metrics: dict[str, float] = field(default_factory=dict)
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
+    leaf_failures: dict[str, int] = field(default_factory=dict)
+    """Per leaf node (by path), how many times it failed during the episode."""
 
     @property
     def success(self) -> bool:
@@ -72,6 +76,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
 
     With ``spec.btlog`` set, the episode's .btlog is kept only when it did not succeed."""
     with Episode(spec) as episode:
+        leaf_failures = count_leaf_failures(episode.tree)
         report = episode.run()
         metrics = {
             k: float(v)
@@ -94,7 +99,28 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         failed_node=failed_node,
         injected=list(report.extra.get("injected", [])),
         metrics=metrics,
+        leaf_failures=dict(leaf_failures),
     )
+
+
+def count_leaf_failures(tree: Any) -> Counter[str]:
+    """A counter, kept up to date while ``tree`` runs, of the times each leaf node (by its
+    path) goes to FAILURE."""
+    from bt_manip.bt.status import NodeStatus
+    from bt_manip.bt.walk import children_of, walk_nodes
+    from bt_manip.groot.monitor import watch
+
+    counts: Counter[str] = Counter()
+    for walked in walk_nodes(tree.root):
+        if children_of(walked.node):
+            continue
+
+        def changed(node: Any, previous: Any, new: Any, path: str = walked.path) -> None:
+            if new is NodeStatus.FAILURE:
+                counts[path] += 1
+
+        watch(walked.node, changed)
+    return counts
 
 
 @dataclass
@@ -111,6 +137,8 @@ class BenchSummary:
     failures: list[dict[str, Any]]
     injected: dict[str, int]
     metrics: dict[str, dict[str, float]] = field(default_factory=dict)
+    leaf_failures: list[dict[str, Any]] = field(default_factory=list)
+    """Per leaf that failed in some episode: its path, the episodes it failed in, the times."""
     tree: str = ""
     world: str = ""
     first_seed: int = 0
@@ -138,7 +166,18 @@ class BenchSummary:
             )
         for f in self.failures:
             lines.append(f"  {f['count']:3d} x {f['node'] or '-'}: {f['reason']}")
+        if self.leaf_failures:
+            lines.append("leaves that failed (episodes, times):")
+            for f in self.leaf_failures[:LEAVES_SHOWN]:
+                lines.append(f"  {f['episodes']:3d} {f['times']:4d}  {f['path']}")
+            if len(self.leaf_failures) > LEAVES_SHOWN:
+                lines.append(f"  ... {len(self.leaf_failures) - LEAVES_SHOWN} more in "
+                             "summary.json")
         return "\n".join(lines)
+
+
+LEAVES_SHOWN = 12
+"""Leaves listed in the text summary (summary.json has them all)."""
 
 
 def _stats(values: list[float]) -> dict[str, float]:
@@ -162,6 +201,12 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
     rtf = [r.sim_time / r.wall_time for r in results if r.wall_time > 0]
     names = sorted({k for r in results for k in r.metrics})
     metrics = {k: _stats([r.metrics[k] for r in results if k in r.metrics]) for k in names}
+    episodes: Counter[str] = Counter(p for r in results for p in r.leaf_failures)
+    times: Counter[str] = Counter()
+    for r in results:
+        times.update(r.leaf_failures)
+    leaves = [{"path": p, "episodes": c, "times": times[p]}
+              for p, c in sorted(episodes.items(), key=lambda kv: (-kv[1], -times[kv[0]]))]
     return BenchSummary(
         runs=n,
         successes=wins,
@@ -173,6 +218,7 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
         failures=[{"node": k[0], "reason": k[1], "count": c} for k, c in failures.most_common()],
         injected=dict(injected),
         metrics=metrics,
+        leaf_failures=leaves,
         tree=base.tree,
         world=base.world or "",
         first_seed=base.seed,

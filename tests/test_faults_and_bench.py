@@ -294,3 +294,27 @@ def test_the_block_fault_drops_a_crate_mid_route_or_says_why_not() -> None:
     why = "'dropped_crate_0' would start 40 mm inside 'sofa'"
     assert block_route(_Room(refuse=why), refused, route, "goal") is None
     assert refused.report()[0]["note"] == f"no crate fell: {why}"
+
+
+def test_bench_lists_the_leaves_that_failed_and_in_how_many_episodes(tmp_path: Path) -> None:
+    from bt_manip.bench import run_one
+
+    tree = _retry_tree(tmp_path)
+    results = [
+        run_one(EpisodeSpec(tree=str(tree), seed=seed,
+                            inject=[parse_fault("step:failure:0.5")]))
+        for seed in range(8)
+    ]
+    for r in results:
+        drawn = sum(1 for e in r.injected if e["target"] == "step")
+        # every injected failure of the leaf is counted, and nothing else failed
+        assert r.leaf_failures == ({"RetryUntilSuccessful/step": drawn} if drawn else {})
+    s = summarise(results, EpisodeSpec(tree=str(tree)))
+    failed = [r for r in results if r.leaf_failures]
+    assert failed, "the seeds drew no failure"
+    assert s.leaf_failures == [{
+        "path": "RetryUntilSuccessful/step",
+        "episodes": len(failed),
+        "times": sum(r.leaf_failures["RetryUntilSuccessful/step"] for r in failed),
+    }]
+    assert "leaves that failed (episodes, times):" in s.text()
