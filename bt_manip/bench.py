@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.bench_log import SCHEMA_VERSION
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.outputs import make_folder
 
@@ -227,19 +228,35 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
 
 
 def _progress(total: int) -> Callable[[EpisodeResult], None]:
-    """A progress bar in a terminal, a line every 10 % otherwise."""
+    """Progress of a bench: in a terminal a bar with the running success rate, the time spent
+    and the time left; otherwise a line every 10 %."""
     done = {"n": 0, "ok": 0}
-    if sys.stderr.isatty():
-        from rich.progress import Progress
 
-        bar = Progress(transient=True)
+    def rate() -> str:
+        return f"{done['ok']}/{done['n']} succeeded ({100.0 * done['ok'] / done['n']:.0f} %)"
+
+    if sys.stderr.isatty():
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        bar = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+            TextColumn("elapsed"), TimeElapsedColumn(), TextColumn("left"),
+            TimeRemainingColumn(), transient=True,
+        )
         bar.start()
         task = bar.add_task("episodes", total=total)
 
         def tick(r: EpisodeResult) -> None:
             done["n"] += 1
             done["ok"] += r.success
-            bar.update(task, advance=1, description=f"{done['ok']}/{done['n']} succeeded")
+            bar.update(task, advance=1, description=rate())
             if done["n"] == total:
                 bar.stop()
 
@@ -250,7 +267,7 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
         done["n"] += 1
         done["ok"] += r.success
         if done["n"] % step == 0 or done["n"] == total:
-            print(f"  {done['n']}/{total} episodes, {done['ok']} succeeded", file=sys.stderr)
+            print(f"  {done['n']}/{total} episodes, {rate()}", file=sys.stderr)
 
     return log
 
@@ -290,38 +307,73 @@ def _start_workers(jobs: int, wait: float = 20.0) -> Any:
     return pool
 
 
-def run_bench(
-    base: EpisodeSpec, runs: int, jobs: int = 1, btlog_failures: str | None = None
-) -> list[EpisodeResult]:
-    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
-
-    With ``btlog_failures`` (a folder whose parent exists), each episode that does not succeed
-    leaves ``seed-N.btlog`` there, to replay in Groot2.
-
-    With ``jobs`` > 1 the episodes run in spawned worker processes (each builds its own
-    PyBullet world). The workers never take a Ctrl-C (one interrupted while it starts up would
-    print a traceback); a Ctrl-C, or an error, in the main process stops them.
-    """
-    specs = [replace(base, seed=base.seed + i) for i in range(runs)]
+def episode_specs(base: EpisodeSpec, seeds: list[int],
+                  btlog_failures: str | None = None) -> list[EpisodeSpec]:
+    """One spec per seed; with ``btlog_failures``, each keeps ``seed-N.btlog`` there when its
+    episode does not succeed (the folder is made here)."""
+    specs = [replace(base, seed=seed) for seed in seeds]
     if btlog_failures:
         make_folder(btlog_failures)
         specs = [replace(s, btlog=str(Path(btlog_failures) / f"seed-{s.seed}.btlog"))
                  for s in specs]
+    return specs
+
+
+def run_bench(
+    base: EpisodeSpec,
+    runs: int,
+    jobs: int = 1,
+    btlog_failures: str | None = None,
+    seeds: list[int] | None = None,
+    on_result: Callable[[EpisodeResult], None] | None = None,
+    backend: str = "processes",
+    address: str | None = None,
+) -> list[EpisodeResult]:
+    """Run ``runs`` episodes with seeds base.seed + i (or the given ``seeds``); results sorted
+    by seed. ``on_result`` is called with each result as its episode finishes (in the main
+    process), before the next one is taken.
+
+    With ``btlog_failures`` (a folder whose parent exists), each episode that does not succeed
+    leaves ``seed-N.btlog`` there, to replay in Groot2.
+
+    ``backend`` "processes": with ``jobs`` > 1 the episodes run in spawned worker processes
+    (each builds its own PyBullet world). The workers never take a Ctrl-C (one interrupted
+    while it starts up would print a traceback); a Ctrl-C, or an error, in the main process
+    stops them. ``backend`` "ray": the episodes are Ray tasks on the cluster at ``address``
+    (a local one when None), see :mod:`bt_manip.bench_ray`.
+    """
+    if seeds is None:
+        seeds = [base.seed + i for i in range(runs)]
+    specs = episode_specs(base, seeds, btlog_failures)
     results: list[EpisodeResult] = []
-    if jobs <= 1 or runs <= 1:
-        progress = _progress(runs)
+    progress = _progress(len(specs))
+
+    def finished(result: EpisodeResult) -> None:
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+        progress(result)
+
+    if backend == "ray":
+        from bt_manip.bench_ray import run_on_ray
+
+        run_on_ray(specs, finished, address=address, jobs=jobs)
+    elif jobs <= 1 or len(specs) <= 1:
         for spec in specs:
-            results.append(run_one(spec))
-            progress(results[-1])
-        return sorted(results, key=lambda r: r.seed)
+            finished(run_one(spec))
+    else:
+        _run_in_pool(specs, jobs, finished)
+    return sorted(results, key=lambda r: r.seed)
+
+
+def _run_in_pool(specs: list[EpisodeSpec], jobs: int,
+                 finished: Callable[[EpisodeResult], None]) -> None:
     pool = None
     try:
         with _ctrl_c_held():  # before any other thread starts, so that none takes a Ctrl-C
-            pool = _start_workers(min(jobs, runs))
-        progress = _progress(runs)
+            pool = _start_workers(min(jobs, len(specs)))
         for result in pool.imap_unordered(run_one, specs):
-            results.append(result)
-            progress(result)
+            finished(result)
     except BaseException:
         if pool is not None:
             pool.terminate()
@@ -331,23 +383,26 @@ def run_bench(
     finally:
         if pool is not None:
             pool.join()
-    return sorted(results, key=lambda r: r.seed)
 
 
 def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
     make_folder(out)
-    (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
+    episodes = {"schema_version": SCHEMA_VERSION, "episodes": [asdict(r) for r in results]}
+    (out / "episodes.json").write_text(json.dumps(episodes, indent=2) + "\n")
     names = sorted({k for r in results for k in r.metrics})
     with open(out / "episodes.csv", "w", newline="") as fh:
         w = csv.writer(fh)
-        head = ["seed", "status", "sim_time", "wall_time", "ticks", "failed_node", "reason"]
+        head = ["schema_version", "seed", "status", "sim_time", "wall_time", "ticks",
+                "failed_node", "reason"]
         w.writerow([*head, "injected", *names])
         for r in results:
-            row = [r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}", r.ticks]
+            row = [SCHEMA_VERSION, r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}",
+                   r.ticks]
             row += [r.failed_node, r.reason, len(r.injected)]
             w.writerow(row + [r.metrics.get(k, "") for k in names])
-    (out / "summary.json").write_text(json.dumps(asdict(summary), indent=2) + "\n")
+    summary_json = {"schema_version": SCHEMA_VERSION, **asdict(summary)}
+    (out / "summary.json").write_text(json.dumps(summary_json, indent=2) + "\n")
     _plot(results, summary, out / "outcomes.png")
 
 

@@ -191,7 +191,9 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     )
     text = capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
-    episodes = json.loads((out / "episodes.json").read_text())
+    listed = json.loads((out / "episodes.json").read_text())
+    assert listed["schema_version"] == summary["schema_version"] == 2
+    episodes = listed["episodes"]
     assert [e["seed"] for e in episodes] == [1, 2, 3, 4]
     assert summary["runs"] == 4
     assert summary["successes"] == sum(e["status"] == "SUCCESS" for e in episodes)
@@ -256,7 +258,10 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "interrupted" in err.splitlines()
-    assert not (tmp_path / "out").exists()
+    # no episode finished: the log holds the bench's definition only, ready for --resume
+    lines = (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()
+    assert len(lines) == 1 and '"kind": "bench"' in lines[0]
+    assert not (tmp_path / "out" / "episodes.json").exists()
 
 
 class _Room:
