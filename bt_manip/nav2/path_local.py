@@ -100,8 +100,8 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
     def _pose(self) -> Pose2D:
         given = self.get_input("pose", None)
         if given is not None:
-            context_world = self.context.world
-            return goal_pose(context_world, given)
+            # text may name a pose of the world; a pose tuple needs no world
+            return goal_pose(self.world if isinstance(given, str) else None, given)
         pose: Pose2D = self.robot().base_pose2d()
         return pose
 
