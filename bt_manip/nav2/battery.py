@@ -18,6 +18,7 @@ import math
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
+from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
@@ -72,7 +73,7 @@ class IsBatteryLow(WorldCondition):
     """Whether the robot's battery is low.
 
     - SUCCESS when the battery's percentage (0..1), or its voltage with ``is_voltage``, is at
-      or below ``min_battery``;
+      or below ``min_battery`` (the feedback message gives the reading);
     - FAILURE when it is above, or when there is no battery state to read (the reason says
       why; a voltage that was not given counts as unknown).
 
@@ -110,6 +111,17 @@ class IsBatteryLow(WorldCondition):
         if bool(self.get_input("is_voltage")):
             if math.isnan(state.voltage):
                 return False, "the battery state gives no voltage"
-            return state.voltage <= limit, f"battery at {state.voltage:.2f} V > {limit:g} V"
-        return state.percentage <= limit, (
-            f"battery at {state.percentage:.3f} > {limit:g}")
+            low, reading = state.voltage <= limit, f"{state.voltage:.2f} V"
+        else:
+            low, reading = state.percentage <= limit, f"{state.percentage:.3f}"
+        self.reading = f"battery at {reading} {'<=' if low else '>'} {limit:g}"
+        return low, self.reading
+
+    reading = ""
+
+    def update(self) -> Status:
+        self.reading = ""
+        status = super().update()
+        if status == Status.SUCCESS:
+            self.feedback_message = self.reading  # low: say how low (an Inverter may fail on it)
+        return status

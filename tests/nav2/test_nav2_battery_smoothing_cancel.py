@@ -58,10 +58,11 @@ def test_is_battery_low_reads_the_world_files_battery_as_it_drains(tmp_path: Pat
         tree = load(world, '<IsBatteryLow min_battery="0.3"/>')
         volts = load(world, '<IsBatteryLow min_battery="11.6" is_voltage="true"/>')
         assert tree.tick().value == "FAILURE"  # 0.5 > 0.3
-        assert "battery at 0.500" in tree.root.feedback_message
+        assert tree.root.feedback_message == "battery at 0.500 > 0.3"
         assert volts.tick().value == "SUCCESS"  # 11.5 V <= 11.6 V
         world.step(int(25 * world.rate_hz))  # 25 s: 0.5 - 0.25 = 0.25 <= 0.3
         assert tree.tick().value == "SUCCESS"
+        assert tree.root.feedback_message == "battery at 0.250 <= 0.3"
 
 
 def test_is_battery_low_reads_the_topic_entry_first(room: World) -> None:

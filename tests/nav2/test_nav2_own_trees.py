@@ -108,6 +108,7 @@ def test_the_goal_update_tree_does_not_set_off_on_a_low_battery() -> None:
                         bb(goal=GOAL_TEXT, battery_status="0.05"))
         assert report.status == "FAILURE"
         assert report.sim_time < 1.0
+        assert "BatteryNotLow" in str(report.reason)
         assert distance_to(world, start[0], start[1]) < 0.05
 
 
