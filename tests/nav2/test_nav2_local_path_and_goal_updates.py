@@ -173,3 +173,18 @@ def test_smoother_never_moves_a_point_into_a_lethal_cell() -> None:
     out, _ = smooth_points(pts, cost, (0.0, 0.0), 0.05, SmootherOptions(max_sweeps=200))
     rows, cols = (out[:, 1] / 0.05).astype(int), (out[:, 0] / 0.05).astype(int)
     assert not np.isinf(cost[rows, cols])[free_before].any()
+
+
+def test_goal_updater_in_a_subtree_hears_the_root_topic() -> None:
+    xml = ('<root BTCPP_format="4" main_tree_to_execute="M">'
+           '<BehaviorTree ID="M"><SubTree ID="Nav" goal="{goal}" current="{current}"/>'
+           '</BehaviorTree>'
+           '<BehaviorTree ID="Nav"><GoalUpdater input_goal="{goal}" output_goal="{current}">'
+           '<AlwaysSuccess/></GoalUpdater></BehaviorTree></root>')
+    tree = load_tree_string(xml, context=TreeContext(clock=ManualClock()),
+                            blackboard={"goal": "1;2;0"})
+    tree.tick()
+    assert tree.blackboard.get("current") == "1;2;0"
+    tree.blackboard.set("goal_update", "4;4;0")
+    tree.tick()
+    assert tree.blackboard.get("current") == "4;4;0"
