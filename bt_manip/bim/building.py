@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from bt_manip.bim.ifc_input import IfcSource, check_count
-from bt_manip.errors import Problem
 from bt_manip.bim.shapes import (
     Box,
     ShapeReader,
@@ -28,6 +27,7 @@ from bt_manip.bim.shapes import (
     is_box_like,
     placement_yaw,
 )
+from bt_manip.errors import Problem
 
 PASSAGE_HEIGHT = 1.5
 """An opening from the floor at least this high (m) is a passage for the robot."""

@@ -386,14 +386,14 @@ def _stock_pose(
             )
         return pose
     area = _largest_space(building)
-    pose = place_stock(grid, area, sizes)
-    if pose is None:
+    placed = place_stock(grid, area, sizes)
+    if placed is None:
         raise InputError.single(
             str(source.path), None,
             f"no free spot for the stock ({len(sizes)} stands) in the largest space: give one "
             "with --stock X;Y;YAW",
         )
-    return pose
+    return placed
 
 
 def _check_routes(

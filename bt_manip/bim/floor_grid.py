@@ -71,10 +71,10 @@ class FloorGrid:
         ex = abs(c) * rect.length / 2 + abs(s) * rect.width / 2
         ey = abs(s) * rect.length / 2 + abs(c) * rect.width / 2
         ny, nx = self.blocked.shape
-        i0 = max(int(math.floor((rect.x - ex - self.x0) / self.res)), 0)
-        i1 = min(int(math.ceil((rect.x + ex - self.x0) / self.res)), nx)
-        j0 = max(int(math.floor((rect.y - ey - self.y0) / self.res)), 0)
-        j1 = min(int(math.ceil((rect.y + ey - self.y0) / self.res)), ny)
+        i0 = max(math.floor((rect.x - ex - self.x0) / self.res), 0)
+        i1 = min(math.ceil((rect.x + ex - self.x0) / self.res), nx)
+        j0 = max(math.floor((rect.y - ey - self.y0) / self.res), 0)
+        j1 = min(math.ceil((rect.y + ey - self.y0) / self.res), ny)
         if i0 >= i1 or j0 >= j1:
             return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
         xs = self.x0 + (np.arange(i0, i1) + 0.5) * self.res - rect.x
@@ -149,7 +149,9 @@ class FloorGrid:
         k = int(np.argmin((xs - x) ** 2 + (ys - y) ** 2))
         return (float(xs[k]), float(ys[k]))
 
-    def _near(self, x: float, y: float, reach: float, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def _near(
+        self, x: float, y: float, reach: float, ok: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
         rows, cols = self.cells(Rect(x, y, 2 * reach, 2 * reach))
         cx = self.x0 + (cols + 0.5) * self.res - x
         cy = self.y0 + (rows + 0.5) * self.res - y

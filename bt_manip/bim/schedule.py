@@ -138,7 +138,9 @@ def schedule_from_csv(source: IfcSource, path: str | Path) -> list[PlannedElemen
         if index == 0 and cells[0].lower() == "globalid":
             continue
         if len(cells) != 2:
-            problems.append(Problem(name, line, f"expected 'GlobalId,start', got {len(cells)} fields"))
+            problems.append(
+                Problem(name, line, f"expected 'GlobalId,start', got {len(cells)} fields")
+            )
             continue
         gid, start = cells
         if len(rows) >= MAX_ELEMENTS:
@@ -171,7 +173,9 @@ def schedule_from_csv(source: IfcSource, path: str | Path) -> list[PlannedElemen
             entity = None
         if entity is None:
             problems.append(
-                Problem(name, line, f"unknown GlobalId '{gid}': no entity of {source.path.name} has it")
+                Problem(
+                    name, line, f"unknown GlobalId '{gid}': no entity of {source.path.name} has it"
+                )
             )
             continue
         if not any(entity.is_a(c) for c in INSTALLABLE):
@@ -185,7 +189,9 @@ def schedule_from_csv(source: IfcSource, path: str | Path) -> list[PlannedElemen
             )
             continue
         if gid in seen:
-            problems.append(Problem(name, line, f"GlobalId '{gid}' is listed twice (first at line {seen[gid]})"))
+            problems.append(
+                Problem(name, line, f"GlobalId '{gid}' is listed twice (first at line {seen[gid]})")
+            )
             continue
         seen[gid] = line
         rows.append((sort_key, line, entity, start))

@@ -117,7 +117,7 @@ class ShapeReader:
             settings.set("disable-opening-subtractions", True)
             self._settings = settings
         try:
-            shape = ifcopenshell.geom.create_shape(self._settings, element)
+            shape: Any = ifcopenshell.geom.create_shape(self._settings, element)
         except Exception as exc:  # the kernel raises RuntimeError and others
             raise UnsupportedGeometry(f"the geometry kernel cannot read it ({exc})") from None
         verts = np.asarray(shape.geometry.verts, dtype=float).reshape(-1, 3)

@@ -68,7 +68,9 @@ def footprint(pose: StockPose, sizes: list[tuple[float, float, float]]) -> Rect:
     return Rect(pose.x - c * APRON / 2, pose.y - s * APRON / 2, length + APRON, width, pose.yaw)
 
 
-def apron_pose(pose: StockPose, sizes: list[tuple[float, float, float]]) -> tuple[float, float, float]:
+def apron_pose(
+    pose: StockPose, sizes: list[tuple[float, float, float]]
+) -> tuple[float, float, float]:
     """The robot's pose on the apron, facing the stands."""
     length, _ = stock_size(sizes)
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
