@@ -169,9 +169,8 @@ def convert(options: BimOptions) -> Conversion:
     storey = choose_storey(source)
     names = Names()
     building = read_building(source, storey, {p.entity.id() for p in planned}, names)
-    elements, solids_ok = _elements(source, planned, building.floor_z, names)
+    elements = _elements(source, planned, storey, building.floor_z, names)
     source.raise_problems()
-    del solids_ok
 
     grid = _floor_grid(building)
     sizes = [tuple(e.size) for e in elements]
@@ -265,15 +264,28 @@ def _no_elements(source: IfcSource, options: BimOptions) -> None:
 
 
 def _elements(
-    source: IfcSource, planned: list[PlannedElement], floor_z: float, names: Names
-) -> tuple[list[InstallElement], bool]:
-    """Target pose, size and mass of each element to install."""
+    source: IfcSource, planned: list[PlannedElement], storey: Any, floor_z: float, names: Names
+) -> list[InstallElement]:
+    """Target pose, size and mass of each element to install (on ``storey``)."""
     import ifcopenshell.util.element as util
 
+    from bt_manip.bim.building import storey_of
+
     reader = ShapeReader(source.scale)
+    single = len(source.model.by_type("IfcBuildingStorey")) == 1
     out: list[InstallElement] = []
     for i, p in enumerate(planned):
         el = p.entity
+        if not single:
+            on = storey_of(el)
+            if on is None or on.id() != storey.id():
+                where = f"storey '{on.Name}'" if on is not None else "no storey"
+                source.fail(
+                    el,
+                    f"it is on {where}; the world is built from storey '{storey.Name}' (the "
+                    "one holding the most walls) only",
+                )
+                continue
         try:
             solid = reader.solid(el)
         except UnsupportedGeometry as exc:
@@ -316,7 +328,7 @@ def _elements(
                 stock={},
             )
         )
-    return out, True
+    return out
 
 
 def _floor_grid(building: Building) -> FloorGrid:

@@ -130,8 +130,9 @@ def schedule_from_csv(source: IfcSource, path: str | Path) -> list[PlannedElemen
     kinds: set[str] = set()
     seen: dict[str, int] = {}
     text = data.decode("utf-8-sig", errors="replace")
-    for index, row in enumerate(csv.reader(io.StringIO(text))):
-        line = index + 1
+    reader = csv.reader(io.StringIO(text))
+    for index, row in enumerate(reader):
+        line = reader.line_num  # the row's last line (a quoted field may span lines)
         cells = [c.strip() for c in row]
         if not cells or all(not c for c in cells) or cells[0].startswith("#"):
             continue

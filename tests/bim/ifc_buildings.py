@@ -112,12 +112,15 @@ def _box(f: Any, body: Any, cls: str, name: str, size: tuple[float, float, float
 
 def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
                 sequence: list[int] | None = None, with_tasks: bool = True,
-                with_storey: bool = True, mm: bool = True) -> Building:
+                with_storey: bool = True, mm: bool = True, link: str = "product",
+                element_class: str = "IfcPlate") -> Building:
     """The building of the module docstring.
 
     ``sequence`` lists panel indices: each IfcRelSequence links one to the next (by default
     none: the order comes from the tasks' start times). ``with_tasks=False`` leaves the panels
-    without tasks (a CSV schedule is then needed); IFC2X3 files never get tasks.
+    without tasks (a CSV schedule is then needed); IFC2X3 files never get tasks. ``link`` is
+    how a panel is tied to its task: ``product`` (the task's output, IfcRelAssignsToProduct)
+    or ``process`` (IfcRelAssignsToProcess); ``element_class`` is the panels' IFC class.
     """
     f = ifcopenshell.file(schema=schema)
     if schema == "IFC2X3":  # every IFC2X3 entity names its owner: an author and a tool
@@ -196,7 +199,8 @@ def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
         c, s = math.cos(p.yaw), math.sin(p.yaw)
         x0 = cx - c * PANEL[0] / 2 + s * PANEL[1] / 2
         y0 = cy - s * PANEL[0] / 2 - c * PANEL[1] / 2
-        panel = _box(f, body, "IfcPlate", p.name, PANEL, _matrix(x0, y0, cz - PANEL[2] / 2, p.yaw))
+        panel = _box(f, body, element_class, p.name, PANEL,
+                     _matrix(x0, y0, cz - PANEL[2] / 2, p.yaw))
         api("spatial.assign_container", f, products=[panel], relating_structure=container)
         api("material.assign_material", f, products=[panel], material=material)
         out.panels.append(panel)
@@ -205,7 +209,10 @@ def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
             time = api("sequence.add_task_time", f, task=task)
             api("sequence.edit_task_time", f, task_time=time,
                 attributes={"ScheduleStart": p.start})
-            api("sequence.assign_product", f, relating_product=panel, related_object=task)
+            if link == "product":
+                api("sequence.assign_product", f, relating_product=panel, related_object=task)
+            else:
+                api("sequence.assign_process", f, relating_process=task, related_object=panel)
             out.tasks.append(task)
     for a, b in zip(sequence or [], (sequence or [])[1:], strict=False):
         api("sequence.assign_sequence", f, relating_process=out.tasks[a],

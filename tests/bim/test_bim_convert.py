@@ -6,6 +6,7 @@ import csv
 import json
 import math
 
+import numpy as np
 import pytest
 
 pytest.importorskip("ifcopenshell")
@@ -116,6 +117,43 @@ def test_order_from_sequences(tmp_path):
     assert names == ["Panel W2", "Panel W3", "Panel E1", "Panel W1", "Panel E2", "Panel E3"]
 
 
+@pytest.mark.parametrize("element_class", ["IfcMember", "IfcWall"])
+def test_elements_assigned_to_processes(tmp_path, element_class):
+    ifc = three_rooms(link="process", element_class=element_class).write(tmp_path / "p.ifc")
+    c = convert(BimOptions(ifc, tmp_path / "out"))
+    assert [e.name for e in c.elements] == [p.name for p in PANELS]
+    assert {e.ifc_class for e in c.elements} == {element_class}
+    spec = parse_world(c.world_path)
+    # walls to install are objects at the stock, not walls at their final place
+    assert len(spec.walls) == 6 and len(spec.objects) == 6
+
+
+def test_a_wall_read_by_the_geometry_kernel(tmp_path):
+    import ifcopenshell.api
+
+    b = three_rooms()
+    f = b.file
+    wall = ifcopenshell.api.run("root.create_entity", f, ifc_class="IfcWall", name="Mesh wall")
+    # a 2 m x 0.1 m x 2 m box as a mesh, centred on its placement
+    verts = [(x, y, z) for z in (0.0, 2.0) for x, y in ((-1, -0.05), (1, -0.05), (1, 0.05),
+                                                        (-1, 0.05))]
+    faces = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    rep = ifcopenshell.api.run("geometry.add_mesh_representation", f, context=b.body,
+                               vertices=[verts], faces=[faces])
+    ifcopenshell.api.run("geometry.assign_representation", f, product=wall, representation=rep)
+    matrix = np.eye(4)
+    matrix[:3, 3] = [7.5, 4.5, 0.0]
+    ifcopenshell.api.run("geometry.edit_object_placement", f, product=wall, matrix=matrix)
+    ifcopenshell.api.run("spatial.assign_container", f, products=[wall],
+                         relating_structure=b.storey)
+    c = convert(BimOptions(b.write(tmp_path / "k.ifc"), tmp_path / "out"))
+    mesh = _wall(parse_world(c.world_path), "mesh_wall")
+    assert sorted([mesh.start, mesh.end]) == [pytest.approx((6.5, 4.5), abs=1e-3),
+                                              pytest.approx((8.5, 4.5), abs=1e-3)]
+    assert mesh.thickness == pytest.approx(0.1, abs=1e-3)
+    assert mesh.height == pytest.approx(2.0, abs=1e-3)
+
+
 def test_order_from_csv(tmp_path):
     ifc = three_rooms(with_tasks=False).write(tmp_path / "b.ifc")
     # the same GlobalIds are not kept across generations: read them from this file
@@ -150,14 +188,24 @@ def test_ifc2x3_with_a_csv(tmp_path):
         pytest.approx((1.5, 1.6), abs=1e-3), pytest.approx((4.5, 0.9), abs=1e-3)]
 
 
+def test_file_in_metres(tmp_path):
+    ifc = three_rooms(mm=False).write(tmp_path / "m.ifc")
+    c = convert(BimOptions(ifc, tmp_path / "out"))
+    partition = _wall(parse_world(c.world_path), "partition")
+    assert partition.end == pytest.approx((5.0, 6.0), abs=1e-3)
+    assert (partition.doors[0].at, partition.doors[0].width) == pytest.approx((1.5, 1.6), abs=1e-3)
+    assert c.elements[0].target["z"] == pytest.approx(1.0, abs=1e-3)
+
+
 def test_command_line_writes_a_world_that_loads(tmp_path, capsys):
     from bt_manip.sim.world import World
 
     ifc = three_rooms().write(tmp_path / "b.ifc")
     assert main(["bim", str(ifc), "--out", str(tmp_path / "out"), "--stock", "1.65;2.6;1.5708",
-                 "--start", "Office"]) == 0
+                 "--start", "Office", "--seed-range", "0:2"]) == 0
     out = capsys.readouterr().out
     assert "6 elements to install" in out and "stock at (1.65, 2.60)" in out
+    assert "loaded the world with seeds 0..1: every start is free" in out
     with World(tmp_path / "out" / "world.yaml", seed=3) as world:
         robot = world.summary()
         assert "robot robot (husky_ur3)" in robot
