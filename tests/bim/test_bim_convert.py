@@ -220,3 +220,27 @@ def test_command_line_writes_a_world_that_loads(tmp_path, capsys):
 def test_elements_in_a_panel_list_can_be_changed():
     b = three_rooms(panels=[Panel("Only", (0.11, 3.0, 1.0), math.pi / 2, "2026-03-02")])
     assert len(b.panels) == 1 and len(b.tasks) == 1
+
+
+NAVIGATE = """<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence>
+      <Navigate goal="office"/>
+      <Navigate goal="stock"/>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+@pytest.mark.slow
+def test_the_robot_drives_through_the_generated_doors(tmp_path, converted):
+    # from the workshop through the 1.6 m door to the office, and back to the stock's apron
+    _, conversion, _ = converted
+    tree = tmp_path / "nav.xml"
+    tree.write_text(NAVIGATE)
+    report = tmp_path / "report.json"
+    code = main(["run", str(tree), "--world", str(conversion.world_path), "--seed", "1",
+                 "--quiet", "--report", str(report)])
+    assert code == 0
+    assert json.loads(report.read_text())["status"] == "SUCCESS"

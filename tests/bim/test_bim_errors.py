@@ -156,3 +156,23 @@ def test_stock_on_a_wall(tmp_path, capsys):
     code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"), "--stock", "5;3;0")
     assert code == 2
     assert err.startswith("--stock: the stock area") and "overlaps a wall" in err
+
+
+def test_element_on_another_storey(tmp_path, capsys):
+    b = three_rooms()
+    f = b.file
+    upper = ifcopenshell.api.run("root.create_entity", f, ifc_class="IfcBuildingStorey",
+                                 name="First floor")
+    ifcopenshell.api.run("aggregate.assign_object", f, products=[upper],
+                         relating_object=f.by_type("IfcBuilding")[0])
+    panel = b.panels[0]
+    ifcopenshell.api.run("spatial.assign_container", f, products=[panel],
+                         relating_structure=upper)
+    path = b.write(tmp_path / "two.ifc")
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    assert code == 2
+    assert err.strip() == (
+        f"{path}:{_line_of(path, panel.id())}: #{panel.id()} IfcPlate 'Panel W1': it is on "
+        "storey 'First floor'; the world is built from storey 'Ground floor' (the one holding "
+        "the most walls) only"
+    )
