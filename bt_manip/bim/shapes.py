@@ -18,7 +18,8 @@ from typing import Any
 import numpy as np
 
 BOX_FILL = 0.9
-"""A body is box-like when its volume is at least this share of its upright bounding box's."""
+"""A body is box-like when its volume is at least this share of its upright bounding box's
+(less the mitres of :func:`is_box_like`)."""
 
 
 class UnsupportedGeometry(Exception):
@@ -243,5 +244,11 @@ def placement_yaw(element: Any) -> float | None:
 
 
 def is_box_like(solid: Solid, box: Box) -> bool:
-    """Whether the body fills its upright box (see :data:`BOX_FILL`)."""
-    return box.volume > 0 and solid.volume >= BOX_FILL * box.volume
+    """Whether the body fills its upright box (see :data:`BOX_FILL`).
+
+    A long body (at least twice as long as wide) may also miss a width-square prism at its
+    ends: walls meeting at a corner are often cut at 45 degrees there.
+    """
+    length, width, height = box.size
+    mitres = width * width * height if length >= 2 * width else 0.0
+    return box.volume > 0 and solid.volume >= BOX_FILL * box.volume - mitres

@@ -244,3 +244,19 @@ def test_the_robot_drives_through_the_generated_doors(tmp_path, converted):
                  "--quiet", "--report", str(report)])
     assert code == 0
     assert json.loads(report.read_text())["status"] == "SUCCESS"
+
+
+def test_mitred_wall_ends_are_read():
+    from bt_manip.bim.shapes import Solid, footprint_box, is_box_like
+
+    # a 1 m x 0.3 m x 2.5 m wall cut at 45 degrees at both ends (a trapezoid in plan)
+    plan = [(0.0, 0.0), (1.0, 0.0), (0.7, 0.3), (0.3, 0.3)]
+    points = np.array([(x, y, z) for z in (0.0, 2.5) for x, y in plan])
+    box = footprint_box(points)
+    assert box.size == pytest.approx((1.0, 0.3, 2.5))
+    assert is_box_like(Solid(points, volume=(1.0 + 0.4) / 2 * 0.3 * 2.5), box)
+    # a square post with one corner cut off (12.5 % of its box missing) is not a box
+    post = np.array([(x, y, z) for z in (0.0, 2.5) for x, y in
+                     [(0, 0), (0.6, 0), (0.6, 0.3), (0.3, 0.6), (0, 0.6)]])
+    volume = (0.6 * 0.6 - 0.3 * 0.3 / 2) * 2.5
+    assert not is_box_like(Solid(post, volume=volume), footprint_box(post))
