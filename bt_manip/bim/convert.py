@@ -118,8 +118,9 @@ class Conversion:
         lines = [
             f"{self.source}: {self.schema}, storey '{self.storey}', "
             f"{xmax - xmin:.2f} m x {ymax - ymin:.2f} m",
-            f"  {len(b.walls)} walls with {doors} passages and {closed} closed openings "
-            f"(windows), {len(b.spaces)} spaces, {len(b.furniture)} furniture",
+            f"  {_count(len(b.walls), 'wall')} with {_count(doors, 'passage')} and "
+            f"{_count(closed, 'closed opening')} (windows), {_count(len(b.spaces), 'space')}, "
+            f"{_count(len(b.furniture), 'piece')} of furniture",
             f"  stock at ({self.stock.x:.2f}, {self.stock.y:.2f}) heading "
             f"{math.degrees(self.stock.yaw):.0f} deg; robot start at ({self.start[0]:.2f}, "
             f"{self.start[1]:.2f})",
@@ -137,6 +138,10 @@ class Conversion:
         lines += [f"  note: {n}" for n in self.notes]
         lines.append(f"wrote {self.world_path} and {self.schedule_path}")
         return "\n".join(lines)
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
 
 
 def convert(options: BimOptions) -> Conversion:
@@ -195,10 +200,9 @@ def convert(options: BimOptions) -> Conversion:
     for space in sorted(building.spaces, key=lambda s: s.entity.id()):
         spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
                                   within=_space_rect(space))
-        key = _pose_key(space.name, poses)
-        space.key = key
         if spot is not None:
-            poses[key] = [r(spot[0]), r(spot[1]), 0.0]
+            space.key = _pose_key(space.name, poses)
+            poses[space.key] = [r(spot[0]), r(spot[1]), 0.0]
     world: dict[str, Any] = {
         "name": _world_name(source.path),
         "description": (
@@ -506,7 +510,7 @@ def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
         "spaces": [
             {
                 "name": s.name,
-                "pose": s.key,
+                "pose": s.key or None,
                 "global_id": str(s.entity.GlobalId),
                 "centre": [r(s.box.centre[0]), r(s.box.centre[1])],
                 "size": [r(s.box.size[0]), r(s.box.size[1])],

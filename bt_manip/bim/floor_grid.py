@@ -99,12 +99,10 @@ class FloorGrid:
 
     def is_free(self, rect: Rect) -> bool:
         """No blocked cell in ``rect``, and ``rect`` lies on the grid."""
-        rows, _ = self.cells(rect)
-        if len(rows) == 0:
+        if not self._inside(rect):
             return False
-        cols = self.cells(rect)[1]
-        inside = self._inside(rect)
-        return inside and not bool(self.blocked[rows, cols].any())
+        rows, cols = self.cells(rect)
+        return len(rows) > 0 and not bool(self.blocked[rows, cols].any())
 
     def _inside(self, rect: Rect) -> bool:
         ny, nx = self.blocked.shape
