@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -260,3 +261,15 @@ def test_mitred_wall_ends_are_read():
                      [(0, 0), (0.6, 0), (0.6, 0.3), (0.3, 0.6), (0, 0.6)]])
     volume = (0.6 * 0.6 - 0.3 * 0.3 / 2) * 2.5
     assert not is_box_like(Solid(post, volume=volume), footprint_box(post))
+
+
+def test_schedule_follows_its_json_schema(converted):
+    jsonschema = pytest.importorskip("jsonschema")
+    root = Path(__file__).resolve().parents[2]
+    schema = json.loads((root / "docs" / "schemas" / "bim-schedule.schema.json").read_text())
+    _, conversion, _ = converted
+    document = json.loads(conversion.schedule_path.read_text())
+    jsonschema.validate(document, schema)
+    broken = {**document, "elements": [{**document["elements"][0], "mass": -1}]}
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.validate(broken, schema)
