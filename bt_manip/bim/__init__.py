@@ -10,9 +10,12 @@ optional extra ``bt-manip[bim]``) in the units of the file and writes:
 
 Modules: :mod:`~bt_manip.bim.ifc_input` (reading, bounds, ``file:line: #id IfcClass 'Name'``
 problems), :mod:`~bt_manip.bim.shapes` (element geometry as boxes), :mod:`~bt_manip.bim.building`
-(walls, openings, spaces, furniture), :mod:`~bt_manip.bim.schedule` (the 4D schedule or a CSV),
-:mod:`~bt_manip.bim.floor_grid` (free spots and routes on the floor),
-:mod:`~bt_manip.bim.world_file` (the world YAML) and :mod:`~bt_manip.bim.convert` (the command).
+(walls, openings, spaces, furniture), :mod:`~bt_manip.bim.schedule` (the 4D schedule or a CSV,
+and the elements to install), :mod:`~bt_manip.bim.floor_grid` (the floor as a grid: free spots,
+connected places), :mod:`~bt_manip.bim.routes` (carrying each element from the stock through
+the doors), :mod:`~bt_manip.bim.stock` (the stands), :mod:`~bt_manip.bim.world_file` (the world
+YAML), :mod:`~bt_manip.bim.convert` (the whole conversion) and :mod:`~bt_manip.bim.command`
+(the command line).
 """
 
 from __future__ import annotations

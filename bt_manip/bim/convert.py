@@ -25,8 +25,10 @@ import yaml
 from bt_manip.bim.building import Building, Names, choose_storey, read_building
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
+from bt_manip.bim.routes import CLEARANCE, check_routes, floor_grid
 from bt_manip.bim.schedule import (
     MAX_ELEMENTS,
+    InstallElement,
     PlannedElement,
     schedule_from_csv,
     schedule_from_tasks,
@@ -44,17 +46,11 @@ from bt_manip.bim.stock import (
     stand_rects,
 )
 from bt_manip.bim.world_file import building_entries, r
-from bt_manip.errors import InputError, Problem
+from bt_manip.errors import InputError
 
 DEFAULT_DENSITY = 420.0
 """Mass density (kg/m3) of an element whose material gives none: a light board, like Scenario
 A's panel (1.5 kg for 1.2 x 0.02 x 0.15 m)."""
-CLEARANCE = 0.05
-"""Free space (m) wanted on each side of the robot, or of what it carries, in a passage."""
-REACH_STOCK = 1.0
-"""The robot picks an element up from within this distance (m) of the stock pose."""
-REACH_PLACE = 1.5
-"""The robot installs an element from within this distance (m) of its target."""
 START_JITTER = 0.2
 """The robot's start is moved by up to this much (m in x and y) per seed; 1.5x that in rad."""
 SCHEMA_VERSION = 1
@@ -70,29 +66,6 @@ class BimOptions:
     robot: str = "husky_ur3"
     stock: tuple[float, float, float] | None = None
     start_space: str | None = None
-
-
-@dataclass
-class InstallElement:
-    """One element to install, in schedule order, with everything a tree needs about it."""
-
-    order: int
-    global_id: str
-    name: str
-    ifc_class: str
-    step_id: int
-    object: str
-    """Name of the world object standing for it."""
-    target: dict[str, float]
-    """Pose of its centre once installed: x, y, z (m, floor at z = 0) and yaw (rad)."""
-    size: list[float]
-    """Length along its yaw, width (thickness), height (m)."""
-    mass: float
-    mass_source: str
-    task: str | None
-    start: str | None
-    stock: dict[str, float]
-    """Pose of its centre in its stand at the stock (before the per-seed jitter)."""
 
 
 @dataclass
@@ -177,7 +150,7 @@ def convert(options: BimOptions) -> Conversion:
     elements = _elements(source, planned, storey, building.floor_z, names)
     source.raise_problems()
 
-    grid = _floor_grid(building)
+    grid = floor_grid(building)
     sizes = [tuple(e.size) for e in elements]
     stock = _stock_pose(options, source, building, grid, sizes)  # type: ignore[arg-type]
     world_stands: list[dict[str, Any]] = []
@@ -190,7 +163,7 @@ def convert(options: BimOptions) -> Conversion:
         for rect in stand_rects(slot, size):
             grid.block(rect)
     apron = apron_pose(stock, sizes)  # type: ignore[arg-type]
-    _check_routes(source, building, grid, elements, apron, robot_width)
+    check_routes(source, building, grid, elements, apron, robot_width)
     source.raise_problems()
     start, jitter = _robot_start(options, building, grid, robot_radius)
 
@@ -335,44 +308,6 @@ def _elements(
     return out
 
 
-def _floor_grid(building: Building) -> FloorGrid:
-    """The floor with the walls (between passages), closed openings and furniture painted."""
-    from bt_manip.bim.building import PASSAGE_HEIGHT
-
-    grid = FloorGrid(building.extent)
-    door_index = 0
-    for wall in building.walls:
-        yaw = math.atan2(wall.end[1] - wall.start[1], wall.end[0] - wall.start[0])
-        cuts = [(o.start, o.end) for o in wall.openings if o.passage]
-        s = 0.0
-        for a, b in [*cuts, (wall.length, wall.length)]:
-            if a - s > 1e-6:
-                cx, cy = wall.point_at((s + a) / 2)
-                grid.block(Rect(cx, cy, a - s, wall.thickness, yaw))
-            s = max(s, b)
-        for o in wall.openings:
-            if o.passage:
-                cx, cy = wall.point_at((o.start + o.end) / 2)
-                grid.mark_door(Rect(cx, cy, o.width, wall.thickness + 0.1, yaw), door_index)
-                door_index += 1
-    for f in building.raised + building.furniture:
-        if f.box.bottom < PASSAGE_HEIGHT:
-            grid.block(Rect(f.box.centre[0], f.box.centre[1], f.box.size[0], f.box.size[1],
-                            f.box.yaw))
-    return grid
-
-
-def doors_of(building: Building) -> list[tuple[str, float, tuple[float, float]]]:
-    """(wall name, width, centre) of every passage, in the grid's door order."""
-    out = []
-    for wall in building.walls:
-        for o in wall.openings:
-            if o.passage:
-                out.append((str(wall.entity.Name or wall.name), o.width,
-                            wall.point_at((o.start + o.end) / 2)))
-    return out
-
-
 def _space_rect(space: Any) -> Rect:
     b = space.box
     return Rect(b.centre[0], b.centre[1], b.size[0], b.size[1], b.yaw)
@@ -410,48 +345,6 @@ def _stock_pose(
             "with --stock X;Y;YAW",
         )
     return placed
-
-
-def _check_routes(
-    source: IfcSource, building: Building, grid: FloorGrid, elements: list[InstallElement],
-    apron: tuple[float, float, float], robot_width: float,
-) -> None:
-    """Each element can be carried from the stock to its place (see :mod:`floor_grid`)."""
-    doors = doors_of(building)
-    bare = robot_width / 2 + CLEARANCE
-    a = (apron[0], apron[1])
-    if not grid.joined(a, a, bare, REACH_STOCK):
-        source.problems.append(
-            Problem("--stock", None, "the robot has no room to stand at the stock's apron")
-        )
-        return
-    for e in elements:
-        need = max(robot_width, e.size[0]) + 2 * CLEARANCE
-        b = (e.target["x"], e.target["y"])
-        if grid.joined(a, b, need / 2, REACH_PLACE):
-            continue
-        entity = source.model.by_id(e.step_id)
-        if not grid.joined(a, b, bare, REACH_PLACE):
-            source.fail(
-                entity,
-                f"its place ({b[0]:.2f}, {b[1]:.2f}) cannot be reached: no route for the robot "
-                "joins the stock to it",
-            )
-            continue
-        route = grid.doors_on_route(a, b, bare, REACH_PLACE) or []
-        narrow = [doors[i] for i in route if doors[i][1] < need]
-        where = (
-            "; its route from the stock passes "
-            + ", ".join(f"the {w:.2f} m door of wall '{n}' at ({c[0]:.2f}, {c[1]:.2f})"
-                        for n, w, c in narrow)
-            if narrow
-            else "; a passage on its route from the stock is narrower"
-        )
-        source.fail(
-            entity,
-            f"{e.size[0]:.2f} m long, it needs a passage {need:.2f} m wide when carried, wider "
-            f"than any door on its route{where}",
-        )
 
 
 def _robot_start(

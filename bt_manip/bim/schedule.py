@@ -41,6 +41,29 @@ class PlannedElement:
     start: str | None
 
 
+@dataclass
+class InstallElement:
+    """One element to install, in schedule order, with everything a tree needs about it."""
+
+    order: int
+    global_id: str
+    name: str
+    ifc_class: str
+    step_id: int
+    object: str
+    """Name of the world object standing for it."""
+    target: dict[str, float]
+    """Pose of its centre once installed: x, y, z (m, floor at z = 0) and yaw (rad)."""
+    size: list[float]
+    """Length along its yaw, width (thickness), height (m)."""
+    mass: float
+    mass_source: str
+    task: str | None
+    start: str | None
+    stock: dict[str, float]
+    """Pose of its centre in its stand at the stock (before the per-seed jitter)."""
+
+
 def _time_key(text: str | None) -> tuple[int, float]:
     """Sort key of a start: unset last."""
     if text is None:
