@@ -130,14 +130,23 @@ class ShapeReader:
         return Solid(verts, volume)
 
 
+NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Reference",
+            "Clearance", "CoG", "Surface", "Lighting"}
+"""Representation identifiers that are not an element's body."""
+
+
 def body_representation(element: Any) -> Any:
-    """The element's 'Body' shape representation (the first one when it names none)."""
+    """The element's 'Body' shape representation, else the first one that is not a known
+    other kind (an axis, a footprint, a bounding box...), else None."""
     shape = getattr(element, "Representation", None)
     if shape is None:
         return None
     reps = list(shape.Representations)
     for rep in reps:
         if rep.RepresentationIdentifier == "Body":
+            return rep
+    for rep in reps:
+        if rep.RepresentationIdentifier not in NOT_BODY:
             return rep
     return None
 
