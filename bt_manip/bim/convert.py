@@ -125,9 +125,10 @@ def convert(options: BimOptions) -> Conversion:
 
     require_ifcopenshell()
     check_output_folder("--out", options.out)
-    if find_descriptor(options.robot) is None:
+    descriptor = find_descriptor(options.robot)
+    if descriptor is None:
         raise InputError.single("--robot", None, f"unknown robot '{options.robot}'")
-    robot = RobotDescription.load(find_descriptor(options.robot))  # type: ignore[arg-type]
+    robot = RobotDescription.load(descriptor)
     fp = robot.footprint
     robot_width = 2 * fp.radius if fp.is_circle else fp.width
     robot_radius = fp.circumradius
@@ -151,18 +152,17 @@ def convert(options: BimOptions) -> Conversion:
     source.raise_problems()
 
     grid = floor_grid(building)
-    sizes = [tuple(e.size) for e in elements]
-    stock = _stock_pose(options, source, building, grid, sizes)  # type: ignore[arg-type]
+    sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
+    stock = _stock_pose(options, source, building, grid, sizes)
     world_stands: list[dict[str, Any]] = []
     world_objects: list[dict[str, Any]] = []
-    for e, slot in zip(elements, slots(stock, sizes), strict=True):  # type: ignore[arg-type]
-        size = (e.size[0], e.size[1], e.size[2])
+    for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
         world_stands.append(stand_entry(names.make(f"stand_{e.object}", "stand"), slot, size))
         world_objects.append(element_entry(e.object, slot, size, e.mass))
         e.stock = {"x": r(slot.x), "y": r(slot.y), "z": r(size[2] / 2 + 0.0005), "yaw": r(slot.yaw)}
         for rect in stand_rects(slot, size):
             grid.block(rect)
-    apron = apron_pose(stock, sizes)  # type: ignore[arg-type]
+    apron = apron_pose(stock, sizes)
     check_routes(source, building, grid, elements, apron, robot_width)
     source.raise_problems()
     start, jitter = _robot_start(options, building, grid, robot_radius)
@@ -192,15 +192,16 @@ def convert(options: BimOptions) -> Conversion:
                 "name": "robot",
                 "description": options.robot,
                 "pose": [r(v) for v in start],
-                "arm_state": "tuck" if "tuck" in robot.states else None,
-                "randomize": {"x": [-jitter, jitter], "y": [-jitter, jitter],
-                              "yaw": [-1.5 * jitter, 1.5 * jitter]},
             }
         ],
         "poses": poses,
     }
-    if world["robots"][0]["arm_state"] is None:
-        del world["robots"][0]["arm_state"]
+    if "tuck" in robot.states:
+        world["robots"][0]["arm_state"] = "tuck"
+    if jitter > 0:
+        world["robots"][0]["randomize"] = {
+            "x": [-jitter, jitter], "y": [-jitter, jitter], "yaw": [-1.5 * jitter, 1.5 * jitter]
+        }
     make_folder(options.out)
     world_path = options.out / "world.yaml"
     schedule_path = options.out / "schedule.json"
