@@ -176,3 +176,36 @@ def test_element_on_another_storey(tmp_path, capsys):
         "storey 'First floor'; the world is built from storey 'Ground floor' (the one holding "
         "the most walls) only"
     )
+
+
+def test_sequence_cycle(tmp_path, capsys):
+    b = three_rooms(sequence=[0, 1])  # W1 before W2, and (below) W2 before W1
+    import ifcopenshell.guid
+
+    b.file.create_entity("IfcRelSequence", GlobalId=ifcopenshell.guid.new(),
+                         RelatingProcess=b.tasks[1], RelatedProcess=b.tasks[0],
+                         SequenceType="FINISH_START")
+    path = b.write(tmp_path / "cycle.ifc")
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    assert code == 2
+    rels = [r for r in b.file.by_type("IfcRelSequence") if r.RelatedProcess == b.tasks[0]]
+    (rel,) = rels
+    assert err.strip() == (
+        f"{path}:{_line_of(path, rel.id())}: #{rel.id()} IfcRelSequence: the task sequences "
+        "form a cycle: no order satisfies them all"
+    )
+
+
+def test_schedule_rows_with_bad_starts_and_duplicates(tmp_path, capsys):
+    b = three_rooms(with_tasks=False)
+    path = b.write(tmp_path / "b.ifc")
+    g0, g1 = b.panels[0].GlobalId, b.panels[1].GlobalId
+    csv = tmp_path / "s.csv"
+    csv.write_text(f"{g0},2026-03-02\n{g1},next monday\n{g0},2026-03-04\n{g1}\n")
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"), "--schedule", str(csv))
+    assert code == 2
+    assert err.splitlines() == [
+        f"{csv}:2: start 'next monday' is neither a number nor an ISO 8601 date or date-time",
+        f"{csv}:3: GlobalId '{g0}' is listed twice (first at line 1)",
+        f"{csv}:4: expected 'GlobalId,start', got 1 fields",
+    ]
