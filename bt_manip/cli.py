@@ -4,6 +4,7 @@ Verbs:
   run TREE.xml [--world W]   tick a tree (against a world's sim clock when one is given)
   bench TREE.xml --world W   many seeded episodes in parallel, with statistics
   world W.yaml               load a world, print its summary, optionally let it settle
+  bim BUILDING.ifc --out D   an IFC building and its schedule to a world and schedule.json
   validate TREE.xml          check a tree without running it, listing every problem
   show TREE.xml              print a tree as text (or Graphviz with --dot)
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
@@ -330,6 +331,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="step S seconds of sim (0..3600) with no commands and report what moved",
     )
     world.set_defaults(func=cmd_world)
+
+    from bt_manip.bim.command import add_bim_verb
+
+    add_bim_verb(sub)
 
     try:
         from bt_manip.bt.cli_verbs import add_verbs
