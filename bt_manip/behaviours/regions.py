@@ -168,8 +168,8 @@ class DropPoint(WorldAccess, SyncActionNode):
 
     - SUCCESS with ``point`` written;
     - FAILURE (reason in the feedback) when ``region`` names no body of the world, ``index``
-      is not a cell of the grid, the margin leaves no room, or a value read from the blackboard
-      breaks its port's rule.
+      is not a cell of the grid (or not a whole number), the margin leaves no room, or a
+      value read from the blackboard breaks its port's rule.
     It finishes within its tick (never RUNNING), so there is nothing to halt.
     """
 
@@ -193,9 +193,12 @@ class DropPoint(WorldAccess, SyncActionNode):
     def update(self) -> Status:
         try:
             region = region_of(self.world, self.get_input("region"))
+            index = self.get_input("index")
+            if index != int(index):  # a script's number from the blackboard
+                raise ActionFailed(f"index must be a whole number, got {index}")
             point = grid_cell(
                 region,
-                int(self.get_input("index")),
+                int(index),
                 int(self.get_input("rows")),
                 int(self.get_input("cols")),
                 float(self.get_input("margin")),
