@@ -34,7 +34,7 @@ def block_to_bin() -> Sequence:
     point, release, check; retried once, otherwise skipped (gripper opened, hand raised,
     counted)."""
     pick_and_place = Sequence("pick_and_place", children=[
-        OpenGripper("open", opening=0.075),
+        OpenGripper("open", opening=0.06),
         MoveToPose("reach_block", object="{block}", match_object_yaw=True, approach=0.12,
                    path="line"),
         CloseGripper("grasp", require_object=True),
