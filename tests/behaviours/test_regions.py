@@ -202,3 +202,21 @@ def test_top_down_grasp_turns_by_the_block_yaw_folded_into_45_deg(
     assert turned == pytest.approx(turn_deg, abs=2.0)
     lo, _ = pb.getAABB(table.movable["b"], physicsClientId=table.client)
     assert lo[2] > 0.7475 + 0.05  # lifted off the table by the fingers
+
+
+def test_region_of_furniture_and_of_a_robot(table: World) -> None:
+    # the cafe table (boxes and a cylinder): one cell over all of it is its top's centre
+    report, tree = run_xml(
+        table,
+        '<DropPoint region="cafe_table" index="0" rows="1" cols="1" margin="0" clearance="0"'
+        ' point="{p}"/>',
+    )
+    assert report.status == "SUCCESS", report.reason
+    assert tree.blackboard.as_dict()["p"] == pytest.approx([1.0, 0.0, 0.7475], abs=1e-6)
+    # a body with links (the robot): the world bounding box of all its links, the gripper's
+    # included
+    robot = table.robots["sawyer"]
+    region = region_of(table, "sawyer")
+    assert np.allclose(region.pose, np.eye(4))
+    assert region.contains(robot.link_transform("grasp_frame")[:3, 3])
+    assert not region.contains(np.array([0.75, -0.25, 0.8]))  # the bin's centre
