@@ -4,9 +4,17 @@
 - Arm: MoveJointsSequentially, MoveJoints, MoveToPose, Lift.
 - Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.
 - Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear.
-- World: SpawnModel, DeleteModel.
+- World: SpawnModel, DeleteModel. Regions: DropPoint.
 """
 
-from bt_manip.behaviours import arm, attach, conditions, gripper, navigate, world_ops
+from bt_manip.behaviours import (
+    arm,
+    attach,
+    conditions,
+    gripper,
+    navigate,
+    regions,
+    world_ops,
+)
 
-__all__ = ["arm", "attach", "conditions", "gripper", "navigate", "world_ops"]
+__all__ = ["arm", "attach", "conditions", "gripper", "navigate", "regions", "world_ops"]
