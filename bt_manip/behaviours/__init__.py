@@ -4,7 +4,7 @@
 - Arm: MoveJointsSequentially, MoveJoints, MoveToPose, Lift.
 - Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.
 - Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear.
-- World: SpawnModel, DeleteModel.
+- World: SpawnModel, DeleteModel. Regions: DropPoint.
 """
 
 from bt_manip.behaviours import (
@@ -14,7 +14,17 @@ from bt_manip.behaviours import (
     get_clear,
     gripper,
     navigate,
+    regions,
     world_ops,
 )
 
-__all__ = ["arm", "attach", "conditions", "get_clear", "gripper", "navigate", "world_ops"]
+__all__ = [
+    "arm",
+    "attach",
+    "conditions",
+    "get_clear",
+    "gripper",
+    "navigate",
+    "regions",
+    "world_ops",
+]
