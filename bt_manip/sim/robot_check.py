@@ -124,7 +124,8 @@ def _run(client: int, robot: Robot) -> CheckReport:
         _step(client, round(0.2 * RATE_HZ))
     g = desc.gripper
     if g.joints:
-        for phase, opening in (("open", g.max_opening), ("close", g.min_opening), ("open", g.max_opening)):
+        moves = (("open", g.max_opening), ("close", g.min_opening), ("open", g.max_opening))
+        for phase, opening in moves:
             robot.set_gripper(opening)
             timeout = g.max_opening / len(g.joints) / g.max_speed * 2.0 + 2.0
             took = _until(client, timeout, lambda o=opening: abs(robot.gripper_opening() - o))

@@ -104,18 +104,11 @@ class _Urdf:
         self.joints: dict[str, _Joint] = {}
         for el in root.findall("joint"):
             name = el.get("name", "")
-            limit = el.find("limit")
+            jline = _line(text, "joint", name)
 
-            def num(key: str, default: float | None, limit: ET.Element | None = limit) -> float | None:
-                if limit is None or limit.get(key) is None:
-                    return default
-                try:
-                    return float(limit.get(key, ""))
-                except ValueError:
-                    raise InputError.single(
-                        str(path), _line(text, "joint", name),
-                        f"joint '{name}': limit {key}={limit.get(key)!r} is not a number",
-                    ) from None
+            def num(key: str, default: float | None, el: ET.Element = el,
+                    where: tuple[str, int | None] = (name, jline)) -> float | None:
+                return _limit_value(path, el, key, default, *where)
 
             jtype = el.get("type", "")
             bounded = jtype in ("revolute", "prismatic")
@@ -124,7 +117,7 @@ class _Urdf:
                 jtype,
                 _end(el, "parent"),
                 _end(el, "child"),
-                _line(text, "joint", name),
+                jline,
                 (num("lower", 0.0) or 0.0) if bounded else -math.inf,
                 (num("upper", 0.0) or 0.0) if bounded else math.inf,
                 num("velocity", None),
@@ -166,6 +159,25 @@ class _Urdf:
     def root_link(self) -> str:
         roots = [name for name in self.links if name not in self.parent_joint]
         return roots[0] if roots else ""
+
+
+def _limit_value(
+    path: Path, joint: ET.Element, key: str, default: float | None, name: str, line: int | None
+) -> float | None:
+    """Attribute ``key`` of the joint's ``<limit>`` as a finite number, ``default`` if absent."""
+    limit = joint.find("limit")
+    if limit is None or limit.get(key) is None:
+        return default
+    raw = limit.get(key, "")
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError.single(
+            str(path), line, f"joint '{name}': limit {key}={raw!r} is not a finite number"
+        )
+    return value
 
 
 def _line(text: str, tag: str, name: str) -> int | None:
@@ -316,7 +328,8 @@ def _descriptor_text(
     geometry = _Geometry(composed, urdf, opts, arm)
     uri = urdf_uri(opts.urdf, opts.out.parent)
     lines = [
-        f"# {name}: written by `bt-manip robot init` from {Path(uri).name}. Format: robots/README.md.",
+        f"# {name}: written by `bt-manip robot init` from {Path(uri).name}.",
+        "# Format: robots/README.md.",
         f"name: {name}",
         "urdf:",
         f"  base: {uri}",
@@ -483,4 +496,6 @@ def _check_kinematics(desc: RobotDescription) -> None:
     try:
         ArmModel.from_urdf(desc.urdf_path, base_link=desc.arm.base_link, tip_link=desc.end_effector)
     except (KinematicsError, ValueError, RuntimeError) as exc:
-        raise InputError.single(str(desc.path), None, f"the arm model does not build: {exc}") from None
+        raise InputError.single(
+            str(desc.path), None, f"the arm model does not build: {exc}"
+        ) from None

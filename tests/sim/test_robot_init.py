@@ -51,7 +51,8 @@ def test_panda_descriptor_fields(tmp_path: Path) -> None:
     assert desc.states["zero"][3] == pytest.approx(-0.0698)
     assert desc.states["ready"][3] == pytest.approx((-3.0718 - 0.0698) / 2, abs=1e-4)
     for q in desc.states.values():
-        assert all(lo <= v <= hi for v, lo, hi in zip(q, desc.arm.lower, desc.arm.upper))
+        limits = zip(q, desc.arm.lower, desc.arm.upper, strict=True)
+        assert all(lo <= v <= hi for v, lo, hi in limits)
     assert 0.1 < desc.footprint.radius < 0.3
     text = (tmp_path / "panda.yaml").read_text()
     assert "package://example-robot-data/robots/panda_description/urdf/panda.urdf" in text
@@ -139,7 +140,9 @@ def test_check_moves_every_joint_to_its_limits(tmp_path: Path) -> None:
     assert [m.phase for m in report.moves if m.joint == "gripper"] == ["open", "close", "open"]
 
 
-def test_check_fails_when_a_joint_cannot_reach(tmp_path: Path, capsys: pytest.CaptureFixture) -> None:
+def test_check_fails_when_a_joint_cannot_reach(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
     desc = init_descriptor(_panda(tmp_path))
     text = (tmp_path / "panda.yaml").read_text()
     # too weak a shoulder to lift the arm against gravity
