@@ -495,7 +495,7 @@ def _check_kinematics(desc: RobotDescription) -> None:
 
     try:
         ArmModel.from_urdf(desc.urdf_path, base_link=desc.arm.base_link, tip_link=desc.end_effector)
-    except (KinematicsError, ValueError, RuntimeError) as exc:
+    except (KinematicsError, ValueError, RuntimeError, IndexError) as exc:
         raise InputError.single(
             str(desc.path), None, f"the arm model does not build: {exc}"
         ) from None

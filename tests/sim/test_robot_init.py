@@ -177,3 +177,49 @@ def test_ur3_descriptor_works_in_a_world_without_edits(tmp_path: Path) -> None:
         assert report.status == "SUCCESS", report.reason
         pos, _ = episode.world.robots["ur3"].link_pose("tool0")
         assert math.dist(pos, (0.25, -0.15, 0.3)) < 0.01
+
+
+def test_mobile_base_wheels_track_and_footprint(tmp_path: Path) -> None:
+    """The Husky + UR3 URDF read back as a skid-steer: wheels, track, radius, footprint close to
+    the hand-written husky_ur3 descriptor (the geometric track width, 0.5708 m)."""
+    urdf = RobotDescription.load("husky_ur3").urdf_path
+    desc = init_descriptor(
+        InitOptions(
+            urdf, "ur3_base_link", "ur3_tool0", tmp_path / "husky.yaml",
+            gripper=("gripper_left_finger_joint", "gripper_right_finger_joint"),
+            mobile="skid", grasp_frame="grasp_frame",
+        )
+    )
+    assert desc.base.type == "skid_steer"
+    assert set(desc.base.left_wheels) == {"front_left_wheel", "rear_left_wheel"}
+    assert set(desc.base.right_wheels) == {"front_right_wheel", "rear_right_wheel"}
+    assert desc.base.track_width == pytest.approx(0.5708, abs=0.01)
+    assert desc.base.wheel_radius == pytest.approx(0.17775, abs=0.01)
+    assert desc.footprint.length == pytest.approx(0.99, abs=0.05)
+    assert desc.footprint.width == pytest.approx(0.67, abs=0.05)
+    assert 0.0 <= desc.spawn_height < 0.02
+    assert desc.arm.joints[0] == "shoulder_pan_joint" and desc.gripper.max_opening == 0.1
+
+
+def test_mobile_without_wheels_is_refused(tmp_path: Path) -> None:
+    (problem,) = _problems(_panda(tmp_path, mobile="diff"))
+    assert "found no continuous wheel joints on both sides" in problem
+
+
+def test_descriptor_next_to_its_own_urdf_names_it_relatively(tmp_path: Path) -> None:
+    urdf = tmp_path / "models" / "arm.urdf"
+    urdf.parent.mkdir()
+    urdf.write_text(
+        '<robot name="arm">\n  <link name="base"/>\n  <link name="mid"/>\n  <link name="tip"/>\n'
+        '  <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/>\n'
+        '    <axis xyz="0 0 1"/><limit lower="-1" upper="2" velocity="1" effort="10"/>\n'
+        "  </joint>\n"
+        '  <joint name="j2" type="continuous"><parent link="mid"/><child link="tip"/>\n'
+        '    <origin xyz="0 0 0.3"/><axis xyz="0 1 0"/>\n'
+        "  </joint>\n</robot>\n"
+    )
+    desc = init_descriptor(InitOptions(urdf, "base", "tip", tmp_path / "robots" / "arm.yaml"))
+    assert "base: ../models/arm.urdf" in (tmp_path / "robots" / "arm.yaml").read_text()
+    # mid-range where there are limits, 0 for the continuous joint; the default speed for it
+    assert desc.states["ready"] == (0.5, 0.0) and desc.states["zero"] == (0.0, 0.0)
+    assert desc.arm.velocity_limits == (1.0, 1.0)
