@@ -336,6 +336,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     add_bim_verb(sub)
 
+    from bt_manip.sim.robot_command import add_robot_verb
+
+    add_robot_verb(sub)
+
     try:
         from bt_manip.bt.cli_verbs import add_verbs
     except ImportError:
