@@ -6,7 +6,9 @@ injected faults), in J worker processes, and reports:
 
 - the success rate with a 95 % Wilson score interval;
 - sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
-- failures counted by node and reason (the node whose failure ended each failed episode).
+- failures counted by node and reason (the node whose failure ended each failed episode);
+- the leaves that failed during episodes, and in how many episodes: the failures the tree
+  recovered from (or did not), for instance how often a recovery branch was needed.
 
 It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
 """
@@ -31,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.bench_log import SCHEMA_VERSION
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.outputs import make_folder
 
@@ -50,6 +53,8 @@ class EpisodeResult:
     injected: list[dict[str, Any]] = field(default_factory=list)
     metrics: dict[str, float] = field(default_factory=dict)
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
+    leaf_failures: dict[str, int] = field(default_factory=dict)
+    """Per leaf node (by path), how many times it failed during the episode."""
 
     @property
     def success(self) -> bool:
@@ -72,6 +77,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
 
     With ``spec.btlog`` set, the episode's .btlog is kept only when it did not succeed."""
     with Episode(spec) as episode:
+        leaf_failures = count_leaf_failures(episode.tree)
         report = episode.run()
         metrics = {
             k: float(v)
@@ -94,7 +100,28 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         failed_node=failed_node,
         injected=list(report.extra.get("injected", [])),
         metrics=metrics,
+        leaf_failures=dict(leaf_failures),
     )
+
+
+def count_leaf_failures(tree: Any) -> Counter[str]:
+    """A counter, kept up to date while ``tree`` runs, of the times each leaf node (by its
+    path) goes to FAILURE."""
+    from bt_manip.bt.status import NodeStatus
+    from bt_manip.bt.walk import children_of, walk_nodes
+    from bt_manip.groot.monitor import watch
+
+    counts: Counter[str] = Counter()
+    for walked in walk_nodes(tree.root):
+        if children_of(walked.node):
+            continue
+
+        def changed(node: Any, previous: Any, new: Any, path: str = walked.path) -> None:
+            if new is NodeStatus.FAILURE:
+                counts[path] += 1
+
+        watch(walked.node, changed)
+    return counts
 
 
 @dataclass
@@ -111,6 +138,8 @@ class BenchSummary:
     failures: list[dict[str, Any]]
     injected: dict[str, int]
     metrics: dict[str, dict[str, float]] = field(default_factory=dict)
+    leaf_failures: list[dict[str, Any]] = field(default_factory=list)
+    """Per leaf that failed in some episode: its path, the episodes it failed in, the times."""
     tree: str = ""
     world: str = ""
     first_seed: int = 0
@@ -138,7 +167,18 @@ class BenchSummary:
             )
         for f in self.failures:
             lines.append(f"  {f['count']:3d} x {f['node'] or '-'}: {f['reason']}")
+        if self.leaf_failures:
+            lines.append("leaves that failed (episodes, times):")
+            for f in self.leaf_failures[:LEAVES_SHOWN]:
+                lines.append(f"  {f['episodes']:3d} {f['times']:4d}  {f['path']}")
+            if len(self.leaf_failures) > LEAVES_SHOWN:
+                lines.append(f"  ... {len(self.leaf_failures) - LEAVES_SHOWN} more in "
+                             "summary.json")
         return "\n".join(lines)
+
+
+LEAVES_SHOWN = 12
+"""Leaves listed in the text summary (summary.json has them all)."""
 
 
 def _stats(values: list[float]) -> dict[str, float]:
@@ -162,6 +202,12 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
     rtf = [r.sim_time / r.wall_time for r in results if r.wall_time > 0]
     names = sorted({k for r in results for k in r.metrics})
     metrics = {k: _stats([r.metrics[k] for r in results if k in r.metrics]) for k in names}
+    episodes: Counter[str] = Counter(p for r in results for p in r.leaf_failures)
+    times: Counter[str] = Counter()
+    for r in results:
+        times.update(r.leaf_failures)
+    leaves = [{"path": p, "episodes": c, "times": times[p]}
+              for p, c in sorted(episodes.items(), key=lambda kv: (-kv[1], -times[kv[0]]))]
     return BenchSummary(
         runs=n,
         successes=wins,
@@ -173,6 +219,7 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
         failures=[{"node": k[0], "reason": k[1], "count": c} for k, c in failures.most_common()],
         injected=dict(injected),
         metrics=metrics,
+        leaf_failures=leaves,
         tree=base.tree,
         world=base.world or "",
         first_seed=base.seed,
@@ -181,19 +228,35 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
 
 
 def _progress(total: int) -> Callable[[EpisodeResult], None]:
-    """A progress bar in a terminal, a line every 10 % otherwise."""
+    """Progress of a bench: in a terminal a bar with the running success rate, the time spent
+    and the time left; otherwise a line every 10 %."""
     done = {"n": 0, "ok": 0}
-    if sys.stderr.isatty():
-        from rich.progress import Progress
 
-        bar = Progress(transient=True)
+    def rate() -> str:
+        return f"{done['ok']}/{done['n']} succeeded ({100.0 * done['ok'] / done['n']:.0f} %)"
+
+    if sys.stderr.isatty():
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        bar = Progress(
+            TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+            TextColumn("elapsed"), TimeElapsedColumn(), TextColumn("left"),
+            TimeRemainingColumn(), transient=True,
+        )
         bar.start()
         task = bar.add_task("episodes", total=total)
 
         def tick(r: EpisodeResult) -> None:
             done["n"] += 1
             done["ok"] += r.success
-            bar.update(task, advance=1, description=f"{done['ok']}/{done['n']} succeeded")
+            bar.update(task, advance=1, description=rate())
             if done["n"] == total:
                 bar.stop()
 
@@ -204,7 +267,7 @@ def _progress(total: int) -> Callable[[EpisodeResult], None]:
         done["n"] += 1
         done["ok"] += r.success
         if done["n"] % step == 0 or done["n"] == total:
-            print(f"  {done['n']}/{total} episodes, {done['ok']} succeeded", file=sys.stderr)
+            print(f"  {done['n']}/{total} episodes, {rate()}", file=sys.stderr)
 
     return log
 
@@ -244,38 +307,73 @@ def _start_workers(jobs: int, wait: float = 20.0) -> Any:
     return pool
 
 
-def run_bench(
-    base: EpisodeSpec, runs: int, jobs: int = 1, btlog_failures: str | None = None
-) -> list[EpisodeResult]:
-    """Run ``runs`` episodes with seeds base.seed + i; results sorted by seed.
-
-    With ``btlog_failures`` (a folder whose parent exists), each episode that does not succeed
-    leaves ``seed-N.btlog`` there, to replay in Groot2.
-
-    With ``jobs`` > 1 the episodes run in spawned worker processes (each builds its own
-    PyBullet world). The workers never take a Ctrl-C (one interrupted while it starts up would
-    print a traceback); a Ctrl-C, or an error, in the main process stops them.
-    """
-    specs = [replace(base, seed=base.seed + i) for i in range(runs)]
+def episode_specs(base: EpisodeSpec, seeds: list[int],
+                  btlog_failures: str | None = None) -> list[EpisodeSpec]:
+    """One spec per seed; with ``btlog_failures``, each keeps ``seed-N.btlog`` there when its
+    episode does not succeed (the folder is made here)."""
+    specs = [replace(base, seed=seed) for seed in seeds]
     if btlog_failures:
         make_folder(btlog_failures)
         specs = [replace(s, btlog=str(Path(btlog_failures) / f"seed-{s.seed}.btlog"))
                  for s in specs]
+    return specs
+
+
+def run_bench(
+    base: EpisodeSpec,
+    runs: int,
+    jobs: int = 1,
+    btlog_failures: str | None = None,
+    seeds: list[int] | None = None,
+    on_result: Callable[[EpisodeResult], None] | None = None,
+    backend: str = "processes",
+    address: str | None = None,
+) -> list[EpisodeResult]:
+    """Run ``runs`` episodes with seeds base.seed + i (or the given ``seeds``); results sorted
+    by seed. ``on_result`` is called with each result as its episode finishes (in the main
+    process), before the next one is taken.
+
+    With ``btlog_failures`` (a folder whose parent exists), each episode that does not succeed
+    leaves ``seed-N.btlog`` there, to replay in Groot2.
+
+    ``backend`` "processes": with ``jobs`` > 1 the episodes run in spawned worker processes
+    (each builds its own PyBullet world). The workers never take a Ctrl-C (one interrupted
+    while it starts up would print a traceback); a Ctrl-C, or an error, in the main process
+    stops them. ``backend`` "ray": the episodes are Ray tasks on the cluster at ``address``
+    (a local one when None), see :mod:`bt_manip.bench_ray`.
+    """
+    if seeds is None:
+        seeds = [base.seed + i for i in range(runs)]
+    specs = episode_specs(base, seeds, btlog_failures)
     results: list[EpisodeResult] = []
-    if jobs <= 1 or runs <= 1:
-        progress = _progress(runs)
+    progress = _progress(len(specs))
+
+    def finished(result: EpisodeResult) -> None:
+        results.append(result)
+        if on_result is not None:
+            on_result(result)
+        progress(result)
+
+    if backend == "ray":
+        from bt_manip.bench_ray import run_on_ray
+
+        run_on_ray(specs, finished, address=address, jobs=jobs)
+    elif jobs <= 1 or len(specs) <= 1:
         for spec in specs:
-            results.append(run_one(spec))
-            progress(results[-1])
-        return sorted(results, key=lambda r: r.seed)
+            finished(run_one(spec))
+    else:
+        _run_in_pool(specs, jobs, finished)
+    return sorted(results, key=lambda r: r.seed)
+
+
+def _run_in_pool(specs: list[EpisodeSpec], jobs: int,
+                 finished: Callable[[EpisodeResult], None]) -> None:
     pool = None
     try:
         with _ctrl_c_held():  # before any other thread starts, so that none takes a Ctrl-C
-            pool = _start_workers(min(jobs, runs))
-        progress = _progress(runs)
+            pool = _start_workers(min(jobs, len(specs)))
         for result in pool.imap_unordered(run_one, specs):
-            results.append(result)
-            progress(result)
+            finished(result)
     except BaseException:
         if pool is not None:
             pool.terminate()
@@ -285,23 +383,26 @@ def run_bench(
     finally:
         if pool is not None:
             pool.join()
-    return sorted(results, key=lambda r: r.seed)
 
 
 def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
     make_folder(out)
-    (out / "episodes.json").write_text(json.dumps([asdict(r) for r in results], indent=2) + "\n")
+    episodes = {"schema_version": SCHEMA_VERSION, "episodes": [asdict(r) for r in results]}
+    (out / "episodes.json").write_text(json.dumps(episodes, indent=2) + "\n")
     names = sorted({k for r in results for k in r.metrics})
     with open(out / "episodes.csv", "w", newline="") as fh:
         w = csv.writer(fh)
-        head = ["seed", "status", "sim_time", "wall_time", "ticks", "failed_node", "reason"]
+        head = ["schema_version", "seed", "status", "sim_time", "wall_time", "ticks",
+                "failed_node", "reason"]
         w.writerow([*head, "injected", *names])
         for r in results:
-            row = [r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}", r.ticks]
+            row = [SCHEMA_VERSION, r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}",
+                   r.ticks]
             row += [r.failed_node, r.reason, len(r.injected)]
             w.writerow(row + [r.metrics.get(k, "") for k in names])
-    (out / "summary.json").write_text(json.dumps(asdict(summary), indent=2) + "\n")
+    summary_json = {"schema_version": SCHEMA_VERSION, **asdict(summary)}
+    (out / "summary.json").write_text(json.dumps(summary_json, indent=2) + "\n")
     _plot(results, summary, out / "outcomes.png")
 
 

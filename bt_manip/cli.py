@@ -4,6 +4,7 @@ Verbs:
   run TREE.xml [--world W]   tick a tree (against a world's sim clock when one is given)
   bench TREE.xml --world W   many seeded episodes in parallel, with statistics
   world W.yaml               load a world, print its summary, optionally let it settle
+  bim BUILDING.ifc --out D   an IFC building and its schedule to a world and schedule.json
   validate TREE.xml          check a tree without running it, listing every problem
   show TREE.xml              print a tree as text (or Graphviz with --dot)
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
@@ -272,19 +273,40 @@ def build_parser() -> argparse.ArgumentParser:
     add_import_flag(run)
     run.set_defaults(func=cmd_run)
 
-    bench = sub.add_parser("bench", help="run many seeded episodes and report statistics")
-    bench.add_argument("tree", help="BehaviorTree.CPP v4 XML file")
-    bench.add_argument("--world", required=True, help="world file (YAML)")
+    bench = sub.add_parser(
+        "bench", help="run many seeded episodes and report statistics",
+        description="Run many seeded episodes of a tree and report statistics. Exit codes: 0 "
+        "every episode succeeded, 1 some did not, 2 bad input, 130 interrupted (the finished "
+        "episodes are kept in episodes.jsonl; --resume DIR runs the rest).")
+    bench.add_argument("tree", nargs="?", help="BehaviorTree.CPP v4 XML file")
+    bench.add_argument("--world", help="world file (YAML); required unless --resume")
     bench.add_argument("--runs", type=_positive(int), default=20, help="episodes (default 20)")
     bench.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     bench.add_argument("--jobs", type=_within(int, 1, 64), default=2,
-                       help="worker processes (1..64)")
+                       help="worker processes, or CPUs of a local Ray instance (1..64)")
     bench.add_argument(
         "--out",
         default=DEFAULT_BENCH_OUT,
         help=f"folder for JSON, CSV and PNG output (default {DEFAULT_BENCH_OUT}; bt-manip creates "
         "at most this folder, its parent must exist)",
     )
+    bench.add_argument(
+        "--resume", metavar="DIR",
+        help="finish the interrupted bench (or sweep) whose outputs are in DIR: run the seeds "
+        "that have no episode in DIR/episodes.jsonl yet, with the same tree, world and options",
+    )
+    bench.add_argument(
+        "--sweep", metavar="TEXT",
+        help="run the bench once per value of an --inject text or bb:KEY=VALUE with {a,b,...} "
+        "in place of one value, e.g. 'slip:{0,0.1,0.2}'; one folder per value in --out, and "
+        "sweep.json/.csv/.png",
+    )
+    bench.add_argument("--backend", choices=("processes", "ray"), default="processes",
+                       help="where episodes run: local worker processes (default) or Ray "
+                       "(pip install 'bt-manip[ray]')")
+    bench.add_argument("--address", metavar="ADDR",
+                       help="with --backend ray: the cluster's address (default: start a local "
+                       "instance with --jobs CPUs)")
     bench.add_argument("--tree-id")
     bench.add_argument("--models", action="append", default=[], metavar="MODELS.xml")
     bench.add_argument("--bb", action="append", type=_bb_pair, default=[], metavar="KEY=VALUE")
@@ -311,6 +333,14 @@ def build_parser() -> argparse.ArgumentParser:
         help="step S seconds of sim (0..3600) with no commands and report what moved",
     )
     world.set_defaults(func=cmd_world)
+
+    from bt_manip.bim.command import add_bim_verb
+
+    add_bim_verb(sub)
+
+    from bt_manip.sim.robot_command import add_robot_verb
+
+    add_robot_verb(sub)
 
     try:
         from bt_manip.bt.cli_verbs import add_verbs
@@ -349,7 +379,7 @@ def cmd_world(args: argparse.Namespace) -> int:
     return 0
 
 
-def _episode_spec(args: argparse.Namespace) -> Any:
+def episode_spec(args: argparse.Namespace) -> Any:
     from bt_manip.episode import EpisodeSpec
 
     options = RunOptions(
@@ -399,7 +429,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from bt_manip.outputs import write_text
 
     _check_outputs(args, ("--report", "--bb-out", "--record", "--btlog"))
-    with Episode(_episode_spec(args)) as episode:
+    with Episode(episode_spec(args)) as episode:
         tree, world = episode.tree, episode.world
         if world is not None and not args.quiet:
             print(world.summary())
@@ -468,33 +498,15 @@ def _start_groot(args: argparse.Namespace, episode: Any) -> Any:
 
 
 def cmd_bench(args: argparse.Namespace) -> int:
-    from bt_manip.bench import run_bench, summarise, write_outputs
-    from bt_manip.episode import Episode
-    from bt_manip.outputs import check_output_folder, make_folder
+    from bt_manip.bench_command import run_bench_command
+    from bt_manip.outputs import make_folder
 
-    if args.out == DEFAULT_BENCH_OUT and not Path(DEFAULT_BENCH_OUT).parent.exists():
+    if args.address and args.backend != "ray":
+        raise InputError.single("--address", None, "only with --backend ray")
+    if (not args.resume and args.out == DEFAULT_BENCH_OUT
+            and not Path(DEFAULT_BENCH_OUT).parent.exists()):
         make_folder(Path(DEFAULT_BENCH_OUT).parent)  # out/, bt-manip's own default folder
-    check_output_folder("--out", args.out)
-    if args.btlog_failures:
-        check_output_folder("--btlog-failures", args.btlog_failures)
-    base = _episode_spec(args)
-    with Episode(base):  # check the tree and world once, before starting workers
-        pass
-    print(
-        f"bench: {args.runs} episodes of {args.tree} on {args.world}, seeds "
-        f"{args.seed}..{args.seed + args.runs - 1}, {args.jobs} process(es)"
-    )
-    results = run_bench(base, args.runs, jobs=args.jobs, btlog_failures=args.btlog_failures)
-    summary = summarise(results, base)
-    print(summary.text())
-    out = Path(args.out)
-    if _write_outputs([("--out", str(out), lambda: write_outputs(results, summary, out))]):
-        return EXIT_BAD_INPUT
-    print(f"wrote {out}/episodes.json, episodes.csv, summary.json, outcomes.png")
-    if args.btlog_failures:
-        failed = sum(1 for r in results if not r.success)
-        print(f"wrote {failed} .btlog file(s) of failed episodes to {args.btlog_failures}")
-    return 0 if summary.successes == summary.runs else 1
+    return run_bench_command(args)
 
 
 def _live_view(tree: Any) -> Any:

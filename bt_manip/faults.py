@@ -9,7 +9,11 @@ Specifications (``--inject``, repeatable):
                     probability P per carry; robot behaviours that carry ask :func:`plan_slip`
                     when they start and call :func:`slip_out` when the slip is due.
 ``block:P``         with probability P per navigation, an obstacle is dropped on the planned
-                    route; the Navigate behaviour calls :func:`block_route`.
+                    route: the Navigate behaviour calls :func:`block_route` (the crate falls
+                    as the navigation starts); Nav2's planners draw it with :func:`plan_block`
+                    and keep it with :meth:`FaultInjector.defer_block`, and FollowPath drops
+                    it when the robot comes within :data:`BLOCK_NEAR` of its place (an obstacle
+                    appearing in front of the robot, the case Nav2's recoveries are for).
 ``pose_noise:SIGMA_M[:SIGMA_DEG]``
                     the pose the robot perceives of each object is off by an offset drawn once
                     per object and episode: x and y normal with sigma SIGMA_M (m), yaw normal
@@ -63,6 +67,8 @@ BLOCK_SIZE = 0.3
 """Side (m) of the crate an injected ``block`` fault drops on the route."""
 BLOCK_CLEARANCE = 1.5
 """The crate falls at least this far (m) from the route's start and its goal."""
+BLOCK_NEAR = 1.0
+"""A deferred crate (Nav2's FollowPath) falls when the robot comes this close (m) to its place."""
 CRATE_DROP_HEIGHT = 0.3
 """Height (m) of the crate's underside above the floor when it appears: it falls into place."""
 CRATE_MASS = 8.0
@@ -199,6 +205,8 @@ class FaultInjector:
     seed: int = 0
     clock: Any = None
     events: list[FaultEvent] = field(default_factory=list)
+    pending_blocks: dict[str, PendingBlock] = field(default_factory=dict)
+    """Per robot, a drawn ``block`` whose crate has not fallen yet (see :meth:`defer_block`)."""
 
     def __post_init__(self) -> None:
         self._rng = np.random.default_rng([int(self.seed) & 0xFFFFFFFF, 0xFA17])
@@ -259,6 +267,20 @@ class FaultInjector:
             self._offsets[object_name] = offset
             self.events.append(FaultEvent(POSE_NOISE, object_name, self._now(), offset.text()))
         return offset
+
+    def defer_block(self, robot: str, block: PendingBlock) -> None:
+        """Keep ``block`` until ``robot`` comes near its place (:meth:`due_block`); a robot has
+        at most one pending crate (a later draw replaces an earlier one that never fell)."""
+        self.pending_blocks[robot] = block
+
+    def due_block(self, robot: str, x: float, y: float) -> PendingBlock | None:
+        """The pending crate of ``robot`` when (``x``, ``y``) is within :data:`BLOCK_NEAR` of
+        its place (it is then no longer pending), else None."""
+        block = self.pending_blocks.get(robot)
+        if block is None or np.hypot(block.x - x, block.y - y) > BLOCK_NEAR:
+            return None
+        del self.pending_blocks[robot]
+        return block
 
     def report(self) -> list[dict[str, Any]]:
         out: list[dict[str, Any]] = []
@@ -342,13 +364,22 @@ def slip_out(world: Any, robot: Any, slip: PendingSlip) -> None:
     robot.set_gripper(robot.description.gripper.max_opening)
 
 
-def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) -> str | None:
-    """The ``block`` fault for a navigation along ``polyline`` (rows x, y, ...) to ``route``.
+@dataclass(frozen=True)
+class PendingBlock:
+    """A ``block`` fault drawn for a route: a crate is due at (``x``, ``y``) on it."""
 
-    A crate falls on the route, at the middle point of the route that is at least
+    x: float
+    y: float
+    route: str
+
+
+def plan_block(injector: FaultInjector, polyline: Any, route: str) -> PendingBlock | None:
+    """Draw the ``block`` fault for a navigation along ``polyline`` (rows x, y, ...) to
+    ``route``; where the crate is due when it was drawn.
+
+    The crate's place is the middle point of the route that is at least
     :data:`BLOCK_CLEARANCE` from both ends (a route with no such point gets none, and nothing is
-    drawn): it tests going around an obstacle, not a goal made unreachable. Returns the crate's
-    name, or None when none fell.
+    drawn): the fault tests going around an obstacle, not a goal made unreachable.
     """
     if not injector.specs or polyline is None or len(polyline) < 2:
         return None
@@ -358,17 +389,24 @@ def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) 
     )
     if not far.any() or not injector.block(route):
         return None
-    from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
-
     candidates = np.flatnonzero(far)
     x, y = pts[candidates[len(candidates) // 2]]
+    return PendingBlock(float(x), float(y), route)
+
+
+def drop_crate(world: Any, injector: FaultInjector, block: PendingBlock) -> str | None:
+    """Drop the crate of ``block``: it appears :data:`CRATE_DROP_HEIGHT` above the floor at its
+    place and falls. Returns the crate's name, or None when it could not appear there (it would
+    start inside a body; the fault's event says so)."""
+    from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
+
     n = sum(1 for name in world.movable if name.startswith("dropped_crate"))
     spec = BodySpec(
         name=f"dropped_crate_{n}",
         movable=True,
         parts=[Part("box", (BLOCK_SIZE,) * 3, colour=COLOURS["brown"])],
         urdf=None,
-        pose=Pose3D((float(x), float(y), BLOCK_SIZE / 2 + CRATE_DROP_HEIGHT)),
+        pose=Pose3D((block.x, block.y, BLOCK_SIZE / 2 + CRATE_DROP_HEIGHT)),
         planar=False,
         mass=CRATE_MASS,
         friction=CRATE_FRICTION,
@@ -379,6 +417,17 @@ def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) 
     try:
         world.spawn(spec)
     except ValueError as exc:  # it would start inside a body, or the name is taken
-        injector.events[-1].note = f"no crate fell: {exc}"
+        for event in reversed(injector.events):
+            if event.kind == "block" and event.target == block.route:
+                event.note = f"no crate fell: {exc}"
+                break
         return None
     return spec.name
+
+
+def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) -> str | None:
+    """The ``block`` fault for a navigation along ``polyline`` to ``route``, at once: drawn as
+    :func:`plan_block` says, the crate falls now (:func:`drop_crate`). Returns the crate's name,
+    or None when none fell."""
+    block = plan_block(injector, polyline, route)
+    return drop_crate(world, injector, block) if block is not None else None

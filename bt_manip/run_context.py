@@ -6,7 +6,9 @@ timers) plus what a run with a world adds:
 - ``faults``: the run's :class:`~bt_manip.faults.FaultInjector` (None: no faults injected);
 - ``overlay``: the :class:`~bt_manip.overlay.Overlay` that behaviours draw on and viewers read;
 - :meth:`RunContext.robot_services`: per robot, its navigator and arm IK, built on first use
-  and kept for the rest of the run.
+  and kept for the rest of the run;
+- ``running``: the robot actions RUNNING now (:class:`RunningActions`), so that a node can
+  cancel another node's action (Nav2's Cancel* nodes).
 
 The episode (:mod:`bt_manip.episode`) builds one per run; a Python-authored tree that acts on a
 world is given one with :meth:`RunContext.for_world`. Nothing of a run is kept on the simulator's
@@ -16,7 +18,7 @@ objects: a second run on the same world starts with fresh services.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from bt_manip.bt.context import TreeContext
 from bt_manip.overlay import Overlay
@@ -91,12 +93,43 @@ class RobotServices:
         return self._arm_iks[tip]
 
 
+class Cancellable(Protocol):
+    """A running robot action as :class:`RunningActions` holds it."""
+
+    def cancel(self, reason: str) -> None: ...
+
+
+@dataclass
+class RunningActions:
+    """The robot actions of a run that are RUNNING now, with the robot each acts on.
+
+    A robot action adds itself when it starts and removes itself when it finishes or is
+    halted (:class:`~bt_manip.behaviours.base.RobotAction`); :meth:`of_kind` finds the ones
+    another node may cancel.
+    """
+
+    _actions: dict[int, tuple[Cancellable, str]] = field(default_factory=dict, repr=False)
+
+    def started(self, action: Cancellable, robot: str) -> None:
+        self._actions[id(action)] = (action, robot)
+
+    def finished(self, action: Cancellable) -> None:
+        self._actions.pop(id(action), None)
+
+    def of_kind(self, kind: type, robot: str) -> list[Cancellable]:
+        """The running actions that are instances of ``kind`` and act on ``robot`` (or on
+        the world's only robot, registered as "")."""
+        return [a for a, r in self._actions.values()
+                if isinstance(a, kind) and (r == robot or not r)]
+
+
 @dataclass
 class RunContext(TreeContext):
     """A tree context with the services of a run (see the module docstring)."""
 
     faults: FaultInjector | None = None
     overlay: Overlay = field(default_factory=Overlay)
+    running: RunningActions = field(default_factory=RunningActions)
     _robots: dict[str, RobotServices] = field(default_factory=dict, init=False, repr=False)
 
     @classmethod

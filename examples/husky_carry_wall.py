@@ -14,8 +14,9 @@ from pathlib import Path
 from bt_manip.behaviours.arm import Lift, MoveJoints, MoveJointsSequentially
 from bt_manip.behaviours.attach import Attach
 from bt_manip.behaviours.conditions import CarriedClear, IsAttached, ObjectAbove
+from bt_manip.behaviours.get_clear import GetClear
 from bt_manip.behaviours.gripper import CloseGripper, OpenGripper
-from bt_manip.behaviours.navigate import Navigate, Reverse
+from bt_manip.behaviours.navigate import Navigate
 from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
@@ -39,7 +40,7 @@ def grasp_panel() -> Fallback:
                 Navigate("to_pregrasp", goal="pregrasp_panel", xy_tolerance=0.03,
                          yaw_tolerance=0.03),
                 Sequence("clear_and_drive_again", children=[
-                    ForceSuccess(child=Reverse("reverse", distance=0.5)),
+                    ForceSuccess(child=GetClear("get_clear", distance=0.5, near=0.3)),
                     AlwaysFailure("drive_failed"),
                 ]),
             ])),
@@ -57,12 +58,14 @@ def grasp_panel() -> Fallback:
 
 
 def build(context: TreeContext | None = None) -> Tree:
-    """Fetch the panel (grasp retried), lift it, check the grasp, carry it to the goal."""
+    """Fetch the panel (grasp retried), lift it (straight up out of its stand first, then by
+    joints), check the grasp, carry it to the goal."""
     root = Sequence("carry_wall_panel", children=[
         MoveJoints("tuck_arm", state="tuck"),
         OpenGripper("open_gripper"),
         RetryUntilSuccessful("grasp_attempts", num_attempts=4,
                              child=SubTree("GraspPanel", child=grasp_panel())),
+        Lift("lift_out_of_stand", height=0.1, speed=0.3),
         Lift("lift_panel", deltas=LIFT_DEG, speed=0.3),
         Sequence("grasp_holds", children=[
             IsAttached("panel_attached", object="panel"),
@@ -72,7 +75,7 @@ def build(context: TreeContext | None = None) -> Tree:
             "carry_or_back_off", children=[
                 Navigate("carry_to_goal", goal="goal"),
                 Sequence("clear_and_retry", children=[
-                    ForceSuccess(child=Reverse("back_up", distance=0.5)),
+                    ForceSuccess(child=GetClear("back_up", distance=0.5, near=0.3)),
                     AlwaysFailure("carry_failed"),
                 ]),
             ])),

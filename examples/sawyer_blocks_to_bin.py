@@ -1,7 +1,7 @@
 """Scenario B authored in Python: the same tree as trees/sawyer_blocks_to_bin.xml.
 
-Run it against the world:
-    python examples/sawyer_blocks_to_bin.py --seed 3
+Run it against the world (or a variant, e.g. worlds/sawyer_table_bin_moved.yaml):
+    python examples/sawyer_blocks_to_bin.py --seed 3 [--world worlds/sawyer_table_bin_moved.yaml]
 or print it as BehaviorTree.CPP XML (for Groot2):
     python examples/sawyer_blocks_to_bin.py --xml
 """
@@ -14,6 +14,7 @@ from pathlib import Path
 from bt_manip.behaviours.arm import Lift, MoveJoints, MoveToPose
 from bt_manip.behaviours.conditions import IsHolding, ObjectInRegion
 from bt_manip.behaviours.gripper import CloseGripper, OpenGripper
+from bt_manip.behaviours.regions import DropPoint
 from bt_manip.behaviours.world_ops import DeleteModel, SpawnModel
 from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
@@ -23,16 +24,17 @@ from bt_manip.run_context import RunContext
 
 ROOT = Path(__file__).resolve().parents[1]
 
-BIN_GRID = [(x, y) for y in (-0.33, -0.25, -0.17) for x in (0.67, 0.75, 0.83)] + [(0.75, -0.25)]
-"""Where each block is let go: a 3 x 3 grid over the bin, then the centre again."""
-DROP_HEIGHT = 0.93
+CELLS = [0, 1, 2, 3, 4, 5, 6, 7, 8, 4]
+"""The cell of the 3 x 3 grid over the bin where each block is let go (the centre again for
+the tenth)."""
 
 
-def block_to_bin() -> Fallback:
-    """One block: pick top-down, lift, carry over its spot, release, check; retried once,
-    otherwise skipped (gripper opened, hand raised, counted)."""
+def block_to_bin() -> Sequence:
+    """One block: its drop point over the bin, then pick top-down, lift, carry over the drop
+    point, release, check; retried once, otherwise skipped (gripper opened, hand raised,
+    counted)."""
     pick_and_place = Sequence("pick_and_place", children=[
-        OpenGripper("open", opening=0.075),
+        OpenGripper("open", opening=0.06),
         MoveToPose("reach_block", object="{block}", match_object_yaw=True, approach=0.12,
                    path="line"),
         CloseGripper("grasp", require_object=True),
@@ -49,9 +51,13 @@ def block_to_bin() -> Fallback:
         ForceSuccess(child=Lift("clear_table", height=0.1)),
         Script("count_skip", code="skipped += 1"),
     ])
-    return Fallback("block_or_skip", children=[
-        RetryUntilSuccessful("try_twice", num_attempts=2, child=pick_and_place),
-        skip,
+    return Sequence("block_to_bin", children=[
+        DropPoint("drop_point", region="bin", index="{cell}", rows=3, cols=3, margin=0.02,
+                  clearance=0.0625, point="{drop}"),
+        Fallback("block_or_skip", children=[
+            RetryUntilSuccessful("try_twice", num_attempts=2, child=pick_and_place),
+            skip,
+        ]),
     ])
 
 
@@ -66,11 +72,11 @@ def count_if_in_bin() -> ForceSuccess:
 def build(context: TreeContext | None = None) -> Tree:
     """The whole task: spawn the blocks, start at home, each of the ten blocks, back home,
     count the blocks resting in the bin, delete the blocks, check."""
-    names = [f"block_{i}" for i in range(len(BIN_GRID))]
+    names = [f"block_{i}" for i in range(len(CELLS))]
     blocks = [
-        SubTree("BlockToBin", child=block_to_bin(), block=f"block_{i}",
-                drop=f"{x:g};{y:g};{DROP_HEIGHT:g}", in_bin="{in_bin}", skipped="{skipped}")
-        for i, (x, y) in enumerate(BIN_GRID)
+        SubTree("BlockToBin", child=block_to_bin(), block=f"block_{i}", cell=str(cell),
+                in_bin="{in_bin}", skipped="{skipped}")
+        for i, cell in enumerate(CELLS)
     ]
     root = Sequence("blocks_to_bin", children=[
         Script("init", code="in_bin := 0; skipped := 0; resting_in_bin := 0"),
@@ -92,6 +98,7 @@ def build(context: TreeContext | None = None) -> Tree:
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--world", default=str(ROOT / "worlds" / "sawyer_table.yaml"))
     parser.add_argument("--xml", action="store_true", help="print the tree as XML and stop")
     args = parser.parse_args()
     if args.xml:
@@ -100,7 +107,7 @@ def main() -> int:
     from bt_manip.runner import Runner
     from bt_manip.sim.world import World
 
-    with World(ROOT / "worlds" / "sawyer_table.yaml", seed=args.seed) as world:
+    with World(args.world, seed=args.seed) as world:
         tree = build(RunContext.for_world(world))
         report = Runner(tree, world).run()
         print(report.summary())

@@ -144,6 +144,7 @@ def test_groot_model_lists_the_robot_nodes_with_their_ports(
     robot_nodes = {
         "Navigate",
         "Reverse",
+        "GetClear",
         "MoveJointsSequentially",
         "MoveJoints",
         "MoveToPose",
@@ -159,6 +160,7 @@ def test_groot_model_lists_the_robot_nodes_with_their_ports(
         "CarriedClear",
         "SpawnModel",
         "DeleteModel",
+        "DropPoint",
     }
     assert robot_nodes <= set(nodes)
     assert "Sequence" not in nodes and "Timeout" not in nodes  # built-ins are not listed
@@ -166,11 +168,11 @@ def test_groot_model_lists_the_robot_nodes_with_their_ports(
     assert {"targets", "order", "units", "tolerance", "speed"} <= set(ports)
     assert ports["targets"].get("type") == "std::vector<double>"
     assert nodes["CloseGripper"].tag == "Action" and nodes["IsAttached"].tag == "Condition"
-    # the model file loads back: the scenario tree validates against it
-    assert (
-        main(["validate", str(ROOT / "trees" / "husky_carry_wall.xml"), "--models", str(model)])
-        == 0
-    )
+    drop = {p.get("name"): p for p in nodes["DropPoint"]}
+    assert drop["point"].tag == "output_port" and drop["index"].tag == "input_port"
+    # the model file loads back: the scenario trees validate against it
+    for scenario in ("husky_carry_wall.xml", "sawyer_blocks_to_bin.xml"):
+        assert main(["validate", str(ROOT / "trees" / scenario), "--models", str(model)]) == 0
 
 
 def test_bb_numbers_feed_ports_of_any_number_type_and_scripts(

@@ -6,6 +6,8 @@ import math
 import re
 from pathlib import Path
 
+import pytest
+
 from bt_manip.sim.world_spec import parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -66,3 +68,30 @@ def test_worlds_readme_describes_the_table_as_its_yaml_builds_it() -> None:
     assert ("ten 5 cm blocks of 0.1 kg on a 2 x 5 grid (x 0.7 and 0.8, y 0.0 to 0.4) at "
             "z = 0.7725 (jittered +-1 cm and +-10 deg per seed)") in text
     assert sorted(table.poses) == ["bin_drop"]
+
+
+def test_sawyer_world_variants_change_only_what_their_headers_say() -> None:
+    readme = (ROOT / "worlds" / "README.md").read_text()
+    base = parse_world(ROOT / "worlds" / "sawyer_table.yaml")
+    turned = parse_world(ROOT / "worlds" / "sawyer_table_yaw45.yaml")
+    moved = parse_world(ROOT / "worlds" / "sawyer_table_bin_moved.yaml")
+    quarter = (-0.7854, 0.7854)
+    for variant in (turned, moved):
+        assert [r.pose for r in variant.robots] == [r.pose for r in base.robots]
+        assert [(m.name, m.parts, m.pose, m.mass) for m in variant.models] == [
+            (m.name, m.parts, m.pose, m.mass) for m in base.models
+        ]
+        assert {(m.randomize.x, m.randomize.y, m.randomize.yaw) for m in variant.models} == {
+            ((-0.01, 0.01), (-0.01, 0.01), quarter)
+        }
+        assert [f.parts for f in variant.furniture] == [f.parts for f in base.furniture]
+    assert [f.pose for f in turned.furniture] == [f.pose for f in base.furniture]
+    assert "+-45 deg" in _section(readme, "sawyer_table_yaw45.yaml")
+    bin_ = {f.name: f for f in moved.furniture}["bin"]
+    assert bin_.pose.xyz == (0.84, -0.27, 0.8)
+    yaw = 2 * math.atan2(bin_.pose.quat[2], bin_.pose.quat[3])
+    assert math.degrees(yaw) == pytest.approx(20.0, abs=0.01)
+    text = _section(readme, "sawyer_table_bin_moved.yaml")
+    assert "the bin moved to (0.84, -0.27)" in text and "turned by 20 deg" in text
+    header = (ROOT / "worlds" / "sawyer_table_bin_moved.yaml").read_text()
+    assert "(0.84, -0.27)" in header and "turned by 20 deg" in header

@@ -205,7 +205,9 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     )
     text = capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
-    episodes = json.loads((out / "episodes.json").read_text())
+    listed = json.loads((out / "episodes.json").read_text())
+    assert listed["schema_version"] == summary["schema_version"] == 2
+    episodes = listed["episodes"]
     assert [e["seed"] for e in episodes] == [1, 2, 3, 4]
     assert summary["runs"] == 4
     assert summary["successes"] == sum(e["status"] == "SUCCESS" for e in episodes)
@@ -270,7 +272,10 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     _, err = proc.communicate(timeout=60)
     assert proc.returncode == 130, err
     assert "interrupted" in err.splitlines()
-    assert not (tmp_path / "out").exists()
+    # no episode finished: the log holds the bench's definition only, ready for --resume
+    lines = (tmp_path / "out" / "episodes.jsonl").read_text().splitlines()
+    assert len(lines) == 1 and '"kind": "bench"' in lines[0]
+    assert not (tmp_path / "out" / "episodes.json").exists()
 
 
 class _Room:
@@ -338,3 +343,27 @@ def test_pose_noise_sigmas_are_those_asked_for() -> None:
     assert len(dx) == 400
     assert 0.008 < float(np.std(dx)) < 0.012
     assert 0.8 * np.radians(2) < float(np.std(dyaw)) < 1.2 * np.radians(2)
+
+
+def test_bench_lists_the_leaves_that_failed_and_in_how_many_episodes(tmp_path: Path) -> None:
+    from bt_manip.bench import run_one
+
+    tree = _retry_tree(tmp_path)
+    results = [
+        run_one(EpisodeSpec(tree=str(tree), seed=seed,
+                            inject=[parse_fault("step:failure:0.5")]))
+        for seed in range(8)
+    ]
+    for r in results:
+        drawn = sum(1 for e in r.injected if e["target"] == "step")
+        # every injected failure of the leaf is counted, and nothing else failed
+        assert r.leaf_failures == ({"RetryUntilSuccessful/step": drawn} if drawn else {})
+    s = summarise(results, EpisodeSpec(tree=str(tree)))
+    failed = [r for r in results if r.leaf_failures]
+    assert failed, "the seeds drew no failure"
+    assert s.leaf_failures == [{
+        "path": "RetryUntilSuccessful/step",
+        "episodes": len(failed),
+        "times": sum(r.leaf_failures["RetryUntilSuccessful/step"] for r in failed),
+    }]
+    assert "leaves that failed (episodes, times):" in s.text()

@@ -135,6 +135,10 @@ class RobotAction(WorldAccess, ActionNode):
       :class:`ActionFailed`).
     - When halted while RUNNING, the robot is left safe (base braked, arm holding) and
       :meth:`on_halt` runs.
+    - While RUNNING in a run, it is listed in the run's ``running`` actions, so that another
+      node may :meth:`cancel` it (Nav2's Cancel* nodes): the robot is left safe at once and
+      the action returns SUCCESS at its next tick, as Nav2's actions do when their goal is
+      cancelled.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
@@ -145,6 +149,7 @@ class RobotAction(WorldAccess, ActionNode):
         self.feedback_message = ""
         self._start_error: str | None = None
         self._slip: PendingSlip | None = None
+        self._cancelled: str | None = None
         self.started_at = self.now()
         try:
             self.start()
@@ -152,6 +157,30 @@ class RobotAction(WorldAccess, ActionNode):
                 self._draw_slip()
         except (ActionFailed, PortError) as exc:
             self._start_error = str(exc)
+        if self._start_error is None:
+            self._list_running()
+
+    def _list_running(self) -> None:
+        context = self.context
+        if not isinstance(context, RunContext) or context.world is None:
+            return
+        try:
+            robot = self.robot_name()
+        except (ActionFailed, PortError):
+            robot = ""
+        context.running.started(self, robot)
+
+    def _unlist_running(self) -> None:
+        context = self.context
+        if isinstance(context, RunContext):
+            context.running.finished(self)
+
+    def cancel(self, reason: str) -> None:
+        """Cancel the running action (another node asked): leave the robot safe now; the
+        action returns SUCCESS at its next tick, with ``reason`` as its feedback."""
+        self._cancelled = reason
+        self._make_safe()
+        self._unlist_running()
 
     def _draw_slip(self) -> None:
         """Whether a ``slip`` fault makes what the robot carries slip out during this move."""
@@ -171,6 +200,9 @@ class RobotAction(WorldAccess, ActionNode):
         if self._start_error is not None:
             self.feedback_message = self._start_error
             return Status.FAILURE
+        if getattr(self, "_cancelled", None) is not None:
+            self.feedback_message = f"cancelled: {self._cancelled}"
+            return Status.SUCCESS
         try:
             if self._slip is not None and self.now() >= self._slip.at:
                 slip, self._slip = self._slip, None
@@ -182,6 +214,7 @@ class RobotAction(WorldAccess, ActionNode):
             return Status.FAILURE
 
     def terminate(self, new_status: Status) -> None:
+        self._unlist_running()
         if new_status == Status.INVALID:
             self._make_safe()
             self.on_halt()

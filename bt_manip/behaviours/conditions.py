@@ -11,6 +11,7 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
 from bt_manip.behaviours.gripper import grasped_object
+from bt_manip.behaviours.regions import region_of
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port, count_of
 from bt_manip.geometry import rotation_matrix
@@ -59,15 +60,17 @@ class IsHolding(WorldCondition):
 
 @registry.register
 class ObjectInRegion(WorldCondition):
-    """SUCCESS when the centre of ``object`` lies in a box region, else FAILURE.
+    """SUCCESS when the centre of ``object`` lies in a box region, else FAILURE (also when
+    ``inside`` names no body of the world).
 
-    The region is either ``inside``, the name of a body (its bounding box, e.g. a bin), or
-    ``min``/``max`` corners as ``x;y;z``.
+    The region is either ``inside``, the name of a body (its box in its own frame, e.g. a bin,
+    turned with it; see :mod:`bt_manip.behaviours.regions`), or ``min``/``max`` world corners
+    as ``x;y;z``.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "object": OBJECT,
-        "inside": PortInformation(str, False, "body whose bounding box is the region", ""),
+        "inside": PortInformation(str, False, "body whose box is the region", ""),
         "min": Port(list[float], False, "lower corner x;y;z", [], count_of(0, 3)),
         "max": Port(list[float], False, "upper corner x;y;z", [], count_of(0, 3)),
     }
@@ -77,17 +80,18 @@ class ObjectInRegion(WorldCondition):
         body = self.object_body(name)
         world = self.world
         inside = self.get_input("inside")
+        pos, _ = pb.getBasePositionAndOrientation(body, physicsClientId=world.client)
         if inside:
-            lo, hi = pbq.aabb(world.client, world.body_id(inside))
+            if region_of(world, inside).contains(np.asarray(pos)):
+                return True, ""
             region = f"'{inside}'"
         else:
             lo, hi = self.get_input("min"), self.get_input("max")
             if len(lo) != 3 or len(hi) != 3:
                 raise ActionFailed('give inside="body" or min="x;y;z" and max="x;y;z"')
             region = f"[{lo}, {hi}]"
-        pos, _ = pb.getBasePositionAndOrientation(body, physicsClientId=world.client)
-        if all(lo[i] <= pos[i] <= hi[i] for i in range(3)):
-            return True, ""
+            if all(lo[i] <= pos[i] <= hi[i] for i in range(3)):
+                return True, ""
         where = ", ".join(f"{v:.3f}" for v in pos)
         return False, f"'{name}' at ({where}) is not in {region}"
 

@@ -61,7 +61,8 @@ def spec_of(cls: type[BtNode]) -> NodeSpec:
             ports[name] = PortSpec(
                 name=name,
                 direction=direction_of(info, is_output),
-                type_name=cls.PORT_TYPE_NAMES.get(name) or type_name(info.data_type),
+                type_name=(cls.MODEL_TYPE_NAMES.get(name) or cls.PORT_TYPE_NAMES.get(name)
+                           or type_name(info.data_type)),
                 default=format_literal(info.default_value) if info.has_default else None,
                 description=info.description,
             )

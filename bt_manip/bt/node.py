@@ -127,6 +127,9 @@ class BtNode(PortsMixin):
     on one counter (0: never); they tell the failures of a node's last run from older ones
     (see :mod:`bt_manip.failure_cause`)."""
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
+    MODEL_TYPE_NAMES: ClassVar[dict[str, str]] = {}
+    """Type names the TreeNodesModel shows for ports, when they differ from those the
+    blackboard uses (e.g. Nav2's ROS message types, :mod:`bt_manip.nav2.model_types`)."""
 
     pre_tick: Callable[[BtNode], NodeStatus] | None = None
     """BT.CPP's pre-tick callback: called before the tick of a node that is not finished and

@@ -235,7 +235,10 @@ def type_from_name(name: str | None) -> Any:
     if not name:
         return object
     table = {"int": int, "unsigned": int, "unsigned int": int, "int64_t": int, "uint64_t": int,
-             "long": int, "double": float, "float": float, "bool": bool, "std::string": str,
+             "long": int, "short": int, "unsigned short": int, "int8_t": int, "uint8_t": int,
+             "int16_t": int, "uint16_t": int, "int32_t": int, "uint32_t": int, "size_t": int,
+             "std::chrono::milliseconds": int, "double": float, "float": float, "bool": bool,
+             "std::string": str,
              "string": str, "BT::NodeStatus": NodeStatus, "NodeStatus": NodeStatus,
              "std::vector<double>": list[float], "std::vector<int>": list[int],
              "std::vector<std::string>": list[str]}

@@ -14,27 +14,43 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
   (:mod:`.clearing`); PlannerSelector, ControllerSelector, GoalCheckerSelector,
   SmootherSelector (:mod:`.selectors`); ComputePathThroughPoses, RemovePassedGoals
   (:mod:`.through_poses`); TruncatePath, PathLongerOnApproach (a decorator) and
-  InitialPoseReceived (:mod:`.path_nodes`).
+  InitialPoseReceived (:mod:`.path_nodes`); SmoothPath (:mod:`.smoothing`);
+  TruncatePathLocal (:mod:`.path_local`); CancelControl, CancelBackUp, CancelSpin,
+  CancelWait, CancelDriveOnHeading (:mod:`.cancel`);
+- IsBatteryLow on the robot's simulated battery (:mod:`.battery`); the decorator GoalUpdater
+  (:mod:`.goal_updater`).
+
+The TreeNodesModel names the ports' types as Nav2 does (:mod:`.model_types`).
 
 The goal is a pose on the blackboard (``--bb "goal=x;y;yaw"`` or a named pose of the world);
 paths are :class:`~bt_manip.nav2.path.Nav2Path`; result codes are Nav2's numbers
 (:mod:`.errors`). Planning and following are bt-manip's navigation of the robot's base.
 """
 
+from bt_manip.bt.registry import registry
 from bt_manip.nav2 import (
     actions,
+    battery,
+    cancel,
     clearing,
     conditions,
     controls,
     decorators,
     frames,
+    goal_updater,
+    path_local,
     path_nodes,
     progress,
     selectors,
+    smoothing,
     through_poses,
 )
+from bt_manip.nav2.model_types import apply_model_types
+
+apply_model_types(registry)
 
 __all__ = [
-    "actions", "clearing", "conditions", "controls", "decorators", "frames", "path_nodes",
-    "progress", "selectors", "through_poses",
+    "actions", "battery", "cancel", "clearing", "conditions", "controls", "decorators",
+    "frames", "goal_updater", "path_local", "path_nodes", "progress", "selectors", "smoothing",
+    "through_poses",
 ]

@@ -21,11 +21,12 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
-from bt_manip.behaviours.navigate import synced_navigator
+from bt_manip.behaviours.navigate import sync_navigator, synced_navigator
 from bt_manip.bt.node import PortError
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
 from bt_manip.bt.registry import registry
-from bt_manip.nav2.blocking import maybe_block
+from bt_manip.nav2.blocking import drop_if_due, maybe_block
+from bt_manip.nav2.collision_ahead import AheadWatch, blocked_ahead
 from bt_manip.nav2.errors import BehaviorError, ControllerError, PlannerError
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
 from bt_manip.navigation.controller import FollowState, PathFollower
@@ -176,8 +177,8 @@ class ComputePathToPose(PlanAction):
       ``error_code_id`` is Nav2's code (204 GOAL_OUTSIDE_MAP, 206 GOAL_OCCUPIED,
       208 NO_VALID_PATH, ...) and ``error_msg`` says why; ``path`` is left as it was.
 
-    A ``block`` fault (``--inject block:P``) may drop a crate on the first route planned to a
-    goal.
+    A ``block`` fault (``--inject block:P``) is drawn for the first route planned to a goal:
+    its crate falls when FollowPath brings the robot near its place on the route.
     """
 
     UNKNOWN = PlannerError.UNKNOWN
@@ -232,9 +233,13 @@ class FollowPath(Nav2Action):
     - SUCCESS when the base is within Nav2's default goal tolerances (0.25 m, 0.25 rad) of the
       path's last pose;
     - FAILURE with 103 INVALID_PATH (no path or an empty one), 105 FAILED_TO_MAKE_PROGRESS
-      (the base stopped getting closer) or 106 NO_VALID_CONTROL (it ran into something; it
-      stops there).
+      (the base stopped getting closer) or 106 NO_VALID_CONTROL: a movable object lies on the
+      next 0.8 m of the path (checked at 5 Hz, :mod:`bt_manip.nav2.collision_ahead`),
+      or the robot ran into something; it stops there.
     Halted: the base is braked where it is.
+
+    A crate of an injected ``block`` fault falls when the robot comes near its place on the
+    route (:mod:`bt_manip.nav2.blocking`); it is looked for on the path in the same tick.
     """
 
     UNKNOWN = ControllerError.UNKNOWN
@@ -270,6 +275,10 @@ class FollowPath(Nav2Action):
         )
         self.follower = PathFollower(self.path.shifted(self.nav.pivot), self.path.goal, options)
         self.touching = contacts(self.world, robot, self.robot_name())
+        infos = self.world.infos
+        self.leaning_on = frozenset(infos[n].body_id for n in self.touching if n in infos)
+        """Bodies touched at the start: not obstacles ahead (the robot is already at them)."""
+        self.watch = AheadWatch()
 
     def step(self) -> Status:
         robot = self.robot()
@@ -284,7 +293,21 @@ class FollowPath(Nav2Action):
                 ControllerError.NO_VALID_CONTROL,
                 "ran into " + ", ".join(f"'{b}'" for b in sorted(bumped)),
             )
-        status = self.follower.update(robot.base_pose2d(), self.now())
+        pose = robot.base_pose2d()
+        pivot = ahead_of(pose, self.nav.pivot)
+        dropped = drop_if_due(self, *pivot)
+        if self.watch.due(self.now()) or dropped is not None:
+            sync_navigator(self.world, self.robot_name(), self.nav)  # objects that appeared
+            blocked = blocked_ahead(self.nav, path.shifted(self.nav.pivot), pivot,
+                                    self.leaning_on)
+            if blocked is not None:
+                robot.stop_base()
+                self.fail(
+                    ControllerError.NO_VALID_CONTROL,
+                    f"collision ahead: '{blocked.name}' lies on the path "
+                    f"{blocked.distance:.2f} m ahead",
+                )
+        status = self.follower.update(pose, self.now())
         if status.state is FollowState.SUCCEEDED:
             robot.stop_base()
             return Status.SUCCESS

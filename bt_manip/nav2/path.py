@@ -48,6 +48,8 @@ class Nav2Path:
         return len(self.poses)
 
     def __str__(self) -> str:
+        if len(self.poses) == 0:
+            return "empty path"
         return f"path of {len(self.poses)} poses, {self.length:.2f} m, to {self.goal_text()}"
 
     def goal_text(self) -> str:

@@ -23,6 +23,13 @@ from bt_manip.sim.events import Attached, Detached
 DEFAULT_MAX_DISTANCE = 0.01
 """Farthest an object may be from a finger (m) and still be attached."""
 
+SUPPORT_MARGIN = 0.001
+"""A static body this close (m) to an object when it is attached supports it, even where the
+last step found no contact point (a panel leaning on the side of its slot)."""
+
+LEAVE_CLEARANCE = 0.005
+"""Gap (m) an attached object must open from a support before the support counts as left."""
+
 HOLD_FORCE = 2000.0
 """Maximum force (N) the attach joint applies; high enough that a carried panel does not sag."""
 
@@ -125,9 +132,7 @@ class Attachments:
             object_name, body, robot_name, robot.body, link_index, link_name, cid
         )
         self._touched[object_name] = set()
-        self._supports[object_name] = {
-            c.body_b for c in pbq.contacts(self.client, body) if c.body_b != robot.body
-        }
+        self._supports[object_name] = self._supports_of(body, robot.body)
         world.events.announce(Attached(world.time, object_name, robot_name, link_name))
         return AttachResult(True, "", distance)
 
@@ -149,11 +154,21 @@ class Attachments:
             if i.kind in ("wall", "furniture", "ground")
         }
 
+    def _supports_of(self, body: int, robot_body: int) -> set[int]:
+        """Bodies ``body`` touches, or static bodies within :data:`SUPPORT_MARGIN` of it."""
+        out = {c.body_b for c in pbq.contacts(self.client, body) if c.body_b != robot_body}
+        for other in self._static_names():
+            if other not in out and pbq.closest_points(self.client, body, other, SUPPORT_MARGIN):
+                out.add(other)
+        return out
+
     def static_contacts(self, object_name: str) -> list[str]:
         """Static bodies (walls, furniture, floor) the attached object touches now.
 
-        What supported the object when it was attached (the floor, a rack) does not count until
-        the object has left it: lifting an object off its support is not a collision.
+        What supported the object when it was attached (the floor, a rack, the sides of a
+        slot) does not count until the object has left it, that is moved more than
+        :data:`LEAVE_CLEARANCE` away: lifting an object off or out of its support is not a
+        collision, touching the support again after that is.
         """
         held = self._by_object.get(object_name)
         if held is None:
@@ -161,7 +176,11 @@ class Attachments:
         static = self._static_names()
         supports = self._supports.get(object_name, set())
         touching = {c.body_b for c in pbq.contacts(self.client, held.object_body)}
-        supports &= touching  # a support left once is a support no more
+        for support in list(supports):  # a support left once is a support no more
+            if support not in touching and not pbq.closest_points(
+                self.client, held.object_body, support, LEAVE_CLEARANCE
+            ):
+                supports.discard(support)
         return sorted(static[b] for b in touching if b in static and b not in supports)
 
     def record_contacts(self) -> None:

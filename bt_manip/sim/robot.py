@@ -345,6 +345,9 @@ class Robot:
     def set_gripper(self, opening: float) -> None:
         """Command the distance between the finger pads (m), clipped to the gripper's stroke."""
         g = self.description.gripper
+        if not self.gripper_joint_ids:  # an arm without a gripper
+            self._gripper_target = 0.0
+            return
         finger = float(
             np.clip(
                 opening / len(self.gripper_joint_ids), min(g.closed, g.open), max(g.closed, g.open)

@@ -112,7 +112,10 @@ class ArmSpec:
 
 @dataclass(frozen=True)
 class GripperSpec:
-    """Parallel gripper: finger joints (each = pad distance from the centre line, m)."""
+    """Parallel gripper: finger joints (each = pad distance from the centre line, m).
+
+    An arm without a gripper has no joints (``joints == ()``): its opening stays 0.
+    """
 
     joints: tuple[str, ...]
     finger_links: tuple[str, ...]
@@ -333,13 +336,14 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     arm_base = f.text(a, "base_link", "arm")
     gain = f.real(a, "position_gain", "arm", 0.3, positive=True)
 
-    g = f.section(data, "gripper", GRIPPER_KEYS)
+    g = f.section(data, "gripper", GRIPPER_KEYS, required=False)
+    has_gripper = "gripper" in data
     gripper = GripperSpec(
-        f.names(g, "joints", "gripper"),
-        f.names(g, "finger_links", "gripper"),
-        f.real(g, "open", "gripper"),
-        f.real(g, "closed", "gripper"),
-        f.real(g, "max_force", "gripper", positive=True),
+        f.names(g, "joints", "gripper", required=has_gripper),
+        f.names(g, "finger_links", "gripper", required=has_gripper),
+        f.real(g, "open", "gripper", None if has_gripper else 0.0),
+        f.real(g, "closed", "gripper", None if has_gripper else 0.0),
+        f.real(g, "max_force", "gripper", None if has_gripper else 1.0, positive=True),
         f.real(g, "max_speed", "gripper", 0.1, positive=True),
         f.real(g, "pad_friction", "gripper", 1.5, minimum=0.0),
     )

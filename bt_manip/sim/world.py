@@ -8,6 +8,8 @@ the same run bit for bit.
 
 Randomisation: each object or robot with a ``randomize`` range gets offsets drawn from a
 generator seeded by (world seed, entity name), so adding an entity does not change the others.
+Groups (:mod:`bt_manip.sim.groups`) move their members, named poses included, by one rigid
+motion per seed before anything is built; ``World.spec`` is the world file so placed.
 """
 
 from __future__ import annotations
@@ -54,7 +56,8 @@ class BodyInfo:
     line: int
 
 
-def _sample(rng: np.random.Generator, r: Range2D) -> tuple[float, float, float]:
+def sample_offset(rng: np.random.Generator, r: Range2D) -> tuple[float, float, float]:
+    """Offsets (dx, dy, dyaw) drawn uniformly from the ranges of ``r``."""
     return (float(rng.uniform(*r.x)), float(rng.uniform(*r.y)), float(rng.uniform(*r.yaw)))
 
 
@@ -98,7 +101,12 @@ class World:
     """
 
     def __init__(self, path: str | Path, seed: int = 0, *, gui: bool = False) -> None:
-        self.spec: WorldSpec = parse_world(path)
+        from bt_manip.sim.groups import Rigid2D, place_groups
+
+        self.spec: WorldSpec
+        self.group_moves: dict[str, Rigid2D]
+        """Each group's rigid motion for this seed (the spec's members are already moved)."""
+        self.spec, self.group_moves = place_groups(parse_world(path), int(seed))
         self.path = Path(path)
         self.seed = int(seed)
         self.rate_hz = self.spec.physics.rate_hz
@@ -147,7 +155,7 @@ class World:
                 body.name, self._make_body(body, (0.0, 0.0, 0.0)), "furniture", body, body.line
             )
         for body in self.spec.objects:
-            offset = _sample(entity_rng(self.seed, body.name), body.randomize)
+            offset = sample_offset(entity_rng(self.seed, body.name), body.randomize)
             self._add(body.name, self._make_body(body, offset), "object", body, body.line)
         for rspec in self.spec.robots:
             try:
@@ -291,7 +299,7 @@ class World:
         from bt_manip.sim.robot import Robot, RobotDescription
 
         desc = RobotDescription.load(rspec.description_path)
-        dx, dy, dyaw = _sample(entity_rng(self.seed, rspec.name), rspec.randomize)
+        dx, dy, dyaw = sample_offset(entity_rng(self.seed, rspec.name), rspec.randomize)
         pose = rspec.pose
         robot = Robot.spawn(self.client, desc, pose.x + dx, pose.y + dy, pose.yaw + dyaw)
         if rspec.arm_state is not None:
@@ -360,7 +368,7 @@ class World:
         if spec is None:
             known = ", ".join(sorted(self.models)) or "none"
             raise KeyError(f"no model named '{name}' in {self.path.name}; models: {known}")
-        return self.spawn(spec, _sample(entity_rng(self.seed, name), spec.randomize))
+        return self.spawn(spec, sample_offset(entity_rng(self.seed, name), spec.randomize))
 
     def spawn(self, spec: BodySpec, offset: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> int:
         """Add a body while the world runs (movable if ``spec.movable``), moved by ``offset``
@@ -465,6 +473,12 @@ class World:
             lines.append(
                 f"  robot {name} ({robot.description.name}) at "
                 f"x={x:.3f} y={y:.3f} yaw={math.degrees(yaw):.1f} deg"
+            )
+        for name, move in self.group_moves.items():
+            lines.append(
+                f"  group {name} moved by dx={move.dx:.3f} dy={move.dy:.3f} "
+                f"dyaw={math.degrees(move.dyaw):.1f} deg about "
+                f"({move.origin[0]:.3f}, {move.origin[1]:.3f})"
             )
         if self.poses:
             lines.append("  named poses: " + ", ".join(sorted(self.poses)))

@@ -9,8 +9,10 @@ A world file describes, in metres, radians and kilograms (see ``worlds/README.md
 ``models``     movable bodies declared like ``objects`` but not spawned: a tree adds them
                (SpawnModel) and may remove them (DeleteModel);
 ``robots``     a robot ``description`` (``robots/<name>.yaml``), a start ``pose``, an
-               ``arm_state`` and ``randomize``;
-``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees.
+               ``arm_state``, ``randomize`` and a simulated ``battery`` (``percentage``,
+               ``voltage``, ``drain`` per second);
+``poses``      named planar poses ``[x, y, yaw]`` (or ``{x, y, qz, qw}``) for trees;
+``groups``     entities moved together by one rigid motion (see :mod:`bt_manip.sim.groups`).
 
 Every problem found is collected with its file and line; :func:`parse_world` raises one
 :class:`~bt_manip.errors.InputError` with all of them.
@@ -132,6 +134,20 @@ class BodySpec:
     scale: float = 1.0
 
 
+@dataclass(frozen=True)
+class BatterySpec:
+    """A robot's simulated battery: its charge (0..1) and voltage at the start, and how much
+    charge it loses per second of sim time (the voltage stays as given)."""
+
+    percentage: float = 1.0
+    voltage: float = 12.0
+    drain: float = 0.0
+
+    def percentage_at(self, t: float) -> float:
+        """The charge left after ``t`` seconds of sim time (never below 0)."""
+        return max(0.0, self.percentage - self.drain * max(0.0, t))
+
+
 @dataclass
 class RobotSpec:
     name: str
@@ -141,6 +157,7 @@ class RobotSpec:
     arm_state: str | None
     randomize: Range2D
     line: int
+    battery: BatterySpec = field(default_factory=BatterySpec)
 
 
 @dataclass
@@ -166,6 +183,8 @@ class WorldSpec:
     robots: list[RobotSpec] = field(default_factory=list)
     poses: dict[str, Pose2D] = field(default_factory=dict)
     pose_lines: dict[str, int] = field(default_factory=dict)
+    groups: list[Any] = field(default_factory=list)
+    """:class:`~bt_manip.sim.groups.GroupSpec` entries: members moved together."""
 
 
 TOP_KEYS = {
@@ -178,6 +197,7 @@ TOP_KEYS = {
     "models",
     "robots",
     "poses",
+    "groups",
 }
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
@@ -186,7 +206,10 @@ SHAPE_KEYS = {"shape", "size", "radius", "height"}
 PART_KEYS = SHAPE_KEYS | {"xyz", "rpy", "colour", "color"}
 BODY_KEYS = SHAPE_KEYS | {"name", "parts", "urdf", "scale", "pose", "colour", "color"}
 OBJECT_KEYS = BODY_KEYS | {"mass", "friction", "randomize"}
-ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize"}
+ROBOT_KEYS = {"name", "description", "pose", "arm_state", "randomize", "battery"}
+BATTERY_KEYS = {"percentage", "voltage", "drain"}
+BATTERY_VOLTAGE = (0.0, 1000.0)
+"""Battery voltages accepted (V)."""
 RANDOM_KEYS = {"x", "y", "yaw"}
 
 
@@ -514,9 +537,30 @@ def _parse_robots(rd: _Reader, robots: LineList, base: Path) -> list[RobotSpec]:
         if pose is None:
             continue
         out.append(
-            RobotSpec(name, desc, desc_path, pose, arm_state, rd.randomize(d, where), d.line)
+            RobotSpec(name, desc, desc_path, pose, arm_state, rd.randomize(d, where), d.line,
+                      _parse_battery(rd, d, where))
         )
     return out
+
+
+def _parse_battery(rd: _Reader, d: LineDict, where: str) -> BatterySpec:
+    """A robot's ``battery`` mapping (absent: full, 12 V, no drain)."""
+    if "battery" not in d:
+        return BatterySpec()
+    b = rd.mapping(d["battery"], d.line_of("battery"), f"{where}.battery")
+    if b is None:
+        return BatterySpec()
+    here = f"{where}.battery"
+    rd.unknown_keys(b, BATTERY_KEYS, here)
+    default = BatterySpec()
+    percentage = rd.number(b, "percentage", here, default.percentage, within=(0.0, 1.0))
+    voltage = rd.number(b, "voltage", here, default.voltage, within=BATTERY_VOLTAGE)
+    drain = rd.number(b, "drain", here, default.drain, within=(0.0, 1.0))
+    return BatterySpec(
+        default.percentage if percentage is None else percentage,
+        default.voltage if voltage is None else voltage,
+        default.drain if drain is None else drain,
+    )
 
 
 PHYSICS_RATES = (10.0, 10_000.0)
@@ -574,6 +618,9 @@ def parse_world(path: str | Path) -> WorldSpec:
             if p is not None:
                 spec.poses[name] = p
                 spec.pose_lines[name] = poses.line_of(name)  # type: ignore[union-attr]
+    from bt_manip.sim.groups import parse_groups
+
+    spec.groups = parse_groups(rd, data, spec)
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)

@@ -225,3 +225,33 @@ def test_through_poses_without_goals_gives_no_viapoints() -> None:
         status, _ = run(world, tree)
         assert status is NodeStatus.FAILURE
         assert tree.blackboard.get("code") == 309  # NO_VIAPOINTS_GIVEN
+
+
+def test_a_crate_falling_in_front_of_the_robot_takes_it_through_the_recovery_branch() -> None:
+    from bt_manip.bench import count_leaf_failures
+    from bt_manip.faults import FaultInjector, FaultSpec
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)
+        tree = load_tree(str(DEFAULT_TREE), context=RunContext.for_world(world, faults=faults),
+                         blackboard={"goal": "2.616;-0.715;0.848"})
+        failures = count_leaf_failures(tree)
+        status, recoveries = run(world, tree)
+        assert status is NodeStatus.SUCCESS
+        # FollowPath stopped for the crate, its own recovery (clearing the local costmap) did
+        # not help, so the navigation failed once and the recovery branch's first turn ran
+        assert failures["NavigateRecovery/NavigateWithReplanning/FollowPath/FollowPath"] == 2
+        assert recoveries == ["ClearingActions"]
+        assert [e.kind for e in faults.events] == ["block"]
+        x, y, yaw = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - 2.616, y + 0.715) <= 0.25
+        assert abs(math.remainder(yaw - 0.848, math.tau)) <= 0.25
+        # the robot went round the crate: it lies where it fell
+        import pybullet as pb
+
+        drop = faults.report()[0]
+        assert drop["kind"] == "block"
+        crate = world.movable["dropped_crate_0"]
+        cx, cy, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)[0]
+        route = tree.blackboard.get("path").poses[:, :2]
+        assert np.hypot(route[:, 0] - cx, route[:, 1] - cy).min() >= 0.3

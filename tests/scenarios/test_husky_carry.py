@@ -69,3 +69,38 @@ def test_an_injected_attach_failure_is_recovered() -> None:
 def _draws(fault: FaultSpec, seed: int) -> list[bool]:
     injector = FaultInjector([fault], seed=seed)
     return [injector.node_fails("attach_panel", "Attach") for _ in range(2)]
+
+
+TURNED = str(ROOT / "worlds" / "tb3_house_panel_turned.yaml")
+SOUTH = str(ROOT / "worlds" / "tb3_house_panel_south.yaml")
+
+
+def test_a_panel_leaning_in_its_slot_is_lifted_out_without_counting_a_touch() -> None:
+    # in this world and seed the closing gripper leaves the panel leaning on a rail of its
+    # stand: sliding up along the rail it leans on is leaving the stand, not hitting it
+    with Episode(EpisodeSpec(tree=TREE, world=SOUTH, seed=0)) as episode:
+        report = episode.run()
+        assert report.status == "SUCCESS", report.reason
+        assert episode.world.attachments.touched("panel") == []
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_panel_set_moved_and_turned_is_fetched_and_delivered(seed: int) -> None:
+    with Episode(EpisodeSpec(tree=TREE, world=TURNED, seed=seed)) as episode:
+        report = episode.run()
+        world = episode.world
+        assert report.status == "SUCCESS", report.reason
+        statuses = {n.path.split("/")[-1]: n.last_status for n in report.nodes}
+        assert statuses["lift_out_of_stand"] == "SUCCESS"
+        # the goal of this world, in the middle of the living room
+        goal = world.poses["goal"]
+        assert (goal.x, goal.y) == (4.6, -1.0)
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - goal.x, y - goal.y) <= 0.10
+        assert world.attachments.is_attached("panel", "husky")
+        assert world.attachments.touched("panel") == []
+        lo, _ = pb.getAABB(world.movable["panel"], physicsClientId=world.client)
+        assert lo[2] >= 0.1
+        # the stand stayed where the group put it, in the workshop
+        stand = world.body_pose("panel_stand").xyz
+        assert stand[0] < 0.0 and stand[1] < -1.0

@@ -1,0 +1,212 @@
+"""Regions of the world named by a body, and points computed from them.
+
+A region is the box of a named body of the world (a bin, a tray, a table), taken in the body's
+own frame: for a body built of boxes, cylinders and spheres (furniture and objects of a world
+file) it is the smallest box around its parts in that frame, so a bin turned on the table gives
+a region turned with it; for any other body (a URDF with links or meshes) it is the body's
+world axis-aligned bounding box. :class:`~bt_manip.behaviours.conditions.ObjectInRegion`
+checks against the same region, so a point computed here lies in what it calls "inside".
+
+Nodes:
+
+- ``DropPoint``: the centre of one cell of a ``rows`` x ``cols`` grid laid over the top of a
+  region (inset by ``margin``), ``clearance`` metres above its top: where to let go of an
+  object so that it falls into a bin, each object on its own spot.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+import pybullet as pb
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ActionFailed, WorldAccess
+from bt_manip.bt import PortError, SyncActionNode, registry
+from bt_manip.bt.node import closest
+from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port
+from bt_manip.geometry import rotation_matrix
+from bt_manip.sim import pybullet_queries as pbq
+
+MAX_CELLS_PER_SIDE = 100
+"""Largest number of rows or columns of a grid."""
+MAX_CLEARANCE = 2.0
+"""Highest a point may be above its region (m)."""
+
+
+@dataclass(frozen=True)
+class Region:
+    """A box in the world: ``lower``/``upper`` corners in the frame ``pose`` (a 4x4 world
+    transform)."""
+
+    name: str
+    pose: np.ndarray
+    lower: np.ndarray
+    upper: np.ndarray
+
+    @property
+    def size(self) -> np.ndarray:
+        """Extents (x, y, z) of the box in its frame."""
+        extent: np.ndarray = self.upper - self.lower
+        return extent
+
+    def to_world(self, local: np.ndarray) -> np.ndarray:
+        """A point of the region's frame in world coordinates."""
+        world: np.ndarray = self.pose[:3, :3] @ local + self.pose[:3, 3]
+        return world
+
+    def to_local(self, point: np.ndarray) -> np.ndarray:
+        """A world point in the region's frame."""
+        offset = np.asarray(point, dtype=float) - self.pose[:3, 3]
+        local: np.ndarray = self.pose[:3, :3].T @ offset
+        return local
+
+    def contains(self, point: np.ndarray) -> bool:
+        """Whether a world point lies in the box (its faces included)."""
+        local = self.to_local(point)
+        return bool(np.all(self.lower <= local) and np.all(local <= self.upper))
+
+
+_HALF_EXTENTS = {
+    pb.GEOM_BOX: lambda d: (d[0] / 2, d[1] / 2, d[2] / 2),
+    pb.GEOM_CYLINDER: lambda d: (d[1], d[1], d[0] / 2),  # (height, radius)
+    pb.GEOM_CAPSULE: lambda d: (d[1], d[1], d[0] / 2 + d[1]),
+    pb.GEOM_SPHERE: lambda d: (d[0], d[0], d[0]),
+}
+
+
+def region_of(world: Any, name: str) -> Region:
+    """The region of the body ``name`` of ``world``; ActionFailed naming the known bodies when
+    there is none."""
+    try:
+        body = world.body_id(name)
+    except KeyError:
+        known = sorted(world.infos)
+        raise ActionFailed(
+            f"no body named '{name}' in {world.path.name}{closest(name, set(known))}; "
+            f"bodies: {', '.join(known) or 'none'}"
+        ) from None
+    client = world.client
+    local = _local_box(client, body)
+    if local is not None:
+        pos, quat = pb.getBasePositionAndOrientation(body, physicsClientId=client)
+        pose = np.eye(4)
+        pose[:3, :3] = rotation_matrix(quat)
+        pose[:3, 3] = pos
+        return Region(name, pose, local[0], local[1])
+    boxes = [pbq.aabb(client, body, link) for link in range(-1, pb.getNumJoints(
+        body, physicsClientId=client))]
+    lower = np.min([b[0] for b in boxes], axis=0)
+    upper = np.max([b[1] for b in boxes], axis=0)
+    return Region(name, np.eye(4), np.asarray(lower, float), np.asarray(upper, float))
+
+
+def _local_box(client: int, body: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The box around a single-link body's primitive shapes in its base frame, or None when
+    the body has links or shapes of other kinds."""
+    if pb.getNumJoints(body, physicsClientId=client) > 0:
+        return None
+    shapes = pbq.collision_shapes(client, body, -1)
+    if not shapes or any(s.geometry_type not in _HALF_EXTENTS for s in shapes):
+        return None
+    corners = []
+    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    for s in shapes:
+        half = np.asarray(_HALF_EXTENTS[s.geometry_type](s.dimensions), dtype=float)
+        rot = rotation_matrix(s.local_orientation)
+        corners.append((signs * half) @ rot.T + np.asarray(s.local_position, dtype=float))
+    points = np.vstack(corners)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def grid_cell(
+    region: Region, index: int, rows: int, cols: int, margin: float, clearance: float
+) -> np.ndarray:
+    """World point over cell ``index`` of a ``rows`` x ``cols`` grid on top of ``region``.
+
+    The grid covers the region's box seen from above, inset by ``margin`` on every side;
+    columns run along the region's x axis and rows along its y axis, and cells are counted
+    row by row from the corner of lowest x and y. The point is the cell's centre, ``clearance``
+    above the top of the box. ActionFailed when ``index`` is not a cell of the grid or the
+    margin leaves no room.
+    """
+    cells = rows * cols
+    if not 0 <= index < cells:
+        raise ActionFailed(
+            f"index {index} is not a cell of the {rows} x {cols} grid over '{region.name}' "
+            f"(0..{cells - 1})"
+        )
+    lo = region.lower[:2] + margin
+    width = region.size[:2] - 2.0 * margin
+    if np.any(width <= 0.0):
+        raise ActionFailed(
+            f"margin {margin:g} m leaves no room inside '{region.name}' "
+            f"({region.size[0]:.3f} x {region.size[1]:.3f} m)"
+        )
+    col, row = index % cols, index // cols
+    local = np.array([
+        lo[0] + (col + 0.5) * width[0] / cols,
+        lo[1] + (row + 0.5) * width[1] / rows,
+        region.upper[2] + clearance,
+    ])
+    return region.to_world(local)
+
+
+@registry.register
+class DropPoint(WorldAccess, SyncActionNode):
+    """Computes where to let go of an object over a region: the centre of cell ``index`` of a
+    ``rows`` x ``cols`` grid laid over the top of ``region`` (a body of the world, e.g. the
+    ``bin``), inset by ``margin`` from its sides, ``clearance`` metres above its top.
+
+    The region is the body's box in its own frame, so the grid turns with a turned bin; the
+    columns run along the body's x axis, the rows along its y axis, and cells are counted row
+    by row from the corner of lowest x and y (``index`` 0 .. rows x cols - 1). ``point`` is
+    written as a list x;y;z (world), ready for ``MoveToPose position="{point}"``.
+
+    - SUCCESS with ``point`` written;
+    - FAILURE (reason in the feedback) when ``region`` names no body of the world, ``index``
+      is not a cell of the grid (or not a whole number), the margin leaves no room, or a
+      value read from the blackboard breaks its port's rule.
+    It finishes within its tick (never RUNNING), so there is nothing to halt.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "region": PortInformation(str, True, "body of the world whose box is the region (bin)"),
+        "index": Port(int, True, "cell number, row by row from the lowest x and y", None,
+                      NON_NEGATIVE),
+        "rows": Port(int, False, "cells along the region's y axis", 3,
+                     Accepts(1, MAX_CELLS_PER_SIDE)),
+        "cols": Port(int, False, "cells along the region's x axis", 3,
+                     Accepts(1, MAX_CELLS_PER_SIDE)),
+        "margin": Port(float, False, "inset of the grid from each side of the region (m)", 0.02,
+                       Accepts(0, 1)),
+        "clearance": Port(float, False, "height of the point above the region's top (m)", 0.06,
+                          Accepts(0, MAX_CLEARANCE)),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "point": PortInformation(list[float], False, "the drop point x;y;z (world)"),
+    }
+
+    def update(self) -> Status:
+        try:
+            region = region_of(self.world, self.get_input("region"))
+            index = self.get_input("index")
+            if index != int(index):  # a script's number from the blackboard
+                raise ActionFailed(f"index must be a whole number, got {index}")
+            point = grid_cell(
+                region,
+                int(index),
+                int(self.get_input("rows")),
+                int(self.get_input("cols")),
+                float(self.get_input("margin")),
+                float(self.get_input("clearance")),
+            )
+        except (ActionFailed, PortError) as exc:
+            self.feedback_message = str(exc)
+            return Status.FAILURE
+        self.feedback_message = ""
+        self.set_output("point", [float(v) for v in point])
+        return Status.SUCCESS

@@ -1,0 +1,37 @@
+"""From a building model (IFC) to a bt-manip world and an installation schedule.
+
+``bt-manip bim BUILDING.ifc --out DIR`` reads an IFC4 or IFC2X3 file with ifcopenshell (the
+optional extra ``bt-manip[bim]``) in the units of the file and writes:
+
+- ``DIR/world.yaml``: the walls of one storey with their door openings (a window leaves the
+  wall below and above it), the furniture as boxes, named poses at the spaces, the robot at a
+  start pose and a stock area where the elements to install wait in slotted stands;
+- ``DIR/schedule.json``: the elements to install in schedule order with their target poses.
+
+Modules: :mod:`~bt_manip.bim.ifc_input` (reading, bounds, ``file:line: #id IfcClass 'Name'``
+problems), :mod:`~bt_manip.bim.shapes` (element geometry as boxes), :mod:`~bt_manip.bim.building`
+(walls, openings, spaces, furniture), :mod:`~bt_manip.bim.schedule` (the 4D schedule or a CSV,
+and the elements to install), :mod:`~bt_manip.bim.floor_grid` (the floor as a grid: free spots,
+connected places), :mod:`~bt_manip.bim.routes` (carrying each element from the stock through
+the doors), :mod:`~bt_manip.bim.stock` (the stands), :mod:`~bt_manip.bim.world_file` (the world
+YAML), :mod:`~bt_manip.bim.convert` (the whole conversion) and :mod:`~bt_manip.bim.command`
+(the command line).
+"""
+
+from __future__ import annotations
+
+from bt_manip.errors import InputError
+
+INSTALL_HINT = "pip install 'bt-manip[bim]'"
+
+
+def require_ifcopenshell() -> None:
+    """Raise an InputError saying how to install ifcopenshell when it cannot be imported."""
+    try:
+        import ifcopenshell  # noqa: F401
+    except ImportError:
+        raise InputError.single(
+            "bt-manip bim",
+            None,
+            f"reading IFC files needs ifcopenshell, which is not installed: {INSTALL_HINT}",
+        ) from None

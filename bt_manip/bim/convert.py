@@ -1,0 +1,423 @@
+"""``bt-manip bim``: an IFC building and its schedule to ``world.yaml`` and ``schedule.json``.
+
+The steps: read the file (:mod:`~bt_manip.bim.ifc_input`), find the elements to install and
+their order (:mod:`~bt_manip.bim.schedule`), read the storey without them
+(:mod:`~bt_manip.bim.building`), paint the floor grid, place the stock and the robot, check
+that each element can be carried from the stock to its place through the doors
+(:mod:`~bt_manip.bim.floor_grid`), and write the world and the schedule. Every problem of the
+input is collected and reported as ``file:line: #id IfcClass 'Name': message``.
+
+The installation tree (``DIR/install.xml``: fetch each element from its stand, carry it, place
+and fasten it at its target pose in schedule order) is written from ``schedule.json`` by a later
+step, once the Place and Fasten nodes exist; :class:`Conversion` is its input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from bt_manip.bim.building import Building, Names, choose_storey, read_building
+from bt_manip.bim.floor_grid import FloorGrid, Rect
+from bt_manip.bim.ifc_input import IfcSource, open_ifc
+from bt_manip.bim.routes import CLEARANCE, check_routes, floor_grid
+from bt_manip.bim.schedule import (
+    MAX_ELEMENTS,
+    InstallElement,
+    PlannedElement,
+    schedule_from_csv,
+    schedule_from_tasks,
+)
+from bt_manip.bim.shapes import ShapeReader, UnsupportedGeometry, footprint_box, is_box_like
+from bt_manip.bim.shapes import placement_yaw as _placement_yaw
+from bt_manip.bim.stock import (
+    StockPose,
+    apron_pose,
+    element_entry,
+    footprint,
+    place_stock,
+    slots,
+    stand_entry,
+    stand_rects,
+)
+from bt_manip.bim.world_file import building_entries, r
+from bt_manip.errors import InputError
+
+DEFAULT_DENSITY = 420.0
+"""Mass density (kg/m3) of an element whose material gives none: a light board, like Scenario
+A's panel (1.5 kg for 1.2 x 0.02 x 0.15 m)."""
+START_JITTER = 0.2
+"""The robot's start is moved by up to this much (m in x and y) per seed; 1.5x that in rad."""
+SCHEMA_VERSION = 1
+
+
+@dataclass
+class BimOptions:
+    """What ``bt-manip bim`` was asked for."""
+
+    ifc: Path
+    out: Path
+    schedule: Path | None = None
+    robot: str = "husky_ur3"
+    stock: tuple[float, float, float] | None = None
+    start_space: str | None = None
+
+
+@dataclass
+class Conversion:
+    """The result: the building read, the elements in order, and the files written."""
+
+    source: Path
+    schema: str
+    storey: str
+    building: Building
+    elements: list[InstallElement]
+    stock: StockPose
+    start: tuple[float, float, float]
+    world_path: Path
+    schedule_path: Path
+    notes: list[str] = field(default_factory=list)
+
+    def summary(self) -> str:
+        b = self.building
+        doors = sum(1 for w in b.walls for o in w.openings if o.passage)
+        closed = sum(1 for w in b.walls for o in w.openings if not o.passage)
+        xmin, ymin, xmax, ymax = b.extent
+        lines = [
+            f"{self.source}: {self.schema}, storey '{self.storey}', "
+            f"{xmax - xmin:.2f} m x {ymax - ymin:.2f} m",
+            f"  {_count(len(b.walls), 'wall')} with {_count(doors, 'passage')} and "
+            f"{_count(closed, 'closed opening')} (windows), {_count(len(b.spaces), 'space')}, "
+            f"{_count(len(b.furniture), 'piece')} of furniture",
+            f"  stock at ({self.stock.x:.2f}, {self.stock.y:.2f}) heading "
+            f"{math.degrees(self.stock.yaw):.0f} deg; robot start at ({self.start[0]:.2f}, "
+            f"{self.start[1]:.2f})",
+            f"  {len(self.elements)} elements to install, in order:",
+        ]
+        for e in self.elements:
+            t = e.target
+            lines.append(
+                f"  {e.order:3d}. {e.ifc_class} '{e.name}' ({e.global_id}) -> ({t['x']:.3f}, "
+                f"{t['y']:.3f}, {t['z']:.3f}) yaw {math.degrees(t['yaw']):.1f} deg, "
+                f"{e.size[0]:.2f} x {e.size[1]:.2f} x {e.size[2]:.2f} m, {e.mass:.2f} kg"
+                + (f", task '{e.task}'" if e.task else "")
+                + (f", start {e.start}" if e.start else "")
+            )
+        lines += [f"  note: {n}" for n in self.notes]
+        lines.append(f"wrote {self.world_path} and {self.schedule_path}")
+        return "\n".join(lines)
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" + ("" if n == 1 else "s")
+
+
+def convert(options: BimOptions) -> Conversion:
+    """Read the building, check it, write the world and the schedule; InputError on problems."""
+    from bt_manip.bim import require_ifcopenshell
+    from bt_manip.outputs import check_output_folder, make_folder
+    from bt_manip.sim.robot_description import RobotDescription, find_descriptor
+
+    require_ifcopenshell()
+    check_output_folder("--out", options.out)
+    descriptor = find_descriptor(options.robot)
+    if descriptor is None:
+        raise InputError.single("--robot", None, f"unknown robot '{options.robot}'")
+    robot = RobotDescription.load(descriptor)
+    fp = robot.footprint
+    robot_width = 2 * fp.radius if fp.is_circle else fp.width
+    robot_radius = fp.circumradius
+
+    source = open_ifc(options.ifc)
+    if options.schedule is not None:
+        planned = schedule_from_csv(source, options.schedule)
+    else:
+        planned = schedule_from_tasks(source)
+    if not planned:
+        _no_elements(source, options)
+    if len(planned) > MAX_ELEMENTS:
+        raise InputError.single(
+            str(source.path), None,
+            f"{len(planned)} elements to install, more than the limit of {MAX_ELEMENTS}",
+        )
+    storey = choose_storey(source)
+    names = Names()
+    building = read_building(source, storey, {p.entity.id() for p in planned}, names)
+    elements = _elements(source, planned, storey, building.floor_z, names)
+    source.raise_problems()
+
+    grid = floor_grid(building)
+    sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
+    stock = _stock_pose(options, source, building, grid, sizes)
+    world_stands: list[dict[str, Any]] = []
+    world_objects: list[dict[str, Any]] = []
+    for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
+        world_stands.append(stand_entry(names.make(f"stand_{e.object}", "stand"), slot, size))
+        world_objects.append(element_entry(e.object, slot, size, e.mass))
+        e.stock = {"x": r(slot.x), "y": r(slot.y), "z": r(size[2] / 2 + 0.0005), "yaw": r(slot.yaw)}
+        for rect in stand_rects(slot, size):
+            grid.block(rect)
+    apron = apron_pose(stock, sizes)
+    check_routes(source, building, grid, elements, apron, robot_width)
+    source.raise_problems()
+    start, jitter = _robot_start(options, building, grid, robot_radius)
+
+    walls, furniture = building_entries(building)
+    poses: dict[str, list[float]] = {"start": [r(v) for v in start], "stock": [r(v) for v in apron]}
+    half = robot_width / 2 + CLEARANCE
+    for space in sorted(building.spaces, key=lambda s: s.entity.id()):
+        spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
+                                  within=_space_rect(space))
+        if spot is not None:
+            space.key = _pose_key(space.name, poses)
+            poses[space.key] = [r(spot[0]), r(spot[1]), 0.0]
+    world: dict[str, Any] = {
+        "name": _world_name(source.path),
+        "description": (
+            f"generated by bt-manip bim from {source.path.name} ({source.schema}), storey "
+            f"'{storey.Name or storey.id()}'; floor extent "
+            + ", ".join(f"{v:.2f}" for v in building.extent)
+            + " m (xmin, ymin, xmax, ymax)"
+        ),
+        "walls": walls,
+        "furniture": furniture + world_stands,
+        "objects": world_objects,
+        "robots": [
+            {
+                "name": "robot",
+                "description": options.robot,
+                "pose": [r(v) for v in start],
+            }
+        ],
+        "poses": poses,
+    }
+    if "tuck" in robot.states:
+        world["robots"][0]["arm_state"] = "tuck"
+    if jitter > 0:
+        world["robots"][0]["randomize"] = {
+            "x": [-jitter, jitter], "y": [-jitter, jitter], "yaw": [-1.5 * jitter, 1.5 * jitter]
+        }
+    make_folder(options.out)
+    world_path = options.out / "world.yaml"
+    schedule_path = options.out / "schedule.json"
+    header = (
+        f"# Generated by `bt-manip bim {source.path.name}`: the building's walls, openings,\n"
+        "# furniture and spaces, the elements to install waiting in stands at the stock\n"
+        "# (their order and target poses are in schedule.json), and the robot.\n"
+    )
+    text = header + yaml.safe_dump(world, sort_keys=False, default_flow_style=None, width=100)
+    world_path.write_text(text)
+    conversion = Conversion(
+        source.path, source.schema, str(storey.Name or f"#{storey.id()}"), building, elements,
+        stock, start, world_path, schedule_path, list(building.notes),
+    )
+    schedule_path.write_text(json.dumps(_schedule_document(conversion, options), indent=2) + "\n")
+    _check_world(world_path)
+    return conversion
+
+
+def _no_elements(source: IfcSource, options: BimOptions) -> None:
+    if options.schedule is not None:
+        raise InputError.single(str(options.schedule), None, "the schedule lists no element")
+    if source.schema == "IFC2X3":
+        message = (
+            "no element to install: schedules are read from IFC4 files only; give the order "
+            "of an IFC2X3 file's elements with --schedule FILE.csv (GlobalId,start)"
+        )
+    else:
+        message = (
+            "no element to install: no IfcTask is linked (IfcRelAssignsToProduct or "
+            "IfcRelAssignsToProcess) to an IfcPlate, IfcMember or IfcWall; link them or give "
+            "--schedule FILE.csv (GlobalId,start)"
+        )
+    projects = source.model.by_type("IfcProject")
+    if projects:
+        raise InputError([source.problem(projects[0], message)])
+    raise InputError.single(str(source.path), None, message)
+
+
+def _elements(
+    source: IfcSource, planned: list[PlannedElement], storey: Any, floor_z: float, names: Names
+) -> list[InstallElement]:
+    """Target pose, size and mass of each element to install (on ``storey``)."""
+    import ifcopenshell.util.element as util
+
+    from bt_manip.bim.building import storey_of
+
+    reader = ShapeReader(source.scale)
+    single = len(source.model.by_type("IfcBuildingStorey")) == 1
+    out: list[InstallElement] = []
+    for i, p in enumerate(planned):
+        el = p.entity
+        if not single:
+            on = storey_of(el)
+            if on is None or on.id() != storey.id():
+                where = f"storey '{on.Name}'" if on is not None else "no storey"
+                source.fail(
+                    el,
+                    f"it is on {where}; the world is built from storey '{storey.Name}' (the "
+                    "one holding the most walls) only",
+                )
+                continue
+        try:
+            solid = reader.solid(el)
+        except UnsupportedGeometry as exc:
+            source.fail(el, f"unsupported geometry: {exc}")
+            continue
+        box = footprint_box(solid.points, _placement_yaw(el))
+        if not is_box_like(solid, box):
+            source.fail(
+                el,
+                "unsupported geometry: an element to install must be an upright box (it fills "
+                f"{solid.volume / max(box.volume, 1e-12):.0%} of its upright bounding box)",
+            )
+            continue
+        density, where = None, ""
+        for material in util.get_materials(el):
+            for pset in util.get_psets(material).values():
+                value = pset.get("MassDensity")
+                if isinstance(value, int | float) and value > 0:
+                    density, where = float(value), f"MassDensity of '{material.Name}'"
+                    break
+            if density is not None:
+                break
+        if density is None:
+            density, where = DEFAULT_DENSITY, f"default density {DEFAULT_DENSITY:g} kg/m3"
+        x, y, z = box.centre
+        out.append(
+            InstallElement(
+                order=i + 1,
+                global_id=str(el.GlobalId),
+                name=str(el.Name or ""),
+                ifc_class=el.is_a(),
+                step_id=int(el.id()),
+                object=names.make(el.Name, f"element_{el.id()}"),
+                target={"x": r(x), "y": r(y), "z": r(z - floor_z), "yaw": r(box.yaw)},
+                size=[r(s) for s in box.size],
+                mass=r(density * solid.volume),
+                mass_source=where,
+                task=p.task,
+                start=p.start,
+                stock={},
+            )
+        )
+    return out
+
+
+def _space_rect(space: Any) -> Rect:
+    b = space.box
+    return Rect(b.centre[0], b.centre[1], b.size[0], b.size[1], b.yaw)
+
+
+def _largest_space(building: Building) -> Rect:
+    if building.spaces:
+        space = max(building.spaces, key=lambda s: (s.box.size[0] * s.box.size[1], -s.entity.id()))
+        return _space_rect(space)
+    xmin, ymin, xmax, ymax = building.extent
+    return Rect((xmin + xmax) / 2, (ymin + ymax) / 2, xmax - xmin, ymax - ymin)
+
+
+def _stock_pose(
+    options: BimOptions, source: IfcSource, building: Building, grid: FloorGrid,
+    sizes: list[tuple[float, float, float]],
+) -> StockPose:
+    if options.stock is not None:
+        pose = StockPose(*options.stock)
+        rect = footprint(pose, sizes)
+        if not grid.is_free(rect):
+            raise InputError.single(
+                "--stock", None,
+                f"the stock area ({rect.length:.2f} m x {rect.width:.2f} m with its apron, "
+                f"centred at ({rect.x:.2f}, {rect.y:.2f})) overlaps a wall, a closed opening "
+                "or furniture; give a free spot",
+            )
+        return pose
+    area = _largest_space(building)
+    placed = place_stock(grid, area, sizes)
+    if placed is None:
+        raise InputError.single(
+            str(source.path), None,
+            f"no free spot for the stock ({len(sizes)} stands) in the largest space: give one "
+            "with --stock X;Y;YAW",
+        )
+    return placed
+
+
+def _robot_start(
+    options: BimOptions, building: Building, grid: FloorGrid, robot_radius: float
+) -> tuple[tuple[float, float, float], float]:
+    """The robot's start (nearest the centre of its space with room to turn) and jitter."""
+    area = _largest_space(building)
+    label = "the largest space"
+    if options.start_space is not None:
+        wanted = options.start_space.lower()
+        match = [s for s in building.spaces if s.name.lower() == wanted or
+                 _pose_key(s.name, {}) == wanted]
+        if not match:
+            known = ", ".join(sorted(s.name for s in building.spaces)) or "none"
+            raise InputError.single("--start", None,
+                                    f"no space named '{options.start_space}'; spaces: {known}")
+        area = _space_rect(match[0])
+        label = f"space '{match[0].name}'"
+    for jitter in (START_JITTER, 0.0):
+        half = robot_radius + jitter * math.sqrt(2) + CLEARANCE
+        spot = grid.nearest_clear(area.x, area.y, half, within=area)
+        if spot is not None:
+            return (spot[0], spot[1], area.yaw), jitter
+    raise InputError.single(
+        "--start", None,
+        f"no free spot for the robot ({2 * robot_radius:.2f} m across) in {label}",
+    )
+
+
+def _pose_key(name: str, taken: dict[str, Any]) -> str:
+    import re
+
+    base = re.sub(r"[^A-Za-z0-9_]+", "_", name).strip("_").lower() or "space"
+    key, n = base, 2
+    while key in taken:
+        key, n = f"{base}_{n}", n + 1
+    return key
+
+
+def _world_name(path: Path) -> str:
+    import re
+
+    return re.sub(r"[^A-Za-z0-9_]+", "_", path.stem).strip("_") or "building"
+
+
+def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
+    return {
+        "schema_version": SCHEMA_VERSION,
+        "source": str(c.source),
+        "ifc_schema": c.schema,
+        "storey": c.storey,
+        "units": {"length": "m", "angle": "rad", "mass": "kg"},
+        "robot": options.robot,
+        "world": c.world_path.name,
+        "stock": {"x": r(c.stock.x), "y": r(c.stock.y), "yaw": r(c.stock.yaw)},
+        "spaces": [
+            {
+                "name": s.name,
+                "pose": s.key or None,
+                "global_id": str(s.entity.GlobalId),
+                "centre": [r(s.box.centre[0]), r(s.box.centre[1])],
+                "size": [r(s.box.size[0]), r(s.box.size[1])],
+                "yaw": r(s.box.yaw),
+            }
+            for s in c.building.spaces
+        ],
+        "elements": [asdict(e) for e in c.elements],
+    }
+
+
+def _check_world(path: Path) -> None:
+    """The written world must load: a problem here is bt-manip's, reported as such."""
+    from bt_manip.sim.world_spec import parse_world
+
+    parse_world(path)

@@ -1,0 +1,216 @@
+"""The floor as an occupancy grid: free spots for the robot and the stock, and routes.
+
+Walls (between their passages), window sills and lintels, furniture and the stock's stands are
+painted as blocked cells of a 5 cm grid over the building's extent (with a margin around it).
+A robot that is ``w`` wide (with what it carries) can be in a cell whose distance to the
+nearest blocked cell is at least ``w / 2``, so it passes a door exactly when the door is wider
+than ``w``; two places are joined when such cells connect them. Results are as fine as the
+grid (5 cm).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+from bt_manip.errors import InputError
+
+RESOLUTION = 0.05
+"""Cell size (m)."""
+MARGIN = 2.0
+"""Free floor (m) around the building's extent (a robot may go round the outside)."""
+MAX_CELLS = 25_000_000
+"""Cells at most, as for navigation grids (250 m x 250 m at 5 cm)."""
+
+
+@dataclass(frozen=True)
+class Rect:
+    """A rectangle on the floor: centre, length along ``yaw``, width across it."""
+
+    x: float
+    y: float
+    length: float
+    width: float
+    yaw: float = 0.0
+
+    def grown(self, d: float) -> Rect:
+        return Rect(self.x, self.y, self.length + 2 * d, self.width + 2 * d, self.yaw)
+
+
+class FloorGrid:
+    """Blocked cells, door cells and clearances over ``extent`` (xmin, ymin, xmax, ymax)."""
+
+    def __init__(
+        self, extent: tuple[float, float, float, float], resolution: float = RESOLUTION
+    ) -> None:
+        xmin, ymin, xmax, ymax = extent
+        self.res = resolution
+        self.x0 = xmin - MARGIN
+        self.y0 = ymin - MARGIN
+        nx = math.ceil((xmax - xmin + 2 * MARGIN) / resolution)
+        ny = math.ceil((ymax - ymin + 2 * MARGIN) / resolution)
+        if nx * ny > MAX_CELLS:
+            raise InputError.single(
+                "bt-manip bim",
+                None,
+                f"the building spans {xmax - xmin:.1f} m x {ymax - ymin:.1f} m: its floor grid "
+                f"would have {nx * ny} cells of {resolution} m, more than the limit of {MAX_CELLS}",
+            )
+        self.blocked = np.zeros((ny, nx), dtype=bool)
+        self.doors = np.zeros((ny, nx), dtype=np.int32)
+        self._clearance: np.ndarray | None = None
+        self._labels: dict[float, np.ndarray] = {}
+
+    # -- painting --------------------------------------------------------------------------
+    def cells(self, rect: Rect) -> tuple[np.ndarray, np.ndarray]:
+        """Row and column indices of the cells whose centres lie in ``rect``."""
+        c, s = math.cos(rect.yaw), math.sin(rect.yaw)
+        ex = abs(c) * rect.length / 2 + abs(s) * rect.width / 2
+        ey = abs(s) * rect.length / 2 + abs(c) * rect.width / 2
+        ny, nx = self.blocked.shape
+        i0 = max(math.floor((rect.x - ex - self.x0) / self.res), 0)
+        i1 = min(math.ceil((rect.x + ex - self.x0) / self.res), nx)
+        j0 = max(math.floor((rect.y - ey - self.y0) / self.res), 0)
+        j1 = min(math.ceil((rect.y + ey - self.y0) / self.res), ny)
+        if i0 >= i1 or j0 >= j1:
+            return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+        xs = self.x0 + (np.arange(i0, i1) + 0.5) * self.res - rect.x
+        ys = self.y0 + (np.arange(j0, j1) + 0.5) * self.res - rect.y
+        gx, gy = np.meshgrid(xs, ys)
+        u = gx * c + gy * s
+        v = -gx * s + gy * c
+        inside = (np.abs(u) <= rect.length / 2) & (np.abs(v) <= rect.width / 2)
+        rows, cols = np.nonzero(inside)
+        return rows + j0, cols + i0
+
+    def block(self, rect: Rect) -> None:
+        rows, cols = self.cells(rect)
+        self.blocked[rows, cols] = True
+        self._clearance = None
+        self._labels.clear()
+
+    def mark_door(self, rect: Rect, index: int) -> None:
+        """Label the cells of door ``index`` (0-based) so routes can name the doors they use."""
+        rows, cols = self.cells(rect)
+        self.doors[rows, cols] = index + 1
+
+    def is_free(self, rect: Rect) -> bool:
+        """No blocked cell in ``rect``, and ``rect`` lies on the grid."""
+        if not self._inside(rect):
+            return False
+        rows, cols = self.cells(rect)
+        return len(rows) > 0 and not bool(self.blocked[rows, cols].any())
+
+    def _inside(self, rect: Rect) -> bool:
+        ny, nx = self.blocked.shape
+        c, s = math.cos(rect.yaw), math.sin(rect.yaw)
+        ex = abs(c) * rect.length / 2 + abs(s) * rect.width / 2
+        ey = abs(s) * rect.length / 2 + abs(c) * rect.width / 2
+        return (
+            rect.x - ex >= self.x0
+            and rect.y - ey >= self.y0
+            and rect.x + ex <= self.x0 + nx * self.res
+            and rect.y + ey <= self.y0 + ny * self.res
+        )
+
+    # -- clearances and routes ---------------------------------------------------------------
+    def clearance(self) -> np.ndarray:
+        """Distance (m) from each cell to the nearest blocked cell's edge (0 when blocked)."""
+        if self._clearance is None:
+            from scipy.ndimage import distance_transform_edt
+
+            d = distance_transform_edt(~self.blocked) * self.res - self.res / 2
+            self._clearance = np.maximum(d, 0.0)
+        return self._clearance
+
+    def centre(self, row: int, col: int) -> tuple[float, float]:
+        return (self.x0 + (col + 0.5) * self.res, self.y0 + (row + 0.5) * self.res)
+
+    def nearest_clear(
+        self, x: float, y: float, half_width: float, within: Rect | None = None
+    ) -> tuple[float, float] | None:
+        """The cell centre nearest (x, y) with ``half_width`` of clearance (inside ``within``)."""
+        ok = self.clearance() >= half_width
+        if within is not None:
+            mask = np.zeros_like(ok)
+            rows, cols = self.cells(within)
+            mask[rows, cols] = True
+            ok &= mask
+        rows, cols = np.nonzero(ok)
+        if len(rows) == 0:
+            return None
+        xs = self.x0 + (cols + 0.5) * self.res
+        ys = self.y0 + (rows + 0.5) * self.res
+        k = int(np.argmin((xs - x) ** 2 + (ys - y) ** 2))
+        return (float(xs[k]), float(ys[k]))
+
+    def _near(
+        self, x: float, y: float, reach: float, ok: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        rows, cols = self.cells(Rect(x, y, 2 * reach, 2 * reach))
+        cx = self.x0 + (cols + 0.5) * self.res - x
+        cy = self.y0 + (rows + 0.5) * self.res - y
+        keep = (cx * cx + cy * cy <= reach * reach) & ok[rows, cols]
+        return rows[keep], cols[keep]
+
+    def joined(
+        self, a: tuple[float, float], b: tuple[float, float], half_width: float, reach: float
+    ) -> bool:
+        """Whether a robot ``2 * half_width`` wide can go from within ``reach`` of ``a`` to
+        within ``reach`` of ``b``."""
+        from scipy.ndimage import label
+
+        key = round(half_width, 4)
+        ok = self.clearance() >= half_width
+        if key not in self._labels:
+            self._labels[key] = label(ok)[0]
+        labels = self._labels[key]
+        ra, ca = self._near(a[0], a[1], reach, ok)
+        rb, cb = self._near(b[0], b[1], reach, ok)
+        return bool(set(labels[ra, ca].tolist()) & set(labels[rb, cb].tolist()))
+
+    def doors_on_route(
+        self, a: tuple[float, float], b: tuple[float, float], half_width: float, reach: float
+    ) -> list[int] | None:
+        """Doors (0-based indices) crossed by a shortest route (in cells) from near ``a`` to
+        near ``b`` for a robot ``2 * half_width`` wide, in order; None if there is none."""
+        ok = self.clearance() >= half_width
+        ra, ca = self._near(a[0], a[1], reach, ok)
+        rb, cb = self._near(b[0], b[1], reach, ok)
+        if len(ra) == 0 or len(rb) == 0:
+            return None
+        ny, nx = ok.shape
+        flat_ok = ok.ravel()
+        parent = np.full(ny * nx, -2, dtype=np.int64)
+        goal = np.zeros(ny * nx, dtype=bool)
+        goal[rb * nx + cb] = True
+        queue: deque[int] = deque()
+        for idx in (ra * nx + ca).tolist():
+            parent[idx] = -1
+            queue.append(idx)
+        found = -1
+        while queue:
+            idx = queue.popleft()
+            if goal[idx]:
+                found = idx
+                break
+            r, c = divmod(idx, nx)
+            for nb, valid in ((idx - nx, r > 0), (idx + nx, r < ny - 1),
+                              (idx - 1, c > 0), (idx + 1, c < nx - 1)):
+                if valid and flat_ok[nb] and parent[nb] == -2:
+                    parent[nb] = idx
+                    queue.append(nb)
+        if found < 0:
+            return None
+        doors = self.doors.ravel()
+        out: list[int] = []
+        idx = found
+        while idx >= 0:
+            d = int(doors[idx])
+            if d and (not out or out[-1] != d - 1):
+                out.append(d - 1)
+            idx = int(parent[idx])
+        return out[::-1]

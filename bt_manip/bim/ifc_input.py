@@ -1,0 +1,105 @@
+"""Reading an IFC file within bounds, and naming its entities in problems.
+
+An IFC file in the STEP physical format (ISO 10303-21) holds one entity per line
+(``#42=IFCWALL('2O2Fr$t4X7Zf8NOew3FLOH',$,'Wall 1',...);``), so a problem about an entity is
+reported as ``file:line: #42 IfcWall 'Wall 1': message``, the line found by scanning the file
+for ``#42=`` only when a problem is reported.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import MIB, read_bounded
+
+MAX_IFC_BYTES = 64 * MIB
+"""Largest IFC file read."""
+SCHEMAS = ("IFC2X3", "IFC4", "IFC4X3")
+"""Schemas read: ``IFC4X3`` and its addenda are read like IFC4."""
+
+_ENTITY_LINE = re.compile(rb"^[ \t]*#(\d+)[ \t]*=", re.MULTILINE)
+
+
+@dataclass
+class IfcSource:
+    """An opened IFC file: the ifcopenshell model, its bytes, its length unit in metres."""
+
+    path: Path
+    data: bytes
+    model: Any
+    scale: float
+    schema: str
+    problems: list[Problem] = field(default_factory=list)
+    _lines: dict[int, int] | None = None
+
+    def line_of(self, step_id: int) -> int | None:
+        """1-based line on which entity ``#step_id`` is defined (None if not found)."""
+        if self._lines is None:
+            self._lines = {}
+            for m in _ENTITY_LINE.finditer(self.data):
+                self._lines.setdefault(int(m.group(1)), self.data.count(b"\n", 0, m.start()) + 1)
+        return self._lines.get(step_id)
+
+    def problem(self, entity: Any, message: str) -> Problem:
+        """``file:line: #id IfcClass 'Name': message`` about ``entity``."""
+        step_id = int(entity.id())
+        name = getattr(entity, "Name", None)
+        label = f"#{step_id} {entity.is_a()}" + (f" '{name}'" if name else "")
+        return Problem(str(self.path), self.line_of(step_id), f"{label}: {message}")
+
+    def fail(self, entity: Any, message: str) -> None:
+        """Collect a problem about ``entity``."""
+        self.problems.append(self.problem(entity, message))
+
+    def raise_problems(self) -> None:
+        """Raise the collected problems, if any, as one InputError."""
+        if self.problems:
+            raise InputError(list(self.problems))
+
+
+def open_ifc(path: str | Path) -> IfcSource:
+    """Read and parse an IFC file (STEP format, at most :data:`MAX_IFC_BYTES`)."""
+    import ifcopenshell
+    import ifcopenshell.util.unit
+
+    path = Path(path)
+    data = read_bounded(path, MAX_IFC_BYTES, "IFC file")
+    head = data[:4096].lstrip(b"\xef\xbb\xbf \t\r\n")
+    if not head.startswith(b"ISO-10303-21;"):
+        hint = ""
+        if head.startswith(b"PK"):
+            hint = " (an .ifczip archive: unzip it first)"
+        elif head.startswith(b"<"):
+            hint = " (ifcXML is not read: export the model as .ifc)"
+        raise InputError.single(
+            str(path), 1, f"not an IFC file: it does not start with 'ISO-10303-21;'{hint}"
+        )
+    schema_match = re.search(rb"FILE_SCHEMA\s*\(\s*\(\s*'([A-Za-z0-9_]+)'", data[:65536])
+    if schema_match is None:
+        raise InputError.single(str(path), 1, "not an IFC file: no FILE_SCHEMA in its header")
+    schema = schema_match.group(1).decode().upper()
+    if not any(schema.startswith(s) for s in SCHEMAS):
+        line = data.count(b"\n", 0, schema_match.start()) + 1
+        raise InputError.single(
+            str(path), line, f"schema {schema} is not read; IFC2X3 and IFC4 files are"
+        )
+    try:
+        model = ifcopenshell.file.from_string(data.decode("utf-8", errors="replace"))
+    except Exception as exc:
+        raise InputError.single(str(path), None, f"cannot parse the IFC file: {exc}") from None
+    scale = float(ifcopenshell.util.unit.calculate_unit_scale(model))
+    return IfcSource(path, data, model, scale, model.schema)
+
+
+def check_count(source: IfcSource, ifc_class: str, found: list[Any], limit: int) -> None:
+    """Refuse a file holding more than ``limit`` entities of ``ifc_class``."""
+    if len(found) > limit:
+        raise InputError.single(
+            str(source.path),
+            None,
+            f"the file holds {len(found)} {ifc_class} entities, more than the limit of {limit}",
+        )

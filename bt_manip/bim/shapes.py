@@ -1,0 +1,263 @@
+"""The geometry of an IFC element as points in metres, and the box around them.
+
+:func:`element_solid` gives the corner points and the volume of an element's body, in world
+coordinates and metres. Simple bodies (extrusions of a rectangle or a polygon, the form walls,
+slabs, plates and openings usually take) are read directly from their placement and profile;
+anything else (meshes, mapped items, booleans, sweeps) goes through ifcopenshell's geometry
+kernel. :func:`footprint_box` fits the upright box of least footprint around the points: its
+centre, size (length along its yaw, width, height) and yaw; a body whose volume is much less
+than that box's is not box-like (a curved or L-shaped wall, a tilted element).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+BOX_FILL = 0.9
+"""A body is box-like when its volume is at least this share of its upright bounding box's
+(less the mitres of :func:`is_box_like`)."""
+
+
+class UnsupportedGeometry(Exception):
+    """The element's geometry cannot be read or is not what bt-manip models."""
+
+
+@dataclass(frozen=True)
+class Solid:
+    """The points (N x 3, metres, world frame) and volume (m3) of an element's body."""
+
+    points: np.ndarray
+    volume: float
+
+
+@dataclass(frozen=True)
+class Box:
+    """An upright box: centre (x, y, z), size (length along ``yaw``, width, height), yaw."""
+
+    centre: tuple[float, float, float]
+    size: tuple[float, float, float]
+    yaw: float
+
+    @property
+    def bottom(self) -> float:
+        return self.centre[2] - self.size[2] / 2
+
+    @property
+    def top(self) -> float:
+        return self.centre[2] + self.size[2] / 2
+
+    @property
+    def volume(self) -> float:
+        return self.size[0] * self.size[1] * self.size[2]
+
+    def axis(self) -> tuple[float, float]:
+        return (math.cos(self.yaw), math.sin(self.yaw))
+
+
+class ShapeReader:
+    """Reads element bodies of one IFC file; ``scale`` converts file lengths to metres."""
+
+    def __init__(self, scale: float) -> None:
+        self.scale = scale
+        self._settings: Any = None
+
+    def solid(self, element: Any) -> Solid:
+        """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
+        rep = body_representation(element)
+        if rep is None:
+            raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
+        fast = self._extrusions(element, rep)
+        return fast if fast is not None else self._kernel(element)
+
+    # -- simple extrusions, read directly -------------------------------------------------
+    def _extrusions(self, element: Any, rep: Any) -> Solid | None:
+        import ifcopenshell.util.placement as placement
+
+        items = list(rep.Items)
+        if not items or any(not item.is_a("IfcExtrudedAreaSolid") for item in items):
+            return None
+        if element.ObjectPlacement is None:
+            return None
+        world = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+        all_points: list[np.ndarray] = []
+        volume = 0.0
+        for item in items:
+            profile = _profile_points(item.SweptArea)
+            if profile is None:
+                return None
+            local = (
+                np.asarray(placement.get_axis2placement(item.Position), dtype=float)
+                if item.Position is not None
+                else np.eye(4)
+            )
+            direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
+            norm = float(np.linalg.norm(direction))
+            if norm < 1e-12 or len(direction) != 3:
+                return None
+            direction = direction / norm * float(item.Depth)
+            base = np.column_stack([profile, np.zeros(len(profile)), np.ones(len(profile))])
+            top = base.copy()
+            top[:, :3] += direction
+            pts = (world @ local @ np.vstack([base, top]).T).T[:, :3]
+            all_points.append(pts)
+            volume += _polygon_area(profile) * abs(float(direction[2]))
+        points = np.vstack(all_points) * self.scale
+        return Solid(points, volume * self.scale**3)
+
+    # -- anything else, through the geometry kernel -----------------------------------------
+    def _kernel(self, element: Any) -> Solid:
+        import ifcopenshell.geom
+
+        if self._settings is None:
+            settings = ifcopenshell.geom.settings()
+            settings.set("use-world-coords", True)
+            settings.set("disable-opening-subtractions", True)
+            self._settings = settings
+        try:
+            shape: Any = ifcopenshell.geom.create_shape(self._settings, element)
+        except Exception as exc:  # the kernel raises RuntimeError and others
+            raise UnsupportedGeometry(f"the geometry kernel cannot read it ({exc})") from None
+        verts = np.asarray(shape.geometry.verts, dtype=float).reshape(-1, 3)
+        faces = np.asarray(shape.geometry.faces, dtype=int).reshape(-1, 3)
+        if len(verts) == 0 or len(faces) == 0:
+            raise UnsupportedGeometry("its body geometry is empty")
+        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+        volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6.0)
+        return Solid(verts, volume)
+
+
+NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Reference",
+            "Clearance", "CoG", "Surface", "Lighting"}
+"""Representation identifiers that are not an element's body."""
+
+
+def body_representation(element: Any) -> Any:
+    """The element's 'Body' shape representation, else the first one that is not a known
+    other kind (an axis, a footprint, a bounding box...), else None."""
+    shape = getattr(element, "Representation", None)
+    if shape is None:
+        return None
+    reps = list(shape.Representations)
+    for rep in reps:
+        if rep.RepresentationIdentifier == "Body":
+            return rep
+    for rep in reps:
+        if rep.RepresentationIdentifier not in NOT_BODY:
+            return rep
+    return None
+
+
+def _profile_points(profile: Any) -> np.ndarray | None:
+    """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise."""
+    import ifcopenshell.util.placement as placement
+
+    if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
+        hx, hy = float(profile.XDim) / 2, float(profile.YDim) / 2
+        pts = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    elif profile.is_a("IfcArbitraryClosedProfileDef") and not profile.is_a(
+        "IfcArbitraryProfileDefWithVoids"
+    ):
+        curve = profile.OuterCurve
+        if curve.is_a("IfcPolyline"):
+            pts = np.array([p.Coordinates[:2] for p in curve.Points], dtype=float)
+        elif curve.is_a("IfcIndexedPolyCurve") and curve.Segments is None:
+            pts = np.array([c[:2] for c in curve.Points.CoordList], dtype=float)
+        else:
+            return None
+        if len(pts) > 1 and np.allclose(pts[0], pts[-1]):
+            pts = pts[:-1]
+        if len(pts) < 3:
+            return None
+    else:
+        return None
+    position = getattr(profile, "Position", None)
+    if position is not None:
+        m = np.asarray(placement.get_axis2placement(position), dtype=float)
+        pts = pts @ m[:2, :2].T + m[:2, 3]
+    return pts
+
+
+def _polygon_area(pts: np.ndarray) -> float:
+    x, y = pts[:, 0], pts[:, 1]
+    return abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2.0
+
+
+def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
+    """The upright box of least footprint around ``points``, its length along its yaw.
+
+    The yaw follows the longer horizontal side; of its two senses the one nearer ``hint_yaw``
+    (the element's placement x axis) is taken, so a wall keeps the direction it was drawn in.
+    """
+    xy = points[:, :2]
+    z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
+    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
+    for angle in _candidate_angles(xy):
+        c, s = math.cos(angle), math.sin(angle)
+        u = xy @ np.array([c, s])
+        v = xy @ np.array([-s, c])
+        lo = np.array([u.min(), v.min()])
+        hi = np.array([u.max(), v.max()])
+        area = float(np.prod(hi - lo))
+        if best is None or area < best[0] - 1e-9:
+            best = (area, angle, lo, hi)
+    assert best is not None
+    _, angle, lo, hi = best
+    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    if width > length:
+        angle += math.pi / 2
+        length, width = width, length
+    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
+        angle += math.pi
+    angle = math.atan2(math.sin(angle), math.cos(angle))
+    mid_u, mid_v = (lo + hi) / 2
+    a0 = best[1]
+    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
+    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
+    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+
+
+def _candidate_angles(xy: np.ndarray) -> list[float]:
+    """Edge directions of the convex hull of ``xy`` (one of them bounds the least box)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.unique(np.round(xy, 6), axis=0)
+    if len(pts) < 3:
+        if len(pts) == 2:
+            d = pts[1] - pts[0]
+            return [math.atan2(d[1], d[0])]
+        return [0.0]
+    try:
+        hull = pts[ConvexHull(pts).vertices]
+    except QhullError:  # collinear points
+        d = pts[-1] - pts[0]
+        return [math.atan2(d[1], d[0])]
+    edges = np.roll(hull, -1, axis=0) - hull
+    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+
+
+def placement_yaw(element: Any) -> float | None:
+    """Heading of the element's placement x axis, when it is not vertical."""
+    import ifcopenshell.util.placement as placement
+
+    if getattr(element, "ObjectPlacement", None) is None:
+        return None
+    m = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+    x = m[:3, 0]
+    if math.hypot(x[0], x[1]) < 1e-6:
+        return None
+    return math.atan2(x[1], x[0])
+
+
+def is_box_like(solid: Solid, box: Box) -> bool:
+    """Whether the body fills its upright box (see :data:`BOX_FILL`).
+
+    A long body (at least twice as long as wide) may also miss a width-square prism at its
+    ends: walls meeting at a corner are often cut at 45 degrees there.
+    """
+    length, width, height = box.size
+    mitres = width * width * height if length >= 2 * width else 0.0
+    return box.volume > 0 and solid.volume >= BOX_FILL * box.volume - mitres

@@ -1,0 +1,158 @@
+"""``bt-manip robot check``: does a described robot move as its descriptor says?
+
+:func:`check_robot` spawns the robot alone in an empty headless PyBullet world (a floor for
+mobile bases, none for fixed arms), puts the arm in its ``home`` state, then moves each arm
+joint in turn to its lower limit, its upper limit (each less a margin) and back, in sim time
+with the robot's own position controllers. A move passes when the joint settles within the
+tolerance of its target before a time-out computed from the joint's speed limit. The gripper,
+when there is one, must open to its full opening and close again. The result is a table
+(:meth:`CheckReport.table`) and ``ok``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import pybullet as pb
+
+from bt_manip.sim.robot import Robot
+from bt_manip.sim.robot_description import RobotDescription
+
+__all__ = ["CheckReport", "MoveResult", "check_robot"]
+
+RATE_HZ = 240
+MARGIN_FRACTION = 0.02
+MARGIN_MIN = 0.02
+TOLERANCE = 0.02
+"""rad (or m) a joint may end from its target."""
+GRIPPER_TOLERANCE = 0.004
+"""m the pad opening may end from the commanded one."""
+WIDE = 2.0 * math.pi
+"""Half range tried for joints without limits."""
+SETTLE_S = 1.0
+
+
+@dataclass(frozen=True)
+class MoveResult:
+    """One commanded move: what was asked, what was reached, and whether it is within tolerance."""
+
+    joint: str
+    phase: str
+    target: float
+    reached: float
+    time_s: float
+
+    @property
+    def ok(self) -> bool:
+        tol = GRIPPER_TOLERANCE if self.joint == "gripper" else TOLERANCE
+        return abs(self.reached - self.target) <= tol
+
+
+@dataclass
+class CheckReport:
+    """Every move of one check run."""
+
+    robot: str
+    moves: list[MoveResult] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return all(m.ok for m in self.moves)
+
+    def table(self) -> str:
+        """The moves as an aligned text table, one line per move, and a verdict."""
+        width = max([len("joint")] + [len(m.joint) for m in self.moves])
+        lines = [f"{'joint':<{width}}  {'move':<6} {'target':>8} {'reached':>8} {'time s':>7}  ok"]
+        for m in self.moves:
+            lines.append(
+                f"{m.joint:<{width}}  {m.phase:<6} {m.target:8.4f} {m.reached:8.4f} "
+                f"{m.time_s:7.2f}  {'yes' if m.ok else 'NO'}"
+            )
+        bad = sum(not m.ok for m in self.moves)
+        verdict = "all moves reached" if bad == 0 else f"{bad} of {len(self.moves)} moves missed"
+        lines.append(f"{self.robot}: {verdict}")
+        return "\n".join(lines)
+
+
+def _targets(lower: float, upper: float, start: float) -> tuple[float, float]:
+    if not math.isfinite(lower) or not math.isfinite(upper):
+        lower, upper = start - WIDE, start + WIDE
+        lower = max(lower, -1e3)
+        upper = min(upper, 1e3)
+    margin = max(MARGIN_MIN, MARGIN_FRACTION * (upper - lower))
+    return lower + margin, upper - margin
+
+
+def check_robot(description: RobotDescription) -> CheckReport:
+    """Spawn ``description`` headless and move every joint; see the module docstring."""
+    client = pb.connect(pb.DIRECT)
+    try:
+        pb.setGravity(0, 0, -9.81, physicsClientId=client)
+        pb.setTimeStep(1.0 / RATE_HZ, physicsClientId=client)
+        if description.base.type != "fixed":
+            import pybullet_data
+
+            pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=client)
+            pb.loadURDF("plane.urdf", physicsClientId=client)
+        robot = Robot.spawn(client, description, 0.0, 0.0, 0.0)
+        return _run(client, robot)
+    finally:
+        pb.disconnect(client)
+
+
+def _run(client: int, robot: Robot) -> CheckReport:
+    desc = robot.description
+    report = CheckReport(desc.name)
+    start = list(desc.state("home"))
+    robot.reset_arm(start)
+    _step(client, round(SETTLE_S * RATE_HZ))
+    velocities = desc.arm.velocity_limits
+    for i, name in enumerate(desc.arm.joints):
+        lo, hi = _targets(desc.arm.lower[i], desc.arm.upper[i], start[i])
+        for phase, value in (("lower", lo), ("upper", hi), ("back", start[i])):
+            q = list(start)
+            q[i] = value
+            here = float(robot.arm_positions()[i])
+            timeout = abs(value - here) / max(velocities[i], 1e-3) * 2.0 + 2.0
+            robot.set_arm_targets(q)
+            took = _until(client, timeout, lambda i=i, v=value: abs(robot.arm_positions()[i] - v))
+            report.moves.append(
+                MoveResult(name, phase, value, float(robot.arm_positions()[i]), took)
+            )
+        robot.set_arm_targets(start)
+        _step(client, round(0.2 * RATE_HZ))
+    g = desc.gripper
+    if g.joints:
+        moves = (("open", g.max_opening), ("close", g.min_opening), ("open", g.max_opening))
+        for phase, opening in moves:
+            robot.set_gripper(opening)
+            timeout = g.max_opening / len(g.joints) / g.max_speed * 2.0 + 2.0
+            took = _until(client, timeout, lambda o=opening: abs(robot.gripper_opening() - o))
+            report.moves.append(
+                MoveResult("gripper", phase, opening, robot.gripper_opening(), took)
+            )
+    return report
+
+
+def _step(client: int, n: int) -> None:
+    for _ in range(n):
+        pb.stepSimulation(physicsClientId=client)
+
+
+def _until(client: int, timeout: float, error: object) -> float:
+    """Step until ``error()`` stays within tolerance for 0.1 s or ``timeout`` (sim s) passes."""
+    assert callable(error)
+    calm = 0
+    steps = 0
+    limit = round(timeout * RATE_HZ)
+    while steps < limit:
+        pb.stepSimulation(physicsClientId=client)
+        steps += 1
+        if error() <= TOLERANCE / 4.0:
+            calm += 1
+            if calm >= RATE_HZ // 10:
+                break
+        else:
+            calm = 0
+    return steps / RATE_HZ

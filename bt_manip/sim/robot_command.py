@@ -1,0 +1,87 @@
+"""The ``robot`` verb of the command line: ``robot init`` and ``robot check``."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from bt_manip.sim.robot_init import MOBILE_KINDS
+
+MAX_GRIPPER_JOINTS = 4
+
+
+def _joint_list(text: str) -> tuple[str, ...]:
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    if not 1 <= len(names) <= MAX_GRIPPER_JOINTS:
+        raise argparse.ArgumentTypeError(
+            f"expected 1..{MAX_GRIPPER_JOINTS} joint names separated by commas, got '{text}'"
+        )
+    return names
+
+
+def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Register ``bt-manip robot init`` and ``bt-manip robot check``."""
+    robot = sub.add_parser("robot", help="write a robot descriptor from a URDF, or check one")
+    verbs = robot.add_subparsers(dest="robot_verb", metavar="init|check", parser_class=type(robot))
+    verbs.required = True
+    init = verbs.add_parser("init", help="write robots/NAME.yaml from a URDF and check it")
+    init.add_argument("urdf", help="the robot's URDF")
+    init.add_argument("--base-link", required=True, help="root link of the arm chain")
+    init.add_argument("--arm-tip", required=True, help="last link of the arm chain (IK tip)")
+    init.add_argument(
+        "--gripper", type=_joint_list, default=(), metavar="JOINT[,JOINT]",
+        help="finger joints (prismatic or revolute); open/closed from their limits",
+    )
+    init.add_argument(
+        "--grasp-frame", default="", metavar="LINK",
+        help="link between the finger pads (default: the arm tip)",
+    )
+    init.add_argument(
+        "--mobile", choices=MOBILE_KINDS, default=None,
+        help="a wheeled base (wheels found from its continuous joints); default: fixed base",
+    )
+    init.add_argument("--name", default="", help="robot name (default: the --out file name)")
+    init.add_argument("--out", required=True, help="descriptor to write, e.g. robots/NAME.yaml")
+    init.set_defaults(func=cmd_robot_init)
+    check = verbs.add_parser(
+        "check", help="move every joint of a robot to its limits and back, print a table"
+    )
+    check.add_argument("robot", help="robot name (robots/NAME.yaml) or descriptor path")
+    check.set_defaults(func=cmd_robot_check)
+
+
+def cmd_robot_init(args: argparse.Namespace) -> int:
+    from bt_manip.sim.robot_init import InitOptions, init_descriptor
+
+    desc = init_descriptor(
+        InitOptions(
+            urdf=Path(args.urdf),
+            base_link=args.base_link,
+            arm_tip=args.arm_tip,
+            out=Path(args.out),
+            gripper=args.gripper,
+            mobile=args.mobile,
+            name=args.name,
+            grasp_frame=args.grasp_frame,
+        )
+    )
+    gripper = (
+        f"gripper {', '.join(desc.gripper.joints)} (0 .. {desc.gripper.max_opening:g} m)"
+        if desc.gripper.joints
+        else "no gripper"
+    )
+    print(
+        f"wrote {args.out}: {desc.name}, base {desc.base.type}, arm {len(desc.arm.joints)} joints "
+        f"({desc.arm.base_link} -> {desc.end_effector}), {gripper}, states "
+        f"{', '.join(desc.states)}"
+    )
+    return 0
+
+
+def cmd_robot_check(args: argparse.Namespace) -> int:
+    from bt_manip.sim.robot_check import check_robot
+    from bt_manip.sim.robot_description import RobotDescription
+
+    report = check_robot(RobotDescription.load(args.robot))
+    print(report.table())
+    return 0 if report.ok else 1

@@ -1,0 +1,501 @@
+"""``bt-manip robot init``: a robot descriptor written from a URDF.
+
+Given a URDF and a few names (the arm's base link and tip, the gripper's finger joints, the kind
+of mobile base), :func:`init_descriptor` reads the URDF and writes ``robots/<name>.yaml`` in the
+format of ``robots/README.md``:
+
+- the arm chain from the base link down to the tip: its movable joints in order, their speed
+  and effort limits (lower / upper are read from the URDF at load time);
+- the gripper: each finger joint must be prismatic or revolute; the open and closed positions
+  are its upper and lower limits, the force and speed its effort and velocity limits;
+- named arm states ``zero`` (every joint at 0, clipped into its limits), ``ready`` (the middle
+  of each joint's range, 0 for joints without limits), ``home`` (= ``ready``) and ``tuck``
+  (= ``zero``), all within the limits;
+- the footprint from the collision shapes: for a fixed arm the circle around the links that no
+  arm joint moves, for a mobile base the rectangle around the base links;
+- for ``skid``/``diff`` bases the wheels (continuous joints off the arm, left / right by the
+  side of the root frame they sit on), their radius, track width and the spawn height that puts
+  the wheels on the floor.
+
+The file refers to the URDF by a URI (``package://example-robot-data/...``,
+``pybullet_data://...``) or by a path relative to the descriptor, never an absolute path. The
+result is then loaded the way a world loads robots (:func:`load_description`, plus the arm's
+kinematic model); the descriptor is only kept when that works. Every problem is an
+:class:`~bt_manip.errors.InputError` naming file and line.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import defusedxml.ElementTree as SafeET
+import numpy as np
+
+from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import read_bounded
+from bt_manip.sim.assets import example_robot_data_share, pybullet_data_dir
+from bt_manip.sim.compose import MAX_URDF_BYTES, composed_urdf
+from bt_manip.sim.robot_description import RobotDescription, load_description
+
+__all__ = ["MOBILE_KINDS", "InitOptions", "init_descriptor", "urdf_uri"]
+
+MOBILE_KINDS = ("skid", "diff", "holonomic")
+MOVABLE = ("revolute", "continuous", "prismatic")
+DEFAULT_VELOCITY = 1.0
+"""rad/s (or m/s) for a joint whose URDF gives no velocity limit."""
+DEFAULT_WHEEL_SPEED = 6.0
+DEFAULT_WHEEL_TORQUE = 50.0
+MAX_NAME = 64
+
+
+@dataclass(frozen=True)
+class InitOptions:
+    """What ``robot init`` is told: the URDF, the names in it and where to write."""
+
+    urdf: Path
+    base_link: str
+    arm_tip: str
+    out: Path
+    gripper: tuple[str, ...] = ()
+    mobile: str | None = None
+    name: str = ""
+    grasp_frame: str = ""
+
+
+@dataclass(frozen=True)
+class _Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    line: int | None
+    lower: float
+    upper: float
+    velocity: float | None
+    effort: float | None
+
+
+class _Urdf:
+    """The links and joints of a URDF with the line each is declared on."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+        data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
+        try:
+            root = SafeET.fromstring(data)
+        except ET.ParseError as exc:
+            line = exc.position[0] if exc.position else None
+            raise InputError.single(str(path), line, f"the URDF does not parse: {exc}") from None
+        except Exception as exc:  # defusedxml refuses entities and DTDs with its own errors
+            raise InputError.single(str(path), None, f"the URDF does not parse: {exc}") from None
+        if root.tag != "robot":
+            raise InputError.single(str(path), 1, f"root element is <{root.tag}>, not <robot>")
+        self.robot_name = root.get("name", "") or path.stem
+        text = data.decode("utf-8", errors="replace")
+        self.links: dict[str, int | None] = {}
+        for el in root.findall("link"):
+            name = el.get("name", "")
+            self.links[name] = _line(text, "link", name)
+        self.joints: dict[str, _Joint] = {}
+        for el in root.findall("joint"):
+            name = el.get("name", "")
+            jline = _line(text, "joint", name)
+
+            def num(key: str, default: float | None, el: ET.Element = el,
+                    where: tuple[str, int | None] = (name, jline)) -> float | None:
+                return _limit_value(path, el, key, default, *where)
+
+            jtype = el.get("type", "")
+            bounded = jtype in ("revolute", "prismatic")
+            self.joints[name] = _Joint(
+                name,
+                jtype,
+                _end(el, "parent"),
+                _end(el, "child"),
+                jline,
+                (num("lower", 0.0) or 0.0) if bounded else -math.inf,
+                (num("upper", 0.0) or 0.0) if bounded else math.inf,
+                num("velocity", None),
+                num("effort", None),
+            )
+        self.parent_joint = {j.child: j for j in self.joints.values()}
+
+    def problem(self, line: int | None, message: str) -> Problem:
+        return Problem(str(self.path), line, message)
+
+    def chain(self, base: str, tip: str) -> list[_Joint] | None:
+        """Joints from ``base`` down to ``tip`` (all kinds), or None if tip is not below base."""
+        out: list[_Joint] = []
+        link = tip
+        for _ in range(len(self.joints) + 1):
+            if link == base:
+                return out[::-1]
+            joint = self.parent_joint.get(link)
+            if joint is None:
+                return None
+            out.append(joint)
+            link = joint.parent
+        return None
+
+    def below(self, link: str) -> set[str]:
+        """``link`` and every link below it."""
+        children: dict[str, list[str]] = {}
+        for j in self.joints.values():
+            children.setdefault(j.parent, []).append(j.child)
+        seen = {link}
+        todo = [link]
+        while todo:
+            for c in children.get(todo.pop(), []):
+                if c not in seen:
+                    seen.add(c)
+                    todo.append(c)
+        return seen
+
+    def root_link(self) -> str:
+        roots = [name for name in self.links if name not in self.parent_joint]
+        return roots[0] if roots else ""
+
+
+def _limit_value(
+    path: Path, joint: ET.Element, key: str, default: float | None, name: str, line: int | None
+) -> float | None:
+    """Attribute ``key`` of the joint's ``<limit>`` as a finite number, ``default`` if absent."""
+    limit = joint.find("limit")
+    if limit is None or limit.get(key) is None:
+        return default
+    raw = limit.get(key, "")
+    try:
+        value = float(raw)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError.single(
+            str(path), line, f"joint '{name}': limit {key}={raw!r} is not a finite number"
+        )
+    return value
+
+
+def _line(text: str, tag: str, name: str) -> int | None:
+    for quote in ('"', "'"):
+        at = text.find(f"<{tag} name={quote}{name}{quote}")
+        if at >= 0:
+            return text.count("\n", 0, at) + 1
+    return None
+
+
+def _end(el: ET.Element, which: str) -> str:
+    found = el.find(which)
+    return found.get("link", "") if found is not None else ""
+
+
+def urdf_uri(urdf: Path, descriptor_folder: Path) -> str:
+    """How a descriptor in ``descriptor_folder`` names ``urdf``: a URI, else a relative path."""
+    urdf = urdf.resolve()
+    try:
+        share = example_robot_data_share()
+        return "package://" + urdf.relative_to(share).as_posix()
+    except (ValueError, FileNotFoundError, ImportError):
+        pass
+    try:
+        return "pybullet_data://" + urdf.relative_to(pybullet_data_dir().resolve()).as_posix()
+    except (ValueError, ImportError):
+        pass
+    return Path(os.path.relpath(urdf, descriptor_folder.resolve())).as_posix()
+
+
+def _fmt(value: float) -> str:
+    text = f"{value:.4f}".rstrip("0")
+    return text + "0" if text.endswith(".") else text
+
+
+def _vector(values: list[float]) -> str:
+    return "[" + ", ".join(_fmt(v) for v in values) + "]"
+
+
+def _state(values: list[float], lower: list[float], upper: list[float]) -> str:
+    """Like :func:`_vector`, full precision where rounding would leave the joint limits."""
+    out = []
+    for v, lo, hi in zip(values, lower, upper, strict=True):
+        short = _fmt(v)
+        out.append(short if lo <= float(short) <= hi else repr(float(v)))
+    return "[" + ", ".join(out) + "]"
+
+
+def _check_names(urdf: _Urdf, opts: InitOptions) -> list[Problem]:
+    problems: list[Problem] = []
+    root_line = 1
+    for key, link in (("--base-link", opts.base_link), ("--arm-tip", opts.arm_tip)):
+        if link not in urdf.links:
+            problems.append(
+                urdf.problem(root_line, f"{key}: no link '{link}' in the URDF; links: "
+                             f"{', '.join(list(urdf.links)[:40])}")
+            )
+    if opts.grasp_frame and opts.grasp_frame not in urdf.links:
+        problems.append(
+            urdf.problem(root_line, f"--grasp-frame: no link '{opts.grasp_frame}' in the URDF")
+        )
+    for name in opts.gripper:
+        joint = urdf.joints.get(name)
+        if joint is None:
+            problems.append(urdf.problem(root_line, f"--gripper: no joint '{name}' in the URDF"))
+        elif joint.type not in ("prismatic", "revolute"):
+            problems.append(
+                urdf.problem(
+                    joint.line,
+                    f"--gripper: joint '{name}' is {joint.type or 'untyped'}; a finger joint "
+                    "must be prismatic or revolute",
+                )
+            )
+    if opts.mobile is not None and opts.mobile not in MOBILE_KINDS:
+        problems.append(
+            urdf.problem(None, f"--mobile must be one of {', '.join(MOBILE_KINDS)}")
+        )
+    if opts.mobile == "holonomic":
+        problems.append(
+            urdf.problem(
+                None,
+                "--mobile holonomic: bt-manip has no holonomic base controller yet "
+                "(base types: skid_steer, fixed); use skid or diff, or leave --mobile out",
+            )
+        )
+    return problems
+
+
+def init_descriptor(opts: InitOptions) -> RobotDescription:
+    """Write the descriptor ``opts.out`` for ``opts.urdf`` and return it loaded and checked.
+
+    Raises :class:`~bt_manip.errors.InputError` (file and line of each problem) when the URDF
+    does not parse, names are unknown, the tip is not below the base link, a finger joint is not
+    prismatic/revolute, meshes are missing, or the written descriptor does not load. Nothing is
+    left at ``opts.out`` on failure.
+    """
+    if not opts.urdf.is_file():
+        raise InputError.single(str(opts.urdf), None, "URDF file not found")
+    urdf = _Urdf(opts.urdf)
+    name = opts.name or opts.out.stem
+    if not name or len(name) > MAX_NAME or not all(c.isalnum() or c in "_-" for c in name):
+        raise InputError.single(
+            str(opts.out), None,
+            f"robot name {name!r}: use 1..{MAX_NAME} letters, digits, '_' or '-'",
+        )
+    problems = _check_names(urdf, opts)
+    if problems:
+        raise InputError(problems)
+    chain = urdf.chain(opts.base_link, opts.arm_tip)
+    if chain is None:
+        raise InputError.single(
+            str(opts.urdf),
+            urdf.links.get(opts.arm_tip),
+            f"--arm-tip: link '{opts.arm_tip}' is not below --base-link '{opts.base_link}' "
+            "(no chain of joints leads from the base link down to it)",
+        )
+    arm = [j for j in chain if j.type in MOVABLE]
+    if not arm:
+        raise InputError.single(
+            str(opts.urdf), urdf.links.get(opts.arm_tip),
+            f"no movable joint between '{opts.base_link}' and '{opts.arm_tip}'",
+        )
+    in_arm = {j.name for j in arm}
+    clash = [g for g in opts.gripper if g in in_arm]
+    if clash:
+        raise InputError.single(
+            str(opts.urdf), urdf.joints[clash[0]].line,
+            f"--gripper: joint '{clash[0]}' is part of the arm chain",
+        )
+    # the composed file checks every mesh (missing files reported with their line)
+    composed = composed_urdf(opts.urdf)
+    text = _descriptor_text(urdf, opts, name, arm, composed)
+    return _write_checked(opts.out, text)
+
+
+def _descriptor_text(
+    urdf: _Urdf, opts: InitOptions, name: str, arm: list[_Joint], composed: Path
+) -> str:
+    lower = [j.lower for j in arm]
+    upper = [j.upper for j in arm]
+    zero = [min(max(0.0, lo), hi) for lo, hi in zip(lower, upper, strict=True)]
+    ready = [
+        (lo + hi) / 2.0 if math.isfinite(lo) and math.isfinite(hi) else z
+        for lo, hi, z in zip(lower, upper, zero, strict=True)
+    ]
+    velocities = [j.velocity if j.velocity and j.velocity > 0 else DEFAULT_VELOCITY for j in arm]
+    efforts = [j.effort if j.effort and j.effort > 0 else None for j in arm]
+    geometry = _Geometry(composed, urdf, opts, arm)
+    uri = urdf_uri(opts.urdf, opts.out.parent)
+    lines = [
+        f"# {name}: written by `bt-manip robot init` from {Path(uri).name}.",
+        "# Format: robots/README.md.",
+        f"name: {name}",
+        "urdf:",
+        f"  base: {uri}",
+    ]
+    if opts.mobile in ("skid", "diff"):
+        lines += geometry.mobile_base_lines()
+    else:
+        lines += ["base:", "  type: fixed"]
+    lines += [
+        "arm:",
+        f"  base_link: {opts.base_link}",
+        f"  joints: [{', '.join(j.name for j in arm)}]",
+        f"  velocity_limits: {_vector(velocities)}",
+    ]
+    if all(e is not None for e in efforts):
+        lines.append(f"  efforts: {_vector([e for e in efforts if e is not None])}")
+    lines += [
+        f"end_effector: {opts.arm_tip}",
+        f"grasp_frame: {opts.grasp_frame or opts.arm_tip}",
+    ]
+    if opts.gripper:
+        fingers = [urdf.joints[g] for g in opts.gripper]
+        open_, closed = fingers[0].upper, fingers[0].lower
+        force = min((f.effort for f in fingers if f.effort and f.effort > 0), default=40.0)
+        speed = min((f.velocity for f in fingers if f.velocity and f.velocity > 0), default=0.1)
+        lines += [
+            "gripper:",
+            f"  joints: [{', '.join(opts.gripper)}]",
+            f"  finger_links: [{', '.join(f.child for f in fingers)}]",
+            f"  open: {_fmt(open_)}        # finger joint upper limit",
+            f"  closed: {_fmt(closed)}      # finger joint lower limit",
+            f"  max_force: {_fmt(force)}",
+            f"  max_speed: {_fmt(speed)}",
+        ]
+    lines += [
+        "states:                  # rad, arm joint order, within the joint limits",
+        f"  home: {_state(ready, lower, upper)}    # = ready",
+        f"  tuck: {_state(zero, lower, upper)}    # = zero",
+        f"  zero: {_state(zero, lower, upper)}",
+        f"  ready: {_state(ready, lower, upper)}   # middle of each joint's range",
+    ]
+    lines += geometry.footprint_lines()
+    return "\n".join(lines) + "\n"
+
+
+class _Geometry:
+    """Collision-shape extents of the robot at its zero pose (PyBullet, headless)."""
+
+    def __init__(self, composed: Path, urdf: _Urdf, opts: InitOptions, arm: list[_Joint]) -> None:
+        import pybullet as pb
+
+        from bt_manip.sim import pybullet_queries as pbq
+
+        self.opts = opts
+        moved = urdf.below(arm[0].child)
+        for g in opts.gripper:
+            moved |= urdf.below(urdf.joints[g].child)
+        client = pb.connect(pb.DIRECT)
+        try:
+            try:
+                body = pb.loadURDF(str(composed), useFixedBase=True, physicsClientId=client)
+            except pb.error:
+                raise InputError.single(
+                    str(opts.urdf), None, "PyBullet cannot load this URDF (check links and meshes)"
+                ) from None
+            names = {-1: pbq.root_link_name(client, body)}
+            infos = pbq.joint_infos(client, body)
+            for info in infos:
+                names[info.index] = info.link_name
+            self.base_boxes: list[tuple[np.ndarray, np.ndarray]] = []
+            self.all_min = np.full(3, np.inf)
+            for index, link in names.items():
+                lo, hi = pb.getAABB(body, index, physicsClientId=client)
+                lo_a, hi_a = np.asarray(lo), np.asarray(hi)
+                if np.all(hi_a - lo_a < 1e-6):  # no collision shape
+                    continue
+                self.all_min = np.minimum(self.all_min, lo_a)
+                if link not in moved:
+                    self.base_boxes.append((lo_a, hi_a))
+            self.wheels: list[tuple[str, float, float]] = []  # joint, y, radius
+            wheel_max: list[float] = []
+            wheel_effort: list[float] = []
+            if opts.mobile in ("skid", "diff"):
+                for info in infos:
+                    joint = urdf.joints.get(info.name)
+                    if joint is None or joint.type != "continuous" or joint.child in moved:
+                        continue
+                    lo, hi = pb.getAABB(body, info.index, physicsClientId=client)
+                    pos = pb.getLinkState(body, info.index, physicsClientId=client)[4]
+                    radius = (hi[2] - lo[2]) / 2.0
+                    if radius <= 0.0:
+                        continue
+                    self.wheels.append((info.name, float(pos[1]), float(radius)))
+                    if joint.velocity:
+                        wheel_max.append(joint.velocity)
+                    if joint.effort:
+                        wheel_effort.append(joint.effort)
+            self.wheel_speed = min(wheel_max, default=DEFAULT_WHEEL_SPEED)
+            self.wheel_torque = min(wheel_effort, default=DEFAULT_WHEEL_TORQUE)
+        finally:
+            pb.disconnect(client)
+
+    def mobile_base_lines(self) -> list[str]:
+        left = [w for w in self.wheels if w[1] > 1e-6]
+        right = [w for w in self.wheels if w[1] < -1e-6]
+        if not left or not right:
+            raise InputError.single(
+                str(self.opts.urdf), None,
+                f"--mobile {self.opts.mobile}: found no continuous wheel joints on both sides "
+                f"of the root link (left: {[w[0] for w in left]}, right: {[w[0] for w in right]})",
+            )
+        track = float(np.mean([w[1] for w in left]) - np.mean([w[1] for w in right]))
+        radius = float(np.mean([w[2] for w in self.wheels]))
+        return [
+            f"spawn_height: {_fmt(max(0.0, -float(self.all_min[2])))}   # wheels on the floor",
+            "base:",
+            "  type: skid_steer",
+            f"  left_wheels: [{', '.join(w[0] for w in left)}]",
+            f"  right_wheels: [{', '.join(w[0] for w in right)}]",
+            f"  wheel_radius: {_fmt(radius)}",
+            f"  track_width: {_fmt(track)}   # geometric; measure the effective one for skid-steer",
+            f"  max_wheel_speed: {_fmt(self.wheel_speed)}",
+            f"  wheel_max_torque: {_fmt(self.wheel_torque)}",
+        ]
+
+    def footprint_lines(self) -> list[str]:
+        if not self.base_boxes:
+            return ["footprint:                # no collision shape off the arm", "  radius: 0.1"]
+        lo = np.min([b[0] for b in self.base_boxes], axis=0)
+        hi = np.max([b[1] for b in self.base_boxes], axis=0)
+        if self.opts.mobile in ("skid", "diff"):
+            return [
+                "footprint:                # around the base links' collision shapes",
+                f"  length: {_fmt(max(hi[0] - lo[0], 0.01))}",
+                f"  width: {_fmt(max(hi[1] - lo[1], 0.01))}",
+                f"  x_offset: {_fmt((hi[0] + lo[0]) / 2.0)}",
+            ]
+        corners = [math.hypot(x, y) for x in (lo[0], hi[0]) for y in (lo[1], hi[1])]
+        return [
+            "footprint:                # circle around the collision shapes no arm joint moves",
+            f"  radius: {_fmt(max(max(corners), 0.01))}",
+        ]
+
+
+def _write_checked(out: Path, text: str) -> RobotDescription:
+    """Write ``text`` beside ``out``, load it as a world would, and move it to ``out`` if good."""
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}-", suffix=".yaml", dir=out.parent)
+    tmp = Path(tmp_name)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        desc = load_description(tmp)
+        _check_kinematics(desc)
+        os.replace(tmp, out)
+    finally:
+        tmp.unlink(missing_ok=True)
+    return load_description(out)
+
+
+def _check_kinematics(desc: RobotDescription) -> None:
+    from bt_manip.kinematics.arm_model import ArmModel, KinematicsError
+
+    try:
+        ArmModel.from_urdf(desc.urdf_path, base_link=desc.arm.base_link, tip_link=desc.end_effector)
+    except (KinematicsError, ValueError, RuntimeError, IndexError) as exc:
+        raise InputError.single(
+            str(desc.path), None, f"the arm model does not build: {exc}"
+        ) from None
