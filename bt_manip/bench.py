@@ -7,8 +7,9 @@ injected faults), in J worker processes, and reports:
 - the success rate with a 95 % Wilson score interval;
 - sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
 - failures counted by node and reason (the node whose failure ended each failed episode);
-- the leaves that failed during episodes, and in how many episodes: the failures the tree
-  recovered from (or did not), for instance how often a recovery branch was needed.
+- the actions that failed during episodes, and in how many episodes: the failures the tree
+  recovered from (or did not), for instance how often a recovery branch was needed
+  (conditions are left out: their failures are how a tree decides, not trouble).
 
 It writes ``episodes.json``, ``episodes.csv``, ``summary.json`` and ``outcomes.png`` to DIR.
 """
@@ -54,7 +55,7 @@ class EpisodeResult:
     metrics: dict[str, float] = field(default_factory=dict)
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
     leaf_failures: dict[str, int] = field(default_factory=dict)
-    """Per leaf node (by path), how many times it failed during the episode."""
+    """Per action node (by path), how many times it failed during the episode."""
 
     @property
     def success(self) -> bool:
@@ -105,15 +106,15 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
 
 
 def count_leaf_failures(tree: Any) -> Counter[str]:
-    """A counter, kept up to date while ``tree`` runs, of the times each leaf node (by its
-    path) goes to FAILURE."""
+    """A counter, kept up to date while ``tree`` runs, of the times each action node (a leaf
+    that is not a condition, by its path) goes to FAILURE."""
     from bt_manip.bt.status import NodeStatus
     from bt_manip.bt.walk import children_of, walk_nodes
     from bt_manip.groot.monitor import watch
 
     counts: Counter[str] = Counter()
     for walked in walk_nodes(tree.root):
-        if children_of(walked.node):
+        if children_of(walked.node) or getattr(walked.node, "KIND", "Action") == "Condition":
             continue
 
         def changed(node: Any, previous: Any, new: Any, path: str = walked.path) -> None:
@@ -139,7 +140,8 @@ class BenchSummary:
     injected: dict[str, int]
     metrics: dict[str, dict[str, float]] = field(default_factory=dict)
     leaf_failures: list[dict[str, Any]] = field(default_factory=list)
-    """Per leaf that failed in some episode: its path, the episodes it failed in, the times."""
+    """Per action that failed in some episode: its path, the episodes it failed in, the
+    times."""
     tree: str = ""
     world: str = ""
     first_seed: int = 0
@@ -168,7 +170,7 @@ class BenchSummary:
         for f in self.failures:
             lines.append(f"  {f['count']:3d} x {f['node'] or '-'}: {f['reason']}")
         if self.leaf_failures:
-            lines.append("leaves that failed (episodes, times):")
+            lines.append("actions that failed (episodes, times):")
             for f in self.leaf_failures[:LEAVES_SHOWN]:
                 lines.append(f"  {f['episodes']:3d} {f['times']:4d}  {f['path']}")
             if len(self.leaf_failures) > LEAVES_SHOWN:

@@ -366,4 +366,4 @@ def test_bench_lists_the_leaves_that_failed_and_in_how_many_episodes(tmp_path: P
         "episodes": len(failed),
         "times": sum(r.leaf_failures["RetryUntilSuccessful/step"] for r in failed),
     }]
-    assert "leaves that failed (episodes, times):" in s.text()
+    assert "actions that failed (episodes, times):" in s.text()
