@@ -16,7 +16,6 @@ ROOT = Path(__file__).resolve().parents[2]
 TREE = str(ROOT / "trees" / "husky_carry_wall_adaptive.xml")
 HOUSE = str(ROOT / "worlds" / "tb3_house.yaml")
 DEV = str(ROOT / "worlds" / "tb3_house_panel_dev.yaml")
-TURNED_CCW = str(ROOT / "worlds" / "tb3_house_panel_turned_ccw.yaml")
 
 
 def _delivered(episode: Episode, report: RunReport) -> None:
@@ -36,12 +35,9 @@ def _delivered(episode: Episode, report: RunReport) -> None:
     assert px > 1.8  # through the doorway
 
 
-@pytest.mark.parametrize(("world", "seed"), [(HOUSE, 0), (DEV, 0), (TURNED_CCW, 1)],
-                         ids=["tb3_house", "panel_moved", "panel_turned_ccw"])
-def test_the_adaptive_tree_delivers_the_panel(world: str, seed: int) -> None:
-    # turned_ccw, seed 1: the base stands beside the stand's rails when it has lifted the
-    # panel; it backs out the way it came before the carry turns it round
-    with Episode(EpisodeSpec(tree=TREE, world=world, seed=seed)) as episode:
+@pytest.mark.parametrize("world", [HOUSE, DEV], ids=["tb3_house", "panel_moved"])
+def test_the_adaptive_tree_delivers_the_panel(world: str) -> None:
+    with Episode(EpisodeSpec(tree=TREE, world=world, seed=0)) as episode:
         report = episode.run()
         _delivered(episode, report)
 
