@@ -19,7 +19,6 @@ from bt_manip.bench_log import (
     BenchLog,
     check_unchanged,
     read_log,
-    spec_from_json,
 )
 from bt_manip.errors import InputError, Problem
 
@@ -78,8 +77,7 @@ def _resume_points(folder: Path) -> tuple[str | None, list[Point]]:
 def _resumed(folder: Path) -> Point:
     logged = read_log(folder)
     check_unchanged(logged, folder)
-    spec = spec_from_json(logged.header.spec)
-    return Point(folder, spec, logged.header.seeds, done=logged.results,
+    return Point(folder, logged.spec, logged.header.seeds, done=logged.results,
                  valid_bytes=logged.valid_bytes)
 
 

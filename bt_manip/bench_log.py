@@ -158,6 +158,8 @@ class LoggedBench:
     bytes are whole lines."""
 
     header: BenchHeader
+    spec: EpisodeSpec
+    """The episodes' definition read from the header (relative paths made relative to here)."""
     results: list[EpisodeResult]
     valid_bytes: int
 
@@ -192,7 +194,7 @@ def read_log(folder: str | Path) -> LoggedBench:
                              f"reads {SCHEMA_VERSION}")
         header = BenchHeader(dict(first["spec"]), [int(s) for s in first["seeds"]],
                              dict(first.get("digests", {})))
-        spec_from_json(header.spec)
+        spec = spec_from_json(header.spec)
     except (ValueError, KeyError, TypeError) as exc:
         raise InputError.single(where, 1, f"not a bench log: {exc}") from None
     known = {f.name for f in fields(EpisodeResult)}
@@ -210,14 +212,13 @@ def read_log(folder: str | Path) -> LoggedBench:
             raise InputError.single(where, number, f"not an episode: {exc}") from None
         results[result.seed] = result
         valid += len(line) + 1
-    return LoggedBench(header, sorted(results.values(), key=lambda r: r.seed), valid)
+    return LoggedBench(header, spec, sorted(results.values(), key=lambda r: r.seed), valid)
 
 
 def check_unchanged(logged: LoggedBench, folder: str | Path) -> None:
     """InputError when the tree or world file differs from the one the bench started with."""
-    spec = spec_from_json(logged.header.spec)
     for key in ("tree", "world"):
-        path = getattr(spec, key)
+        path = getattr(logged.spec, key)
         if not path:
             continue
         if not Path(path).is_file():
