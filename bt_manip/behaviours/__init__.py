@@ -1,8 +1,11 @@
 """Robot behaviours for trees: importing this package registers them with the node registry.
 
-- Base: Navigate, Reverse, GetClear, PlanBaseForGrasp (where to park to grasp an object).
-- Arm: MoveJointsSequentially, MoveJoints, MoveToPose (also to an object's grasp frame), Lift.
+- Base: Navigate, Reverse, GetClear, PlanBaseForGrasp (where to park to grasp an object),
+  PlanBaseForPlace (where to park to place the object in the hand).
+- Arm: MoveJointsSequentially, MoveJoints, MoveToPose (also to an object's grasp frame), Lift,
+  MoveToolBy (a straight move by an offset).
 - Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.
+- Placing: Place (the held object to a target pose), Fasten (fix it to the structure).
 - Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear, ObjectUpright.
 - World: SpawnModel, DeleteModel. Regions: DropPoint.
 """
@@ -12,10 +15,14 @@ from bt_manip.behaviours import (
     attach,
     base_placement,
     conditions,
+    fasten,
     get_clear,
     gripper,
     navigate,
+    place,
+    place_base,
     regions,
+    tool_moves,
     world_ops,
 )
 
@@ -24,9 +31,13 @@ __all__ = [
     "attach",
     "base_placement",
     "conditions",
+    "fasten",
     "get_clear",
     "gripper",
     "navigate",
+    "place",
+    "place_base",
     "regions",
+    "tool_moves",
     "world_ops",
 ]

@@ -7,9 +7,8 @@ that each element can be carried from the stock to its place through the doors
 (:mod:`~bt_manip.bim.floor_grid`), and write the world and the schedule. Every problem of the
 input is collected and reported as ``file:line: #id IfcClass 'Name': message``.
 
-The installation tree (``DIR/install.xml``: fetch each element from its stand, carry it, place
-and fasten it at its target pose in schedule order) is written from ``schedule.json`` by a later
-step, once the Place and Fasten nodes exist; :class:`Conversion` is its input.
+Last, the installation tree ``DIR/install.xml`` (:mod:`~bt_manip.bim.install_tree`: fetch each
+element from its stand, carry it, place and fasten it at its target pose, in schedule order).
 """
 
 from __future__ import annotations
@@ -25,6 +24,7 @@ import yaml
 from bt_manip.bim.building import Building, Names, choose_storey, read_building
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
+from bt_manip.bim.install_tree import install_tree
 from bt_manip.bim.routes import CLEARANCE, check_routes, floor_grid
 from bt_manip.bim.schedule import (
     MAX_ELEMENTS,
@@ -82,6 +82,7 @@ class Conversion:
     world_path: Path
     schedule_path: Path
     notes: list[str] = field(default_factory=list)
+    install_path: Path | None = None
 
     def summary(self) -> str:
         b = self.building
@@ -109,7 +110,9 @@ class Conversion:
                 + (f", start {e.start}" if e.start else "")
             )
         lines += [f"  note: {n}" for n in self.notes]
-        lines.append(f"wrote {self.world_path} and {self.schedule_path}")
+        written = [self.world_path, self.schedule_path]
+        written += [self.install_path] if self.install_path is not None else []
+        lines.append("wrote " + ", ".join(str(p) for p in written[:-1]) + f" and {written[-1]}")
         return "\n".join(lines)
 
 
@@ -218,6 +221,8 @@ def convert(options: BimOptions) -> Conversion:
     )
     schedule_path.write_text(json.dumps(_schedule_document(conversion, options), indent=2) + "\n")
     _check_world(world_path)
+    conversion.install_path = options.out / "install.xml"
+    conversion.install_path.write_text(install_tree(elements, source.path.name))
     return conversion
 
 

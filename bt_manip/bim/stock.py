@@ -1,9 +1,12 @@
 """The stock area: where the elements to install wait, each standing in a slotted stand.
 
-The stands stand side by side across the stock's heading (``yaw``), :func:`spacing` apart, each
-element upright in its slot with its length along the heading, the first to install on the
-right-hand side. The robot reaches them from the apron, a free strip :data:`APRON` long before
-the stock's back end (the ``stock`` pose of the world, facing the stands). Each element is
+The stands stand one behind the other along the stock's heading (``yaw``), :func:`spacing`
+apart, each element upright in its slot with its length across the heading, the first to
+install nearest the apron. The robot reaches them from the apron, a free strip :data:`APRON`
+long before the stock's back end (the ``stock`` pose of the world, facing the stands): it faces
+the first element square on, and each next one from where the ones taken stood. The rails are
+lower (:data:`RAIL`) than the lowest obstacle the navigator maps (2 cm), so the robot drives
+over an empty stand. Each element is
 moved by up to :data:`JITTER` m and rad per seed (its slot leaves :data:`SLOT_GAP` of play on
 each side).
 """
@@ -21,7 +24,7 @@ APRON = 1.4
 """Free floor (m) kept before the stands for the robot."""
 SLOT_GAP = 0.01
 """Play (m) between an element and each rail of its slot."""
-RAIL = (0.02, 0.03)
+RAIL = (0.02, 0.015)
 """Width and height (m) of a stand's rails."""
 JITTER = 0.004
 """Largest offset (m in x and y, rad in yaw) of an element in its slot, per seed."""
@@ -54,8 +57,8 @@ def spacing(thicknesses: list[float]) -> float:
 
 def stock_size(sizes: list[tuple[float, float, float]]) -> tuple[float, float]:
     """Length (along the heading) and width of the stands' area."""
-    length = max((s[0] for s in sizes), default=0.5) + 0.2
-    width = (len(sizes) - 1) * spacing([s[1] for s in sizes]) + max(
+    width = max((s[0] for s in sizes), default=0.5) + 0.2
+    length = (len(sizes) - 1) * spacing([s[1] for s in sizes]) + max(
         (s[1] for s in sizes), default=0.0
     ) + 2 * (SLOT_GAP + RAIL[0]) + 0.1
     return length, width
@@ -79,14 +82,16 @@ def apron_pose(
 
 
 def slots(pose: StockPose, sizes: list[tuple[float, float, float]]) -> list[Slot]:
-    """One slot per element, in installation order, from the right-hand side."""
+    """One slot per element, in installation order, from the apron's side; each element's
+    length lies across the heading."""
     step = spacing([s[1] for s in sizes])
     n = len(sizes)
     c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+    across = math.atan2(math.sin(pose.yaw + math.pi / 2), math.cos(pose.yaw + math.pi / 2))
     out = []
     for k in range(n):
-        v = (k - (n - 1) / 2) * step
-        out.append(Slot(pose.x - s * v, pose.y + c * v, pose.yaw))
+        u = (k - (n - 1) / 2) * step
+        out.append(Slot(pose.x + c * u, pose.y + s * u, across))
     return out
 
 

@@ -16,8 +16,8 @@
 Walls are 0.2 m thick and 2.5 m high, centred on the lines drawn. A slab lies under the whole
 building (top at z = 0), a table (a mesh, turned 30 deg) stands in the workshop's north-east
 corner, and six panels (IfcPlate, 1.2 x 0.02 x 0.3 m of a 400 kg/m3 material: 2.88 kg, within
-the UR3's 3 kg payload) are to be installed on the inner faces of the workshop's west wall and
-the office's east wall, each by its own task.
+the UR3's 3 kg payload) are to be installed standing on the floor against the inner faces of the
+workshop's west wall and the office's east and south walls, each by its own task.
 """
 
 from __future__ import annotations
@@ -63,15 +63,17 @@ class Panel:
     start: str
 
 
-# The default panels: three on the workshop's west wall (facing +x), three on the office's
-# east wall (facing -x), at z = 0.85..1.15 m.
+# The default panels stand on the floor against the walls (z = 0..0.3 m, 5 mm off the wall's
+# face): three on the workshop's west wall (facing +x), two on the office's east wall (facing
+# -x) and one on the office's south wall (facing +y). A UR3 on a Husky reaches about 0.9 m
+# above the floor with its gripper pointing down, so a panel's top edge must stay within that.
 PANELS = [
-    Panel("Panel W1", (0.11, 1.0, 1.0), math.pi / 2, "2026-03-02"),
-    Panel("Panel W2", (0.11, 2.5, 1.0), math.pi / 2, "2026-03-03"),
-    Panel("Panel W3", (0.11, 4.0, 1.0), math.pi / 2, "2026-03-04"),
-    Panel("Panel E1", (9.89, 0.8, 1.0), -math.pi / 2, "2026-03-05"),
-    Panel("Panel E2", (9.89, 1.5, 1.0), -math.pi / 2, "2026-03-06"),
-    Panel("Panel E3", (9.89, 2.2, 1.0), -math.pi / 2, "2026-03-09"),
+    Panel("Panel W1", (0.115, 1.0, 0.15), math.pi / 2, "2026-03-02"),
+    Panel("Panel W2", (0.115, 2.5, 0.15), math.pi / 2, "2026-03-03"),
+    Panel("Panel W3", (0.115, 4.0, 0.15), math.pi / 2, "2026-03-04"),
+    Panel("Panel E1", (9.885, 0.8, 0.15), -math.pi / 2, "2026-03-05"),
+    Panel("Panel E2", (9.885, 2.2, 0.15), -math.pi / 2, "2026-03-06"),
+    Panel("Panel S1", (6.2, 0.115, 0.15), 0.0, "2026-03-09"),
 ]
 
 

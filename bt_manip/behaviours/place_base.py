@@ -1,0 +1,304 @@
+"""PlanBaseForPlace: where to park a mobile manipulator so that its arm can place what it holds.
+
+Like :mod:`bt_manip.behaviours.base_placement` (PlanBaseForGrasp), but for the object already
+in the hand and its target pose: the grasp frame the arm must reach is the one that puts the
+object, held as it is now, at the target (:func:`bt_manip.behaviours.place.place_frames`, both
+turns of the target). Base poses are tried in this order:
+
+1. the poses from which the object, held exactly as now, would already be over its target (the
+   robot stands to the target as it stands to the object now; the arm then only goes down);
+2. the rings of :func:`~bt_manip.behaviours.base_placement.sample` around the target's grasp
+   point, those that turn the object least relative to the robot first.
+
+A pose is kept when the robot's footprint as the navigator plans with it (the carried object
+included, where it is in the hand now) is ``clearance`` from every obstacle, there is room to
+line up behind it and drive straight in, the arm's way to the target crosses no obstacle, the
+arm's IK reaches the pre-place point (``approach`` m above the target) from the arm's posture
+now and every point of the straight line down, and the navigator finds a path to the staging
+pose. The work is bounded as in PlanBaseForGrasp.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess
+from bt_manip.behaviours.base_placement import (
+    Candidate,
+    Placement,
+    PlacementOptions,
+    footprint_free,
+    planar,
+    pose_text,
+    sample,
+    staging,
+    staging_free,
+    way_clear,
+)
+from bt_manip.behaviours.cartesian import STEP, arm_ik
+from bt_manip.behaviours.place import (
+    DEFAULT_APPROACH,
+    DEFAULT_GAP,
+    OBJECT,
+    TARGET,
+    held_body,
+    lifted,
+    place_frames,
+    read_target,
+)
+from bt_manip.bt import registry
+from bt_manip.bt.ports import Accepts, Port
+from bt_manip.grasps import GraspError, box_size
+from bt_manip.navigation.lattice import outline_samples
+from bt_manip.perception import true_pose
+from bt_manip.placing import Target, yaw_of_matrix
+
+STANDOFFS = (0.12, 0.16, 0.2)
+"""How far (m) the poses of step 1 stand back from where the object would be over its target:
+the load must stay clear of the wall it is set against until the arm moves it there."""
+TURNS = (0.0, -0.15, 0.15, -0.3, 0.3)
+"""Turns (rad) of the poses of step 1 about the target's grasp point."""
+LOAD_CLEARANCE = 0.1
+"""Clearance (m) of the carried object, where it is in the hand now, from every obstacle (the
+navigator asks 5 cm and half a grid cell's diagonal)."""
+TURN_WEIGHT = 0.2
+"""Score per radian the object turns relative to the robot (rings), against the 0.1 m, 0.5 rad
+units of :meth:`~bt_manip.behaviours.base_placement.Candidate.score`."""
+
+
+def wrap_half(angle: float) -> float:
+    """``angle`` into (-pi/2, pi/2]: a box turned half a turn is the same box."""
+    a = math.fmod(angle, math.pi)
+    if a > math.pi / 2:
+        a -= math.pi
+    elif a <= -math.pi / 2:
+        a += math.pi
+    return a
+
+
+def reach_down(
+    ik: Any, arm_in_world: np.ndarray, goal: np.ndarray, approach: float, seed: np.ndarray
+) -> tuple[np.ndarray | None, str]:
+    """Joint values at ``goal`` when the arm (its base at ``arm_in_world``) reaches the point
+    ``approach`` m above it and every waypoint of the straight line down; else None and IK's
+    reason."""
+    to_arm = np.linalg.inv(arm_in_world)
+    pre = lifted(goal, approach)
+    result = ik.full.solve(to_arm @ pre, q_seed=seed)
+    if not result.success:
+        return None, f"pre-place point: {result.reason}"
+    q = result.q
+    n = max(1, math.ceil(approach / STEP))
+    for i in range(1, n + 1):
+        result = ik.full.solve(to_arm @ lifted(goal, approach * (1 - i / n)), q_seed=q)
+        if not result.success:
+            return None, f"line down: {result.reason}"
+        q = result.q
+    return np.asarray(q, dtype=float), ""
+
+
+def mirrored(
+    target: Target, object_now: np.ndarray, base_now: np.ndarray, goal_xy: np.ndarray
+) -> list[Candidate]:
+    """Base poses from which the object, held as now, is over each turn of the target, each
+    moved back by each of :data:`STANDOFFS` and turned about the target's grasp point by each
+    of :data:`TURNS` (the arm turns the object back by as much)."""
+    out = []
+    x0, y0 = float(base_now[0, 3]), float(base_now[1, 3])
+    gx, gy = float(goal_xy[0]), float(goal_xy[1])
+    for back in STANDOFFS:
+        for turn in TURNS:
+            for flip in (False, True):
+                base = target.matrix(flip) @ np.linalg.inv(object_now) @ base_now
+                yaw = yaw_of_matrix(base)
+                x = float(base[0, 3]) - back * math.cos(yaw)
+                y = float(base[1, 3]) - back * math.sin(yaw)
+                c, s = math.cos(turn), math.sin(turn)
+                x, y = gx + c * (x - gx) - s * (y - gy), gy + s * (x - gx) + c * (y - gy)
+                out.append(Candidate(x, y, yaw + turn, 0.0, turn, math.hypot(x - x0, y - y0)))
+    return out
+
+
+def load_samples(size: tuple[float, float, float], object_in_base: np.ndarray) -> np.ndarray:
+    """Points (x, y; robot frame) every 5 cm round the horizontal outline of the held box."""
+    hx, hy = size[0] / 2, size[1] / 2
+    corners = [(-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy)]
+    pts = []
+    for (ax, ay), (bx, by) in zip(corners, corners[1:] + corners[:1], strict=True):
+        n = max(1, math.ceil(math.hypot(bx - ax, by - ay) / 0.05))
+        pts += [(ax + (bx - ax) * i / n, ay + (by - ay) * i / n) for i in range(n)]
+    local = np.array([[x, y, 0.0, 1.0] for x, y in pts])
+    return (object_in_base @ local.T).T[:, :2]
+
+
+def plan_place_base(
+    node: WorldAccess, robot: Any, name: str, target: Target, options: PlacementOptions,
+    gap: float = DEFAULT_GAP,
+) -> Placement:
+    """A base pose from which ``robot``'s arm places the object ``name`` it holds at
+    ``target`` (see the module docstring)."""
+    from bt_manip.behaviours.navigate import synced_navigator
+
+    body = held_body(node, name)
+    nav = synced_navigator(node, robot)
+    nav.refresh()
+    options = dataclasses.replace(options, pivot=float(nav.pivot))
+    grid = nav.costmap.grid
+    clear = nav.costmap.clear
+    origin = np.asarray(grid.origin, dtype=float)
+    res = float(grid.resolution)
+    pts = outline_samples(nav.base_footprint)
+    x0, y0, yaw0 = robot.base_pose2d()
+    base_now = planar(x0, y0, yaw0)
+    arm = robot.link_transform(robot.description.arm.base_link)
+    arm_in_base = np.linalg.inv(base_now) @ arm
+    services = node.run_context.robot_services(node.robot_name_of(robot))
+    tip = robot.description.grasp_frame
+    ik = arm_ik(services, tip)
+    seed = robot.arm_positions()
+    hand = robot.link_transform(tip)
+    object_now = true_pose(node.world, body)
+    try:
+        size = box_size(node.world, name)
+    except GraspError as exc:
+        raise ActionFailed(f"cannot place '{name}': {exc}") from None
+    load = load_samples(size, np.linalg.inv(base_now) @ object_now)
+    load_options = dataclasses.replace(options, clearance=LOAD_CLEARANCE)
+    frames = [lifted(f, gap) for f in place_frames(target, np.linalg.inv(hand) @ object_now, hand)]
+    goal_xy = frames[0][:2, 3]
+    relative_now = yaw_of_matrix(object_now) - yaw0
+
+    def turn(cand: Candidate) -> float:
+        return abs(wrap_half(target.yaw - cand.yaw - relative_now))
+
+    rings = sample(goal_xy, arm_in_base[:2, 3], np.array([x0, y0]), options)
+    rings.sort(key=lambda c: c.score(options.preferred_distance) + turn(c) / TURN_WEIGHT)
+    candidates = mirrored(target, object_now, base_now, goal_xy) + rings
+    counts = {
+        "sampled": len(candidates), "collide": 0, "load collides": 0, "no room to line up": 0, "reach over": 0,
+        "IK": 0, "no path": 0,
+    }
+    turning = float(nav.base_footprint.circumradius)
+    ik_checks = path_checks = 0
+    last_ik = ""
+    pivot = float(nav.pivot)
+    for cand in candidates:
+        if not footprint_free(clear, origin, res, pts, cand, options.clearance):
+            counts["collide"] += 1
+            continue
+        if not footprint_free(clear, origin, res, load, cand, LOAD_CLEARANCE):
+            counts["load collides"] += 1
+            continue
+        if not staging_free(clear, origin, res, pts, cand, options, turning) or not (
+            staging_free(clear, origin, res, load, cand, load_options, 0.0)
+        ):
+            counts["no room to line up"] += 1
+            continue
+        arm_world = planar(cand.x, cand.y, cand.yaw) @ arm_in_base
+        if not way_clear(grid.occupied, origin, res, arm_world[:2, 3], goal_xy):
+            counts["reach over"] += 1
+            continue
+        if ik_checks >= options.max_ik_candidates:
+            break
+        ik_checks += 1
+        q = None
+        for frame in frames:
+            q, why = reach_down(ik, arm_world, frame, options.approach, seed)
+            if q is not None:
+                break
+            last_ik = why
+        if q is None:
+            counts["IK"] += 1
+            continue
+        if path_checks >= options.max_path_checks:
+            break
+        path_checks += 1
+        sx, sy, syaw = staging(cand, options)
+        start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
+        goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
+        if not nav.plan_to(start, goal).ok:
+            counts["no path"] += 1
+            continue
+        return Placement(True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), frame, q, counts)
+    parts = [f"{counts['sampled']} poses sampled"]
+    labels = {
+        "collide": "too close to an obstacle",
+        "load collides": "with the load too close to an obstacle",
+        "no room to line up": "with no room to line up behind them",
+        "reach over": "would reach over an obstacle",
+        "IK": "out of the arm's reach",
+        "no path": "with no path to them",
+    }
+    parts += [f"{counts[k]} {text}" for k, text in labels.items() if counts[k]]
+    if ik_checks >= options.max_ik_candidates or path_checks >= options.max_path_checks:
+        parts.append("check budget spent")
+    if last_ik:
+        parts.append(f"last IK failure: {last_ik}")
+    return Placement(False, "; ".join(parts), counts=counts)
+
+
+@registry.register
+class PlanBaseForPlace(RobotAction):
+    """Finds a base pose from which the arm places the held ``object`` at ``target``
+    (``x;y;z;yaw`` of its centre), as the Place node does it: from ``approach`` m above, straight
+    down (see :mod:`bt_manip.behaviours.place_base`).
+
+    - SUCCESS with ``base_pose`` (``x;y;yaw``, for ``Navigate goal="{base_pose}"``) and
+      ``staging_pose`` (the pose to line up at first, ``staging`` m behind, facing the same
+      way) set;
+    - FAILURE when the robot does not hold the object, the target is not ``x;y;z;yaw``, or no
+      sampled pose passes every check: the reason starts "no base pose from which the arm
+      places OBJECT" and counts what each check rejected.
+    It does its work in the tick it starts (bounded), so it is never RUNNING and halting has
+    nothing to undo.
+    """
+
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        **RobotAction.INPUT_PORTS,
+        "object": OBJECT,
+        "target": TARGET,
+        "approach": Port(
+            float, False, "length of the straight final motion down (m)", DEFAULT_APPROACH,
+            Accepts(0.02, 0.3),
+        ),
+        "clearance": Port(
+            float, False, "footprint clearance from obstacles (m)", PlacementOptions.clearance,
+            Accepts(0.0, 0.5),
+        ),
+    }
+    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "base_pose": PortInformation(str, False, "base pose x;y;yaw for Navigate goal"),
+        "staging_pose": PortInformation(
+            str, False, "pose x;y;yaw to line up at before driving straight to base_pose"
+        ),
+    }
+
+    def start(self) -> None:
+        robot = self.robot()
+        if robot.description.base.type != "skid_steer":
+            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        name = self.get_input("object")
+        options = PlacementOptions(
+            approach=float(self.get_input("approach")),
+            clearance=float(self.get_input("clearance")),
+            arm_state="",
+        )
+        placement = plan_place_base(self, robot, name, read_target(self), options)
+        if not placement.ok:
+            raise ActionFailed(
+                f"no base pose from which the arm places {name}: {placement.reason}"
+            )
+        assert placement.base_pose is not None
+        self.set_output("base_pose", pose_text(placement.base_pose))
+        self.set_output("staging_pose", pose_text(placement.staging_pose or ()))
+        if placement.grasp is not None:
+            self.overlay.show_frame("ik_target", placement.grasp)
+
+    def step(self) -> Status:
+        return Status.SUCCESS
