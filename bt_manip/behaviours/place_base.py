@@ -59,7 +59,7 @@ from bt_manip.navigation.lattice import outline_samples
 from bt_manip.perception import true_pose
 from bt_manip.placing import Target, yaw_of_matrix
 
-STANDOFFS = (0.12, 0.16, 0.2)
+STANDOFFS = (0.16, 0.2, 0.24)
 """How far (m) the poses of step 1 stand back from where the object would be over its target:
 the load must stay clear of the wall it is set against until the arm moves it there."""
 TURNS = (0.0, -0.15, 0.15, -0.3, 0.3)
@@ -137,6 +137,29 @@ def load_samples(size: tuple[float, float, float], object_in_base: np.ndarray) -
     return (object_in_base @ local.T).T[:, :2]
 
 
+def carry_fits(nav: Any) -> Any:
+    """A test of whether the carrying robot fits at a candidate pose as the navigator checks a
+    goal when it plans over poses with a load (its own layers and clearance), or None when the
+    navigator has no load layers."""
+    from bt_manip.navigation.lattice import LatticeOptions, _pose_free
+
+    nav._build_carry_layers()  # the layers hold the movable objects where they are now
+    carry = getattr(nav, "_carry", None)
+    if carry is None:
+        return None
+    low_fp, high_fp, low, clear_low, clear_high = carry
+    pts = outline_samples(low_fp, 0.05)
+    pts_high = outline_samples(high_fp, 0.05)
+    need = LatticeOptions().min_clearance + low.resolution / math.sqrt(2.0)
+    x0, y0 = low.origin
+
+    def fits(cand: Candidate) -> bool:
+        return bool(_pose_free(clear_low, clear_high, x0, y0, low.resolution, pts, pts_high,
+                               cand.x, cand.y, cand.yaw, need))
+
+    return fits
+
+
 def plan_place_base(
     node: WorldAccess, robot: Any, name: str, target: Target, options: PlacementOptions,
     gap: float = DEFAULT_GAP,
@@ -170,6 +193,7 @@ def plan_place_base(
         raise ActionFailed(f"cannot place '{name}': {exc}") from None
     load = load_samples(size, np.linalg.inv(base_now) @ object_now)
     load_options = dataclasses.replace(options, clearance=LOAD_CLEARANCE)
+    fits = carry_fits(nav)
     frames = [lifted(f, gap) for f in place_frames(target, np.linalg.inv(hand) @ object_now, hand)]
     goal_xy = frames[0][:2, 3]
     relative_now = yaw_of_matrix(object_now) - yaw0
@@ -181,8 +205,8 @@ def plan_place_base(
     rings.sort(key=lambda c: c.score(options.preferred_distance) + turn(c) / TURN_WEIGHT)
     candidates = mirrored(target, object_now, base_now, goal_xy) + rings
     counts = {
-        "sampled": len(candidates), "collide": 0, "load collides": 0, "no room to line up": 0, "reach over": 0,
-        "IK": 0, "no path": 0,
+        "sampled": len(candidates), "collide": 0, "load collides": 0, "no room to line up": 0,
+        "reach over": 0, "IK": 0, "no path": 0,
     }
     turning = float(nav.base_footprint.circumradius)
     ik_checks = path_checks = 0
@@ -192,7 +216,9 @@ def plan_place_base(
         if not footprint_free(clear, origin, res, pts, cand, options.clearance):
             counts["collide"] += 1
             continue
-        if not footprint_free(clear, origin, res, load, cand, LOAD_CLEARANCE):
+        if not footprint_free(clear, origin, res, load, cand, LOAD_CLEARANCE) or (
+            fits is not None and not fits(cand)
+        ):
             counts["load collides"] += 1
             continue
         if not staging_free(clear, origin, res, pts, cand, options, turning) or not (

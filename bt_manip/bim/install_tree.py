@@ -31,7 +31,7 @@ from bt_manip.bim.schedule import InstallElement
 
 LIFT = 0.15
 """How high (m) an element is lifted straight out of its stand."""
-PULL_IN = 0.12
+PULL_IN = 0.16
 """How far (m) the element is pulled in towards the robot for the carry."""
 FINGER_PLAY = 0.001
 """The fingers close to this much (m) wider than the element."""

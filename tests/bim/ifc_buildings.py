@@ -63,17 +63,19 @@ class Panel:
     start: str
 
 
-# The default panels stand on the floor against the walls (z = 0..0.3 m, 5 mm off the wall's
-# face): three on the workshop's west wall (facing +x), two on the office's east wall (facing
-# -x) and one on the office's south wall (facing +y). A UR3 on a Husky reaches about 0.9 m
-# above the floor with its gripper pointing down, so a panel's top edge must stay within that.
+# The default panels stand on the floor before the walls (z = 0..0.3 m), 8 cm off the wall's
+# face: three before the workshop's west wall (facing +x), two before the office's east wall
+# (facing -x) and one before the office's south wall (facing +y). They suit the robot: a UR3
+# on a Husky with its gripper pointing down reaches a top edge up to about 0.9 m above the
+# floor, and its gripper, closing across a panel's thickness from above, is 15 cm wide, so
+# the wall must leave it 7.5 cm on the panel's far side.
 PANELS = [
-    Panel("Panel W1", (0.115, 1.0, 0.15), math.pi / 2, "2026-03-02"),
-    Panel("Panel W2", (0.115, 2.5, 0.15), math.pi / 2, "2026-03-03"),
-    Panel("Panel W3", (0.115, 4.0, 0.15), math.pi / 2, "2026-03-04"),
-    Panel("Panel E1", (9.885, 0.8, 0.15), -math.pi / 2, "2026-03-05"),
-    Panel("Panel E2", (9.885, 2.2, 0.15), -math.pi / 2, "2026-03-06"),
-    Panel("Panel S1", (6.2, 0.115, 0.15), 0.0, "2026-03-09"),
+    Panel("Panel W1", (0.19, 1.4, 0.15), math.pi / 2, "2026-03-02"),
+    Panel("Panel W2", (0.19, 2.75, 0.15), math.pi / 2, "2026-03-03"),
+    Panel("Panel W3", (0.19, 4.1, 0.15), math.pi / 2, "2026-03-04"),
+    Panel("Panel E1", (9.81, 0.8, 0.15), -math.pi / 2, "2026-03-05"),
+    Panel("Panel E2", (9.81, 2.2, 0.15), -math.pi / 2, "2026-03-06"),
+    Panel("Panel S1", (6.2, 0.19, 0.15), 0.0, "2026-03-09"),
 ]
 
 
