@@ -1,6 +1,6 @@
 """Robot behaviours for trees: importing this package registers them with the node registry.
 
-- Base: Navigate, Reverse, GetClear, PlanBaseForGrasp (where to park to grasp an object),
+- Base: Navigate, Reverse, DriveStraight (onto a pose it faces), GetClear, PlanBaseForGrasp (where to park to grasp an object),
   PlanBaseForPlace (where to park to place the object in the hand).
 - Arm: MoveJointsSequentially, MoveJoints, MoveToPose (also to an object's grasp frame), Lift,
   MoveToolBy (a straight move by an offset).
@@ -15,6 +15,7 @@ from bt_manip.behaviours import (
     attach,
     base_placement,
     conditions,
+    drive_straight,
     fasten,
     get_clear,
     gripper,
@@ -31,6 +32,7 @@ __all__ = [
     "attach",
     "base_placement",
     "conditions",
+    "drive_straight",
     "fasten",
     "get_clear",
     "gripper",

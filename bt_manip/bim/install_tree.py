@@ -92,11 +92,12 @@ def _back_off(parent: ET.Element, name: str, hand_up: float) -> None:
     _node(seq, "AlwaysFailure", name="attempt_failed")
 
 
-def _drive(parent: ET.Element, name: str, goal: str) -> None:
-    """Navigate to ``goal``, backing up half a metre and trying again on a failure."""
+def _drive(parent: ET.Element, name: str, goal: str, tolerance: str = "0.05") -> None:
+    """Navigate to ``goal`` (within ``tolerance`` m and rad), backing up half a metre and trying
+    again on a failure."""
     retry = _node(parent, "RetryUntilSuccessful", name=f"{name}_attempts", num_attempts="3")
     fb = _node(retry, "Fallback", name=f"{name}_or_back_up")
-    _node(fb, "Navigate", name=name, goal=goal, xy_tolerance="0.05", yaw_tolerance="0.05")
+    _node(fb, "Navigate", name=name, goal=goal, xy_tolerance=tolerance, yaw_tolerance=tolerance)
     seq = _node(fb, "Sequence", name=f"{name}_back_up")
     force = _node(seq, "ForceSuccess")
     _node(force, "Reverse", name="back_up", distance="0.5")
@@ -111,9 +112,9 @@ def _fetch_element(root: ET.Element) -> None:
     _node(seq, "MoveJoints", name="tuck_for_driving", state="tuck")
     _node(seq, "PlanBaseForGrasp", name="plan_grasp_base", object="{element}", grasp="top",
           approach="0.12", base_pose="{base_pose}", staging_pose="{staging_pose}")
-    _drive(seq, "to_grasp_staging", "{staging_pose}")
-    _node(seq, "Navigate", name="drive_in", goal="{base_pose}", xy_tolerance="0.03",
-          yaw_tolerance="0.03")
+    _drive(seq, "to_grasp_staging", "{staging_pose}", "0.08")
+    _node(seq, "DriveStraight", name="drive_in", goal="{base_pose}", xy_tolerance="0.04",
+          yaw_tolerance="0.05")
     _node(seq, "MoveJoints", name="arm_ready", state="home")
     _node(seq, "MoveToPose", name="reach_element", object="{element}", grasp="top",
           approach="0.12", tolerance="0.002")
@@ -137,9 +138,10 @@ def _place_element(root: ET.Element) -> None:
     _node(seq, "IsAttached", name="element_in_hand", object="{element}")
     _node(seq, "PlanBaseForPlace", name="plan_place_base", object="{element}",
           target="{target}", base_pose="{place_base}", staging_pose="{place_staging}")
-    _drive(seq, "carry_to_staging", "{place_staging}")
-    _node(seq, "Navigate", name="drive_to_place", goal="{place_base}", xy_tolerance="0.03",
-          yaw_tolerance="0.03")
+    _drive(seq, "carry_to_staging", "{place_staging}", "0.08")
+    # straight in: a path follower turning on the spot at the goal would sweep the load round
+    _node(seq, "DriveStraight", name="drive_to_place", goal="{place_base}", xy_tolerance="0.04",
+          yaw_tolerance="0.05")
     _node(seq, "Place", name="place_element", object="{element}", target="{target}",
           placed_pose="{placed_pose}", deviation_mm="{deviation_mm}",
           deviation_deg="{deviation_deg}", via_tolerance="0.01", speed="0.2")

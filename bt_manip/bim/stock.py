@@ -24,7 +24,7 @@ APRON = 1.4
 """Free floor (m) kept before the stands for the robot."""
 SLOT_GAP = 0.01
 """Play (m) between an element and each rail of its slot."""
-RAIL = (0.02, 0.015)
+RAIL = (0.02, 0.006)
 """Width and height (m) of a stand's rails."""
 JITTER = 0.004
 """Largest offset (m in x and y, rad in yaw) of an element in its slot, per seed."""
