@@ -107,6 +107,9 @@ class RunReport:
     cause: dict[str, str] = field(default_factory=dict)
     """On FAILURE, the node whose failure ended the run: ``path``, ``name``, ``node`` (its ID)
     and ``reason``; empty otherwise."""
+    as_built: list[dict[str, Any]] | None = None
+    """In a world written by ``bt-manip bim``: each scheduled element's planned and placed pose,
+    deviation and status (:mod:`bt_manip.bim.as_built`); None elsewhere."""
 
     @property
     def exit_code(self) -> int:
@@ -122,6 +125,8 @@ class RunReport:
             round(self.real_time_factor, 3) if math.isfinite(self.real_time_factor) else None
         )
         data["exit_code"] = self.exit_code
+        if self.as_built is None:
+            del data["as_built"]
         return data
 
     def write(self, path: str | Path) -> None:
@@ -141,6 +146,10 @@ class RunReport:
         for n in failed[:10]:
             ended = " (ended the run)" if n.path == cause else ""
             lines.append(f"  FAILURE {n.path} [{n.node}]: {n.reason}{ended}")
+        if self.as_built is not None:
+            from bt_manip.bim.as_built import table_text
+
+            lines.append(table_text(self.as_built))
         return "\n".join(lines)
 
 
@@ -148,6 +157,17 @@ def _cause_json(cause: FailureCause | None) -> dict[str, str]:
     if cause is None:
         return {}
     return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
+
+
+def _as_built(world: Any) -> list[dict[str, Any]] | None:
+    """The as-built table when ``world`` was written by ``bt-manip bim`` (see
+    :mod:`bt_manip.bim.as_built`)."""
+    if world is None or getattr(world, "path", None) is None:
+        return None
+    from bt_manip.bim.as_built import as_built, schedule_for
+
+    schedule = schedule_for(world.path)
+    return as_built(world, schedule) if schedule is not None else None
 
 
 def node_reports(tree: Any) -> list[NodeReport]:
@@ -261,6 +281,7 @@ class Runner:
             ticks=self.ticks,
             nodes=self._records(),
             cause=_cause_json(self.cause),
+            as_built=_as_built(self.world),
         )
 
     def _advance(self, wall0: float) -> None:

@@ -1,7 +1,8 @@
 """Robot behaviours for trees: importing this package registers them with the node registry.
 
-- Base: Navigate, Reverse, DriveStraight (onto a pose it faces), GetClear, PlanBaseForGrasp (where to park to grasp an object),
-  PlanBaseForPlace (where to park to place the object in the hand).
+- Base: Navigate, Reverse, DriveStraight (onto a pose it faces), GetClear, PlanBaseForGrasp
+  (where to park to grasp an object), PlanBaseForPlace (where to park to place the object in
+  the hand).
 - Arm: MoveJointsSequentially, MoveJoints, MoveToPose (also to an object's grasp frame), Lift,
   MoveToolBy (a straight move by an offset).
 - Gripper: OpenGripper, CloseGripper. Attach joints: Attach, Detach.

@@ -44,6 +44,7 @@ from bt_manip.bim.stock import (
     slots,
     stand_entry,
     stand_rects,
+    stock_group,
 )
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.errors import InputError
@@ -198,6 +199,9 @@ def convert(options: BimOptions) -> Conversion:
             }
         ],
         "poses": poses,
+        "groups": [
+            stock_group(stock, [e["name"] for e in world_stands + world_objects] + ["stock"])
+        ],
     }
     if "tuck" in robot.states:
         world["robots"][0]["arm_state"] = "tuck"

@@ -6,9 +6,8 @@ install nearest the apron. The robot reaches them from the apron, a free strip :
 long before the stock's back end (the ``stock`` pose of the world, facing the stands): it faces
 the first element square on, and each next one from where the ones taken stood. The rails are
 lower (:data:`RAIL`) than the lowest obstacle the navigator maps (2 cm), so the robot drives
-over an empty stand. Each element is
-moved by up to :data:`JITTER` m and rad per seed (its slot leaves :data:`SLOT_GAP` of play on
-each side).
+over an empty stand. The whole stock (stands, elements and the ``stock`` pose) moves rigidly
+by up to :data:`SHIFT` m and :data:`TURN` rad per seed (a world ``groups:`` entry).
 """
 
 from __future__ import annotations
@@ -26,8 +25,10 @@ SLOT_GAP = 0.01
 """Play (m) between an element and each rail of its slot."""
 RAIL = (0.02, 0.006)
 """Width and height (m) of a stand's rails."""
-JITTER = 0.004
-"""Largest offset (m in x and y, rad in yaw) of an element in its slot, per seed."""
+SHIFT = 0.08
+"""Largest shift (m in x and y) of the whole stock (stands and elements together), per seed."""
+TURN = 0.05
+"""Largest turn (rad) of the whole stock, per seed."""
 MARGIN = 0.2
 """Free floor (m) kept around the stands and the apron when the stock is placed."""
 
@@ -184,5 +185,15 @@ def element_entry(
         "friction": 0.9,
         "colour": "white",
         "pose": pose3(slot.x, slot.y, size[2] / 2 + 0.0005, slot.yaw),
-        "randomize": {"x": [-JITTER, JITTER], "y": [-JITTER, JITTER], "yaw": [-JITTER, JITTER]},
+    }
+
+
+def stock_group(pose: StockPose, members: list[str]) -> dict[str, Any]:
+    """The world's ``groups:`` entry that moves the stands, the elements and the ``stock`` pose
+    together, by up to :data:`SHIFT` and :data:`TURN` per seed."""
+    return {
+        "name": "stock_area",
+        "members": members,
+        "origin": [r(pose.x), r(pose.y)],
+        "randomize": {"x": [-SHIFT, SHIFT], "y": [-SHIFT, SHIFT], "yaw": [-TURN, TURN]},
     }
