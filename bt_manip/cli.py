@@ -5,6 +5,7 @@ Verbs:
   bench TREE.xml --world W   many seeded episodes in parallel, with statistics
   world W.yaml               load a world, print its summary, optionally let it settle
   bim BUILDING.ifc --out D   an IFC building and its schedule to a world and schedule.json
+  bim-report REPORT --png P  the floor plan of an installation run, as built
   validate TREE.xml          check a tree without running it, listing every problem
   show TREE.xml              print a tree as text (or Graphviz with --dot)
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
@@ -334,9 +335,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     world.set_defaults(func=cmd_world)
 
-    from bt_manip.bim.command import add_bim_verb
+    from bt_manip.bim.command import add_bim_report_verb, add_bim_verb
 
     add_bim_verb(sub)
+    add_bim_report_verb(sub)
 
     from bt_manip.sim.robot_command import add_robot_verb
 

@@ -62,6 +62,38 @@ def add_bim_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-
     bim.set_defaults(func=cmd_bim)
 
 
+def add_bim_report_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
+    """Register ``bt-manip bim-report``."""
+    rep = sub.add_parser(
+        "bim-report",
+        help="the floor plan of an installation run, elements coloured by their deviation",
+    )
+    rep.add_argument("report", help="run report (run --report) of a world made by bt-manip bim")
+    rep.add_argument("--png", required=True, help="image to write (PNG)")
+    rep.add_argument("--world", help="world file (default: the one the report names)")
+    rep.set_defaults(func=cmd_bim_report)
+
+
+def cmd_bim_report(args: argparse.Namespace) -> int:
+    from bt_manip.bim.as_built import table_text
+    from bt_manip.bim.as_built_plot import plot, read_report
+    from bt_manip.outputs import check_output_file
+
+    report = read_report(Path(args.report))
+    world = Path(args.world or str(report.get("world") or ""))
+    if not world.is_file():
+        raise InputError.single(
+            "--world" if args.world else args.report, None,
+            f"world file '{world}' not found; give it with --world",
+        )
+    out = Path(args.png)
+    check_output_file("--png", out)
+    plot(report, world, out)
+    print(table_text(report["as_built"]))
+    print(f"wrote {out}")
+    return 0
+
+
 def cmd_bim(args: argparse.Namespace) -> int:
     from bt_manip.bim import require_ifcopenshell
 
