@@ -8,6 +8,8 @@ from pathlib import Path
 
 from bt_manip.errors import InputError
 
+MAX_PAYLOAD = 10000.0
+"""Largest ``--payload`` (kg)."""
 MAX_SEEDS = 1000
 """Seeds ``--seed-range`` checks at most."""
 
@@ -21,6 +23,16 @@ def _stock(text: str) -> tuple[float, float, float]:
     if len(values) != 3 or not all(math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError(f"expected X;Y;YAW (metres, radians), got '{text}'")
     return values  # type: ignore[return-value]
+
+
+def _payload(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not (math.isfinite(value) and 0.0 < value <= MAX_PAYLOAD):
+        raise argparse.ArgumentTypeError(f"expected a mass in (0, {MAX_PAYLOAD:g}] kg, got '{text}'")
+    return value
 
 
 def _seed_range(text: str) -> range:
@@ -55,6 +67,11 @@ def add_bim_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-
         "space)",
     )
     bim.add_argument("--start", metavar="SPACE", help="space the robot starts in (name)")
+    bim.add_argument(
+        "--payload", type=_payload, metavar="KG",
+        help="heaviest element the robot may carry (default: the robot's rated payload, 3 kg "
+        "for husky_ur3)",
+    )
     bim.add_argument(
         "--seed-range", type=_seed_range, metavar="FIRST:END",
         help="load the world with each seed FIRST..END-1 and check every randomised start",
@@ -108,6 +125,7 @@ def cmd_bim(args: argparse.Namespace) -> int:
             robot=args.robot,
             stock=args.stock,
             start_space=args.start,
+            payload=args.payload,
         )
     )
     print(conversion.summary())

@@ -55,6 +55,8 @@ A's panel (1.5 kg for 1.2 x 0.02 x 0.15 m)."""
 START_JITTER = 0.2
 """The robot's start is moved by up to this much (m in x and y) per seed; 1.5x that in rad."""
 SCHEMA_VERSION = 1
+PAYLOADS: dict[str, float] = {"husky_ur3": 3.0}
+"""Rated payload (kg) of the arms of known robots: the UR3's is 3 kg (Universal Robots)."""
 
 
 @dataclass
@@ -67,6 +69,8 @@ class BimOptions:
     robot: str = "husky_ur3"
     stock: tuple[float, float, float] | None = None
     start_space: str | None = None
+    payload: float | None = None
+    """Heaviest element (kg) the robot may carry; None: the robot's figure in PAYLOADS."""
 
 
 @dataclass
@@ -154,6 +158,7 @@ def convert(options: BimOptions) -> Conversion:
     building = read_building(source, storey, {p.entity.id() for p in planned}, names)
     elements = _elements(source, planned, storey, building.floor_z, names)
     source.raise_problems()
+    check_payload(source, elements, options)
 
     grid = floor_grid(building)
     sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
@@ -228,6 +233,30 @@ def convert(options: BimOptions) -> Conversion:
     conversion.install_path = options.out / "install.xml"
     conversion.install_path.write_text(install_tree(elements, source.path.name))
     return conversion
+
+
+def payload_of(options: BimOptions) -> float | None:
+    """The payload (kg) elements are checked against: ``--payload``, else the robot's figure
+    in :data:`PAYLOADS`; None when neither is known."""
+    if options.payload is not None:
+        return options.payload
+    return PAYLOADS.get(options.robot)
+
+
+def check_payload(source: IfcSource, elements: list[InstallElement], options: BimOptions) -> None:
+    """Every element heavier than the robot can carry is a problem: not to be attempted."""
+    payload = payload_of(options)
+    if payload is None:
+        return
+    where = "--payload" if options.payload is not None else f"the {options.robot}'s rated payload"
+    for e in elements:
+        if e.mass > payload:
+            source.fail(
+                source.model.by_id(e.step_id),
+                f"{e.mass:.2f} kg ({e.mass_source}), heavier than the {payload:g} kg the robot "
+                f"can carry ({where}): not to be installed by it",
+            )
+    source.raise_problems()
 
 
 def _no_elements(source: IfcSource, options: BimOptions) -> None:
