@@ -430,6 +430,10 @@ class PlanBaseForGrasp(RobotAction):
             str, False, "named arm state the reach starts from (empty: the posture now)",
             PlacementOptions.arm_state,
         ),
+        "staging": Port(
+            float, False, "how far behind base_pose to line up (m)", PlacementOptions.staging,
+            Accepts(0.2, 2.0),
+        ),
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "base_pose": PortInformation(str, False, "base pose x;y;yaw for Navigate goal"),
@@ -448,6 +452,7 @@ class PlanBaseForGrasp(RobotAction):
             approach=float(self.get_input("approach")),
             clearance=float(self.get_input("clearance")),
             arm_state=self.get_input("arm_state"),
+            staging=float(self.get_input("staging")),
         )
         placement = plan_base(self, robot, name, self.get_input("grasp"), options)
         if not placement.ok:

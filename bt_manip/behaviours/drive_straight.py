@@ -122,9 +122,10 @@ class DriveStraight(RobotAction):
             robot.stop_base()
             raise ActionFailed(f"not at the goal after {float(self.get_input('timeout')):g} s: "
                                f"{ahead:.2f} m to go")
-        # head for a point on the goal line a little ahead, and keep the goal's heading there
+        # head for a point on the goal line a little ahead; over the last stretch, for the
+        # goal's heading only
         look = max(ahead, 0.3)
-        want = gyaw + math.atan2(side, look)
+        want = gyaw + (math.atan2(side, look) if ahead > SLOW_DOWN else 0.0)
         rate = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, STEER_GAIN * wrap(want - yaw)))
         speed = float(self.get_input("speed"))
         if ahead < SLOW_DOWN:

@@ -67,6 +67,9 @@ TURNS = (0.0, -0.15, 0.15, -0.3, 0.3)
 LOAD_CLEARANCE = 0.1
 """Clearance (m) of the carried object, where it is in the hand now, from every obstacle (the
 navigator asks 5 cm and half a grid cell's diagonal)."""
+PLACE_STAGING = 0.45
+"""How far (m) behind the base pose the robot lines up: the last stretch is a straight drive
+(DriveStraight), so it needs less room than a path follower would."""
 TURN_WEIGHT = 0.2
 """Score per radian the object turns relative to the robot (rings), against the 0.1 m, 0.5 rad
 units of :meth:`~bt_manip.behaviours.base_placement.Candidate.score`."""
@@ -314,6 +317,7 @@ class PlanBaseForPlace(RobotAction):
             approach=float(self.get_input("approach")),
             clearance=float(self.get_input("clearance")),
             arm_state="",
+            staging=PLACE_STAGING,
         )
         placement = plan_place_base(self, robot, name, read_target(self), options)
         if not placement.ok:

@@ -55,6 +55,9 @@ A's panel (1.5 kg for 1.2 x 0.02 x 0.15 m)."""
 START_JITTER = 0.2
 """The robot's start is moved by up to this much (m in x and y) per seed; 1.5x that in rad."""
 SCHEMA_VERSION = 1
+WORK_ZONES = (2.2, 2.0, 1.5, 0.0)
+"""Depths (m) of floor kept free of the stock before each element's place, tried in turn: the
+robot stands there to place it, and lines up behind."""
 PAYLOADS: dict[str, float] = {"husky_ur3": 3.0}
 """Rated payload (kg) of the arms of known robots: the UR3's is 3 kg (Universal Robots)."""
 
@@ -162,7 +165,7 @@ def convert(options: BimOptions) -> Conversion:
 
     grid = floor_grid(building)
     sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
-    stock = _stock_pose(options, source, building, grid, sizes)
+    stock = _stock_pose(options, source, building, grid, sizes, elements)
     world_stands: list[dict[str, Any]] = []
     world_objects: list[dict[str, Any]] = []
     for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
@@ -360,9 +363,26 @@ def _largest_space(building: Building) -> Rect:
     return Rect((xmin + xmax) / 2, (ymin + ymax) / 2, xmax - xmin, ymax - ymin)
 
 
+def _with_work_zones(grid: FloorGrid, elements: list[InstallElement], depth: float) -> FloorGrid:
+    """A copy of ``grid`` with the floor ``depth`` m deep on both sides of each element's place
+    blocked (where the robot stands and lines up to place it; 0: none)."""
+    import copy
+
+    if depth <= 0:
+        return grid
+    out = copy.deepcopy(grid)
+    for e in elements:
+        t = e.target
+        c, s = math.cos(t["yaw"]), math.sin(t["yaw"])
+        for side in (1.0, -1.0):
+            d = side * (depth + e.size[1]) / 2
+            out.block(Rect(t["x"] - s * d, t["y"] + c * d, e.size[0] + 0.4, depth, t["yaw"]))
+    return out
+
+
 def _stock_pose(
     options: BimOptions, source: IfcSource, building: Building, grid: FloorGrid,
-    sizes: list[tuple[float, float, float]],
+    sizes: list[tuple[float, float, float]], elements: list[InstallElement],
 ) -> StockPose:
     if options.stock is not None:
         pose = StockPose(*options.stock)
@@ -376,7 +396,11 @@ def _stock_pose(
             )
         return pose
     area = _largest_space(building)
-    placed = place_stock(grid, area, sizes)
+    placed = None
+    for depth in WORK_ZONES:  # keep the floor before the places free, if there is room
+        placed = place_stock(_with_work_zones(grid, elements, depth), area, sizes)
+        if placed is not None:
+            break
     if placed is None:
         raise InputError.single(
             str(source.path), None,

@@ -111,10 +111,11 @@ def _fetch_element(root: ET.Element) -> None:
     _node(seq, "OpenGripper", name="open_fingers")
     _node(seq, "MoveJoints", name="tuck_for_driving", state="tuck")
     _node(seq, "PlanBaseForGrasp", name="plan_grasp_base", object="{element}", grasp="top",
-          approach="0.12", base_pose="{base_pose}", staging_pose="{staging_pose}")
+          approach="0.12", staging="0.45", base_pose="{base_pose}",
+          staging_pose="{staging_pose}")
     _drive(seq, "to_grasp_staging", "{staging_pose}", "0.08")
     _node(seq, "DriveStraight", name="drive_in", goal="{base_pose}", xy_tolerance="0.04",
-          yaw_tolerance="0.05")
+          yaw_tolerance="0.08")
     _node(seq, "MoveJoints", name="arm_ready", state="home")
     _node(seq, "MoveToPose", name="reach_element", object="{element}", grasp="top",
           approach="0.12", tolerance="0.002")
@@ -141,7 +142,7 @@ def _place_element(root: ET.Element) -> None:
     _drive(seq, "carry_to_staging", "{place_staging}", "0.08")
     # straight in: a path follower turning on the spot at the goal would sweep the load round
     _node(seq, "DriveStraight", name="drive_to_place", goal="{place_base}", xy_tolerance="0.04",
-          yaw_tolerance="0.05")
+          yaw_tolerance="0.08")
     _node(seq, "Place", name="place_element", object="{element}", target="{target}",
           placed_pose="{placed_pose}", deviation_mm="{deviation_mm}",
           deviation_deg="{deviation_deg}", via_tolerance="0.01", speed="0.2")

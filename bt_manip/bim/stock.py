@@ -19,7 +19,7 @@ from typing import Any
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.world_file import pose3, r
 
-APRON = 1.4
+APRON = 1.8
 """Free floor (m) kept before the stands for the robot."""
 SLOT_GAP = 0.01
 """Play (m) between an element and each rail of its slot."""
@@ -53,7 +53,7 @@ class Slot:
 
 def spacing(thicknesses: list[float]) -> float:
     """Distance (m) between neighbouring slots: room for the gripper between elements."""
-    return max(0.5, max(thicknesses, default=0.0) + 0.4)
+    return max(0.45, max(thicknesses, default=0.0) + 0.4)
 
 
 def stock_size(sizes: list[tuple[float, float, float]]) -> tuple[float, float]:
@@ -100,7 +100,7 @@ def place_stock(
     grid: FloorGrid, area: Rect, sizes: list[tuple[float, float, float]]
 ) -> StockPose | None:
     """A stock pose inside ``area`` (a space) whose stands and apron, with :data:`MARGIN`
-    around them, are free, farthest from the area's centre (which stays free for the robot);
+    beside them and beyond the stands, are free, farthest from the area's centre (which stays free for the robot);
     headings along the area's axes are tried."""
     length, width = stock_size(sizes)
     best: tuple[float, StockPose] | None = None
@@ -124,7 +124,10 @@ def place_stock(
                 break
             # (fx, fy) is the centre of the stands and apron together
             rect = Rect(fx, fy, length + APRON, width, yaw)
-            if not _within(area, rect) or not grid.is_free(rect.grown(MARGIN)):
+            # the margin on both sides and beyond the stands; the apron may end at a wall
+            kept = Rect(fx + c * MARGIN / 2, fy + s * MARGIN / 2, length + APRON + MARGIN,
+                        width + 2 * MARGIN, yaw)
+            if not _within(area, rect) or not grid.is_free(kept):
                 continue
             pose = StockPose(fx + c * APRON / 2, fy + s * APRON / 2, math.atan2(s, c))
             best = (dist2, pose)

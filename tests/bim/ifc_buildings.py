@@ -14,9 +14,9 @@
 ```
 
 Walls are 0.2 m thick and 2.5 m high, centred on the lines drawn. A slab lies under the whole
-building (top at z = 0), a table (a mesh, turned 30 deg) stands in the workshop's north-east
-corner, and six panels (IfcPlate, 1.2 x 0.02 x 0.3 m of a 400 kg/m3 material: 2.88 kg, within
-the UR3's 3 kg payload) are to be installed standing on the floor against the inner faces of the
+building (top at z = 0), a table (a mesh, turned 30 deg) stands in the store,
+and six panels (IfcPlate, 1.2 x 0.02 x 0.3 m of a 400 kg/m3 material: 2.88 kg, within
+the UR3's 3 kg payload) are to be installed standing on the floor before the inner faces of the
 workshop's west wall and the office's east and south walls, each by its own task.
 """
 
@@ -179,7 +179,7 @@ def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
                      WALL_H), _matrix(lo[0] + WALL_T / 2, lo[1] + WALL_T / 2, 0.0, 0.0))
         if with_storey:
             api("aggregate.assign_object", f, products=[space], relating_object=out.storey)
-    # a 1.2 x 0.8 x 0.75 m table turned by 30 deg, centred at (4.0, 5.2), as a mesh
+    # a 1.2 x 0.8 x 0.75 m table turned by 30 deg, centred at (8.0, 5.0), as a mesh
     hx, hy, hz = 0.6, 0.4, 0.75
     verts = [(x, y, z) for z in (0.0, hz) for x, y in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
     faces = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
@@ -189,7 +189,7 @@ def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
     rep = api("geometry.add_mesh_representation", f, context=body, vertices=[verts], faces=[faces])
     api("geometry.assign_representation", f, product=table, representation=rep)
     api("geometry.edit_object_placement", f, product=table,
-        matrix=_matrix(4.0, 5.2, 0.0, math.radians(30)))
+        matrix=_matrix(8.0, 5.0, 0.0, math.radians(30)))
     api("spatial.assign_container", f, products=[table], relating_structure=container)
     material = api("material.add_material", f, name="Gypsum fibre board")
     pset = api("pset.add_pset", f, product=material, name="Pset_MaterialCommon")

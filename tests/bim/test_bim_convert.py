@@ -61,7 +61,7 @@ def test_furniture_spaces_robot_and_stock(converted):
     _, conversion, spec = converted
     table = next(b for b in spec.furniture if b.name == "table")
     assert table.parts[0].size == pytest.approx((1.2, 0.8, 0.75), abs=1e-3)
-    assert table.pose.xyz == pytest.approx((4.0, 5.2, 0.375), abs=1e-3)
+    assert table.pose.xyz == pytest.approx((8.0, 5.0, 0.375), abs=1e-3)
     yaw = 2 * math.atan2(table.pose.quat[2], table.pose.quat[3])
     assert math.cos(2 * (yaw - math.radians(30))) == pytest.approx(1.0, abs=1e-6)
     assert {"workshop", "office", "store", "start", "stock"} <= set(spec.poses)
