@@ -137,7 +137,8 @@ def load_samples(size: tuple[float, float, float], object_in_base: np.ndarray) -
         n = max(1, math.ceil(math.hypot(bx - ax, by - ay) / 0.05))
         pts += [(ax + (bx - ax) * i / n, ay + (by - ay) * i / n) for i in range(n)]
     local = np.array([[x, y, 0.0, 1.0] for x, y in pts])
-    return (object_in_base @ local.T).T[:, :2]
+    out: np.ndarray = (object_in_base @ local.T).T[:, :2]
+    return out
 
 
 def carry_fits(nav: Any) -> Any:

@@ -31,7 +31,9 @@ def _payload(text: str) -> float:
     except ValueError:
         value = math.nan
     if not (math.isfinite(value) and 0.0 < value <= MAX_PAYLOAD):
-        raise argparse.ArgumentTypeError(f"expected a mass in (0, {MAX_PAYLOAD:g}] kg, got '{text}'")
+        raise argparse.ArgumentTypeError(
+            f"expected a mass in (0, {MAX_PAYLOAD:g}] kg, got '{text}'"
+        )
     return value
 
 

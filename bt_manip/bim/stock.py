@@ -100,8 +100,8 @@ def place_stock(
     grid: FloorGrid, area: Rect, sizes: list[tuple[float, float, float]]
 ) -> StockPose | None:
     """A stock pose inside ``area`` (a space) whose stands and apron, with :data:`MARGIN`
-    beside them and beyond the stands, are free, farthest from the area's centre (which stays free for the robot);
-    headings along the area's axes are tried."""
+    beside them and beyond the stands, are free, farthest from the area's centre (which stays
+    free for the robot); headings along the area's axes are tried."""
     length, width = stock_size(sizes)
     best: tuple[float, StockPose] | None = None
     for turn in (0.0, math.pi / 2, math.pi, -math.pi / 2):
