@@ -40,8 +40,8 @@ from bt_manip.bim.stock import (
     apron_pose,
     element_entry,
     footprint,
-    place_stock,
     slots,
+    stock_poses,
     stand_entry,
     stand_rects,
     stock_group,
@@ -58,6 +58,9 @@ SCHEMA_VERSION = 1
 WORK_ZONES = (2.2, 2.0, 1.5, 0.0)
 """Depths (m) of floor kept free of the stock before each element's place, tried in turn: the
 robot stands there to place it, and lines up behind."""
+MAX_STOCK_TRIALS = 24
+"""Stock poses whose routes are checked at most; when none leaves every place reachable, the
+first is kept and its problems reported."""
 PAYLOADS: dict[str, float] = {"husky_ur3": 3.0}
 """Rated payload (kg) of the arms of known robots: the UR3's is 3 kg (Universal Robots)."""
 
@@ -165,7 +168,7 @@ def convert(options: BimOptions) -> Conversion:
 
     grid = floor_grid(building)
     sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
-    stock = _stock_pose(options, source, building, grid, sizes, elements)
+    stock = _stock_pose(options, source, building, grid, sizes, elements, robot_width)
     world_stands: list[dict[str, Any]] = []
     world_objects: list[dict[str, Any]] = []
     for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
@@ -380,9 +383,28 @@ def _with_work_zones(grid: FloorGrid, elements: list[InstallElement], depth: flo
     return out
 
 
+def _routes_clear(
+    source: IfcSource, building: Building, grid: FloorGrid, elements: list[InstallElement],
+    sizes: list[tuple[float, float, float]], pose: StockPose, robot_width: float,
+) -> bool:
+    """Whether, with the stock at ``pose``, every element can be carried to its place."""
+    import copy
+
+    trial = copy.deepcopy(grid)
+    for size, slot in zip(sizes, slots(pose, sizes), strict=True):
+        for rect in stand_rects(slot, size):
+            trial.block(rect)
+    before = len(source.problems)
+    check_routes(source, building, trial, elements, apron_pose(pose, sizes), robot_width)
+    ok = len(source.problems) == before
+    del source.problems[before:]
+    return ok
+
+
 def _stock_pose(
     options: BimOptions, source: IfcSource, building: Building, grid: FloorGrid,
     sizes: list[tuple[float, float, float]], elements: list[InstallElement],
+    robot_width: float,
 ) -> StockPose:
     if options.stock is not None:
         pose = StockPose(*options.stock)
@@ -397,10 +419,15 @@ def _stock_pose(
         return pose
     area = _largest_space(building)
     placed = None
+    trials = 0
     for depth in WORK_ZONES:  # keep the floor before the places free, if there is room
-        placed = place_stock(_with_work_zones(grid, elements, depth), area, sizes)
-        if placed is not None:
-            break
+        for pose in stock_poses(_with_work_zones(grid, elements, depth), area, sizes):
+            placed = placed or pose
+            if trials >= MAX_STOCK_TRIALS:
+                break
+            trials += 1
+            if _routes_clear(source, building, grid, elements, sizes, pose, robot_width):
+                return pose
     if placed is None:
         raise InputError.single(
             str(source.path), None,

@@ -96,32 +96,31 @@ def slots(pose: StockPose, sizes: list[tuple[float, float, float]]) -> list[Slot
     return out
 
 
-def place_stock(
-    grid: FloorGrid, area: Rect, sizes: list[tuple[float, float, float]]
-) -> StockPose | None:
-    """A stock pose inside ``area`` (a space) whose stands and apron, with :data:`MARGIN`
-    beside them and beyond the stands, are free, farthest from the area's centre (which stays
-    free for the robot); headings along the area's axes are tried."""
+def stock_poses(
+    grid: FloorGrid, area: Rect, sizes: list[tuple[float, float, float]], limit: int = 50
+) -> list[StockPose]:
+    """Stock poses inside ``area`` (a space) whose stands and apron, with :data:`MARGIN` beside
+    them and beyond the stands, are free; farthest from the area's centre (which stays free for
+    the robot) first, at most ``limit``. Headings along the area's axes are tried, on a 0.25 m
+    grid of centres."""
     length, width = stock_size(sizes)
-    best: tuple[float, StockPose] | None = None
-    for turn in (0.0, math.pi / 2, math.pi, -math.pi / 2):
+    found: list[tuple[float, int, StockPose]] = []
+    step = 0.25
+    nu = int(area.length / step) + 1
+    nv = int(area.width / step) + 1
+    ac, as_ = math.cos(area.yaw), math.sin(area.yaw)
+    centres = []
+    for i in range(nu):
+        for j in range(nv):
+            du = -area.length / 2 + i * step
+            dv = -area.width / 2 + j * step
+            centres.append((du * du + dv * dv, area.x + ac * du - as_ * dv,
+                            area.y + as_ * du + ac * dv))
+    centres.sort(reverse=True)
+    for k, turn in enumerate((0.0, math.pi / 2, math.pi, -math.pi / 2)):
         yaw = area.yaw + turn
         c, s = math.cos(yaw), math.sin(yaw)
-        step = 0.25
-        nu = int(area.length / step) + 1
-        nv = int(area.width / step) + 1
-        ac, as_ = math.cos(area.yaw), math.sin(area.yaw)
-        candidates = []
-        for i in range(nu):
-            for j in range(nv):
-                du = -area.length / 2 + i * step
-                dv = -area.width / 2 + j * step
-                candidates.append((du * du + dv * dv, area.x + ac * du - as_ * dv,
-                                   area.y + as_ * du + ac * dv))
-        candidates.sort(reverse=True)
-        for dist2, fx, fy in candidates:
-            if best is not None and dist2 <= best[0]:
-                break
+        for dist2, fx, fy in centres:
             # (fx, fy) is the centre of the stands and apron together
             rect = Rect(fx, fy, length + APRON, width, yaw)
             # the margin on both sides and beyond the stands; the apron may end at a wall
@@ -130,9 +129,17 @@ def place_stock(
             if not _within(area, rect) or not grid.is_free(kept):
                 continue
             pose = StockPose(fx + c * APRON / 2, fy + s * APRON / 2, math.atan2(s, c))
-            best = (dist2, pose)
-            break
-    return best[1] if best else None
+            found.append((-dist2, k, pose))
+    found.sort(key=lambda f: (f[0], f[1]))
+    return [f[2] for f in found[:limit]]
+
+
+def place_stock(
+    grid: FloorGrid, area: Rect, sizes: list[tuple[float, float, float]]
+) -> StockPose | None:
+    """The first of :func:`stock_poses`, or None."""
+    poses = stock_poses(grid, area, sizes, limit=1)
+    return poses[0] if poses else None
 
 
 def _within(area: Rect, rect: Rect) -> bool:

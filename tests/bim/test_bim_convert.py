@@ -72,13 +72,17 @@ def test_furniture_spaces_robot_and_stock(converted):
     assert not robot.randomize.is_zero()
     # the robot starts in the largest space, the workshop (x 0..5, y 0..6)
     assert 0.0 < robot.pose.x < 5.0 and 0.0 < robot.pose.y < 6.0
-    # every element waits in its own stand at the stock, in the workshop, jittered per seed
+    # every element waits in its own stand at the stock, in the workshop; the stock (stands,
+    # elements and its pose) moves as one per seed
     assert [o.name for o in spec.objects] == [e.object for e in conversion.elements]
     for obj in spec.objects:
         assert 0.0 < obj.pose.xyz[0] < 5.0 and 0.0 < obj.pose.xyz[1] < 6.0
-        assert not obj.randomize.is_zero()
     stands = [b for b in spec.furniture if b.name.startswith("stand_")]
     assert len(stands) == 6
+    (group,) = spec.groups
+    assert set(group.members) == {o.name for o in spec.objects} | {s.name for s in stands} | {
+        "stock"}
+    assert not group.randomize.is_zero()
 
 
 def test_targets_sizes_and_masses(converted):
@@ -115,7 +119,7 @@ def test_order_from_sequences(tmp_path):
     ifc = three_rooms(sequence=[3, 0]).write(tmp_path / "link.ifc")
     c = convert(BimOptions(ifc, tmp_path / "link"))
     names = [e.name for e in c.elements]
-    assert names == ["Panel W2", "Panel W3", "Panel E1", "Panel W1", "Panel E2", "Panel E3"]
+    assert names == ["Panel W2", "Panel W3", "Panel E1", "Panel W1", "Panel E2", "Panel S1"]
 
 
 @pytest.mark.parametrize("element_class", ["IfcMember", "IfcWall"])
@@ -162,7 +166,7 @@ def test_order_from_csv(tmp_path):
 
     model = ifcopenshell.open(str(ifc))
     gids = {p.Name: p.GlobalId for p in model.by_type("IfcPlate")}
-    order = ["Panel E2", "Panel W1", "Panel E3", "Panel W3", "Panel E1", "Panel W2"]
+    order = ["Panel E2", "Panel W1", "Panel S1", "Panel W3", "Panel E1", "Panel W2"]
     path = tmp_path / "schedule.csv"
     with path.open("w", newline="") as fh:
         w = csv.writer(fh)
@@ -195,23 +199,23 @@ def test_file_in_metres(tmp_path):
     partition = _wall(parse_world(c.world_path), "partition")
     assert partition.end == pytest.approx((5.0, 6.0), abs=1e-3)
     assert (partition.doors[0].at, partition.doors[0].width) == pytest.approx((1.5, 1.6), abs=1e-3)
-    assert c.elements[0].target["z"] == pytest.approx(1.0, abs=1e-3)
+    assert c.elements[0].target["z"] == pytest.approx(0.15, abs=1e-3)
 
 
 def test_command_line_writes_a_world_that_loads(tmp_path, capsys):
     from bt_manip.sim.world import World
 
     ifc = three_rooms().write(tmp_path / "b.ifc")
-    assert main(["bim", str(ifc), "--out", str(tmp_path / "out"), "--stock", "1.65;2.6;1.5708",
+    assert main(["bim", str(ifc), "--out", str(tmp_path / "out"), "--stock", "2.8;3.55;1.5708",
                  "--start", "Office", "--seed-range", "0:2"]) == 0
     out = capsys.readouterr().out
-    assert "6 elements to install" in out and "stock at (1.65, 2.60)" in out
+    assert "6 elements to install" in out and "stock at (2.80, 3.55)" in out
     assert "loaded the world with seeds 0..1: every start is free" in out
     with World(tmp_path / "out" / "world.yaml", seed=3) as world:
         robot = world.summary()
         assert "robot robot (husky_ur3)" in robot
         panel = world.body_pose("panel_w1")
-        # standing in its stand at the stock: jittered by a few mm at most
+        # standing upright in its stand at the stock (moved with the stock for the seed)
         assert panel.xyz[2] == pytest.approx(0.15, abs=2e-3)
     spec = parse_world(tmp_path / "out" / "world.yaml")
     start = spec.robots[0].pose

@@ -75,11 +75,12 @@ def test_unsupported_geometry_of_a_round_wall(tmp_path, capsys):
 
 def test_element_wider_than_the_doors_on_its_route(tmp_path, capsys):
     # a panel for the store, which only the 0.9 m door joins to the rest
-    panels = [*PANELS, Panel("Panel S1", (9.89, 4.5, 1.0), -math.pi / 2, "2026-03-10")]
+    panels = [*PANELS[:5], Panel("Panel S1", (9.81, 4.5, 0.15), -math.pi / 2, "2026-03-10")]
     b = three_rooms(panels=panels)
     path = b.write(tmp_path / "store.ifc")
     panel = b.panels[-1]
-    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    # a stock that leaves the way to the store's door open
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"), "--stock", "2.8;3.55;1.5708")
     assert code == 2
     assert err.strip() == (
         f"{path}:{_line_of(path, panel.id())}: #{panel.id()} IfcPlate 'Panel S1': 1.20 m long, "
