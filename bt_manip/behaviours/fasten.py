@@ -69,7 +69,7 @@ class Fasten(RobotAction):
         if not dev.within(pos_tol, ang_tol):
             raise ActionFailed(
                 f"'{name}' is {dev.text()} from its target {target.text()} (tolerance "
-                f"{pos_tol * 1000:.0f} mm and {math.degrees(ang_tol):g} deg): not fastened"
+                f"{pos_tol * 1000:g} mm and {math.degrees(ang_tol):g} deg): not fastened"
             )
         max_gap = float(self.get_input("max_gap"))
         near = structures_near(world, body, max_gap)

@@ -248,7 +248,7 @@ class Place(JointMove):
         if not dev.within(pos_tol, ang_tol):
             raise ActionFailed(
                 f"'{name}' is {dev.text()} from its target {self.target.text()} (tolerance "
-                f"{pos_tol * 1000:.0f} mm and {math.degrees(ang_tol):g} deg)"
+                f"{pos_tol * 1000:g} mm and {math.degrees(ang_tol):g} deg)"
             )
         self.feedback_message = f"placed '{name}' {dev.text()} from its target"
         return Status.SUCCESS
