@@ -1,4 +1,4 @@
-"""DriveStraight: drive the base straight ahead onto a pose it already faces.
+"""DriveStraight: drive the base straight ahead (or back) onto a pose it already faces.
 
 The last stretch to a place where the robot sets something down: lined up behind the pose (a
 staging pose, see PlanBaseForPlace), the robot drives forward along the line to it, steering
@@ -40,7 +40,8 @@ def wrap(angle: float) -> float:
 @registry.register
 class DriveStraight(RobotAction):
     """Drives forward along the line to ``goal`` (``x;y;yaw`` or a named pose), which the
-    robot must already face (within 0.3 rad), and stops on it.
+    robot must already face (within 0.3 rad), and stops on it; with ``direction="backward"``
+    it backs along the line onto a goal behind it (backing out the way it came in).
 
     - RUNNING while driving;
     - SUCCESS when the robot has reached the goal along its heading, within ``xy_tolerance``
@@ -59,6 +60,10 @@ class DriveStraight(RobotAction):
         "xy_tolerance": Port(float, False, "distance allowed from the goal (m)", 0.03, POSITIVE),
         "yaw_tolerance": Port(float, False, "heading error allowed (rad)", 0.05, POSITIVE),
         "timeout": Port(float, False, "sim seconds allowed", 30.0, POSITIVE),
+        "direction": Port(
+            str, False, "forward, or backward onto a goal behind the robot", "forward",
+            Accepts(choices=("forward", "backward")),
+        ),
     }
 
     def start(self) -> None:
@@ -66,6 +71,7 @@ class DriveStraight(RobotAction):
         if robot.description.base.type != "skid_steer":
             raise ActionFailed(f"{robot.description.name} has no mobile base")
         self.goal = parse_goal(self.world, self.get_input("goal"))
+        self.back = self.get_input("direction") == "backward"
         x, y, yaw = robot.base_pose2d()
         gx, gy, gyaw = self.goal
         turn = abs(wrap(gyaw - yaw))
@@ -74,9 +80,11 @@ class DriveStraight(RobotAction):
                 f"the robot faces {math.degrees(turn):.0f} deg away from the goal's heading "
                 f"(at most {math.degrees(MAX_START_TURN):.0f}): line it up first"
             )
-        ahead = (gx - x) * math.cos(gyaw) + (gy - y) * math.sin(gyaw)
+        way = gyaw + (math.pi if self.back else 0.0)  # the direction of travel
+        ahead = (gx - x) * math.cos(way) + (gy - y) * math.sin(way)
         if ahead < -float(self.get_input("xy_tolerance")):
-            raise ActionFailed(f"the goal is {-ahead:.2f} m behind the robot")
+            where = "ahead of" if self.back else "behind"
+            raise ActionFailed(f"the goal is {-ahead:.2f} m {where} the robot")
         self.touching = self._contacts()
 
     def _contacts(self) -> set[str]:
@@ -104,7 +112,8 @@ class DriveStraight(RobotAction):
             raise ActionFailed("driving in, touched " + ", ".join(f"'{n}'" for n in sorted(new)))
         x, y, yaw = robot.base_pose2d()
         gx, gy, gyaw = self.goal
-        c, s = math.cos(gyaw), math.sin(gyaw)
+        turn = math.pi if self.back else 0.0  # headings of travel: the robot's and the goal's
+        c, s = math.cos(gyaw + turn), math.sin(gyaw + turn)
         ahead = (gx - x) * c + (gy - y) * s
         side = -(gx - x) * s + (gy - y) * c  # the goal line is to the left when positive
         if ahead <= 0.002:
@@ -125,10 +134,10 @@ class DriveStraight(RobotAction):
         # head for a point on the goal line a little ahead; over the last stretch, for the
         # goal's heading only
         look = max(ahead, 0.3)
-        want = gyaw + (math.atan2(side, look) if ahead > SLOW_DOWN else 0.0)
-        rate = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, STEER_GAIN * wrap(want - yaw)))
+        want = gyaw + turn + (math.atan2(side, look) if ahead > SLOW_DOWN else 0.0)
+        rate = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, STEER_GAIN * wrap(want - yaw - turn)))
         speed = float(self.get_input("speed"))
         if ahead < SLOW_DOWN:
             speed *= 0.25 + 0.75 * ahead / SLOW_DOWN
-        robot.set_base_twist(speed, rate)
+        robot.set_base_twist(-speed if self.back else speed, rate)
         return Status.RUNNING

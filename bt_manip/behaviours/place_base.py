@@ -59,7 +59,7 @@ from bt_manip.navigation.lattice import outline_samples
 from bt_manip.perception import true_pose
 from bt_manip.placing import Target, yaw_of_matrix
 
-STANDOFFS = (0.16, 0.2, 0.24)
+STANDOFFS = (0.12, 0.16, 0.2)
 """How far (m) the poses of step 1 stand back from where the object would be over its target:
 the load must stay clear of the wall it is set against until the arm moves it there."""
 TURNS = (0.0, -0.15, 0.15, -0.3, 0.3)
@@ -225,9 +225,10 @@ def plan_place_base(
         ):
             counts["load collides"] += 1
             continue
+        sx, sy, syaw = staging(cand, options)
         if not staging_free(clear, origin, res, pts, cand, options, turning) or not (
             staging_free(clear, origin, res, load, cand, load_options, 0.0)
-        ):
+        ) or (fits is not None and not fits(Candidate(sx, sy, syaw, 0.0, 0.0, 0.0))):
             counts["no room to line up"] += 1
             continue
         arm_world = planar(cand.x, cand.y, cand.yaw) @ arm_in_base
@@ -249,7 +250,6 @@ def plan_place_base(
         if path_checks >= options.max_path_checks:
             break
         path_checks += 1
-        sx, sy, syaw = staging(cand, options)
         start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
         goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
         if not nav.plan_to(start, goal).ok:

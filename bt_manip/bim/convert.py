@@ -22,6 +22,7 @@ from typing import Any
 import yaml
 
 from bt_manip.bim.building import Building, Names, choose_storey, read_building
+from bt_manip.bim.doorways import crossings, door_poses
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
 from bt_manip.bim.install_tree import install_tree
@@ -180,10 +181,12 @@ def convert(options: BimOptions) -> Conversion:
     apron = apron_pose(stock, sizes)
     check_routes(source, building, grid, elements, apron, robot_width)
     source.raise_problems()
+    cross = crossings(building, grid, elements, apron, robot_width)
     start, jitter = _robot_start(options, building, grid, robot_radius)
 
     walls, furniture = building_entries(building)
     poses: dict[str, list[float]] = {"start": [r(v) for v in start], "stock": [r(v) for v in apron]}
+    poses.update(door_poses({c.door for cs in cross.values() for c in cs}, building))
     half = robot_width / 2 + CLEARANCE
     for space in sorted(building.spaces, key=lambda s: s.entity.id()):
         spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
@@ -237,7 +240,7 @@ def convert(options: BimOptions) -> Conversion:
     schedule_path.write_text(json.dumps(_schedule_document(conversion, options), indent=2) + "\n")
     _check_world(world_path)
     conversion.install_path = options.out / "install.xml"
-    conversion.install_path.write_text(install_tree(elements, source.path.name))
+    conversion.install_path.write_text(install_tree(elements, source.path.name, cross))
     return conversion
 
 

@@ -173,12 +173,14 @@ class FloorGrid:
         return bool(set(labels[ra, ca].tolist()) & set(labels[rb, cb].tolist()))
 
     def doors_on_route(
-        self, a: tuple[float, float], b: tuple[float, float], half_width: float, reach: float
+        self, a: tuple[float, float], b: tuple[float, float], half_width: float, reach: float,
+        start_reach: float | None = None,
     ) -> list[int] | None:
-        """Doors (0-based indices) crossed by a shortest route (in cells) from near ``a`` to
-        near ``b`` for a robot ``2 * half_width`` wide, in order; None if there is none."""
+        """Doors (0-based indices) crossed by a shortest route (in cells) from near ``a``
+        (within ``start_reach``, default ``reach``) to near ``b`` (within ``reach``) for a robot
+        ``2 * half_width`` wide, in order; None if there is none."""
         ok = self.clearance() >= half_width
-        ra, ca = self._near(a[0], a[1], reach, ok)
+        ra, ca = self._near(a[0], a[1], reach if start_reach is None else start_reach, ok)
         rb, cb = self._near(b[0], b[1], reach, ok)
         if len(ra) == 0 or len(rb) == 0:
             return None

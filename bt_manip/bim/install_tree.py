@@ -10,7 +10,10 @@ InstallElement:
    from which the arm takes it from above, line up and drive in, reach down by IK on a
    straight line, close, attach, lift it straight out of the stand; on a failure the hand lets
    go, backs off and the attempt is planned again;
-2. carries it and places it (``PlaceElement``, up to 2 attempts): plan a base pose from which
+2. carries it through each door on its route (``CarryThroughDoor``: to a pose before the door,
+   facing through it, then straight through; :mod:`~bt_manip.bim.doorways`; an element whose
+   route crosses N doors has the SubTree ``InstallElementViaNDoor(s)``, with the crossing poses
+   remapped in), then places it (``PlaceElement``, up to 2 attempts): plan a base pose from which
    the arm sets it down at its target, drive there with it (a drive that fails backs up and
    tries again), Place (straight down, the pose checked: a touch before the final motion or a
    pose out of tolerance fails), Fasten (only within tolerance), open, detach, hand up, arm
@@ -25,13 +28,14 @@ objects where they stand, so the navigator plans around them for the next drives
 from __future__ import annotations
 
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
+from bt_manip.bim.doorways import Crossing
 from bt_manip.bim.schedule import InstallElement
 
 LIFT = 0.15
 """How high (m) an element is lifted straight out of its stand."""
-PULL_IN = 0.16
+PULL_IN = 0.12
 """How far (m) the element is pulled in towards the robot for the carry."""
 FINGER_PLAY = 0.001
 """The fingers close to this much (m) wider than the element."""
@@ -41,7 +45,16 @@ def _node(parent: ET.Element, tag: str, **attrs: str) -> ET.Element:
     return ET.SubElement(parent, tag, {k: v for k, v in attrs.items()})
 
 
-def _main(root: ET.Element, elements: Sequence[InstallElement]) -> None:
+def install_id(doors: int) -> str:
+    """ID of the InstallElement SubTree for an element whose route crosses ``doors`` doors."""
+    if doors == 0:
+        return "InstallElement"
+    return f"InstallElementVia{doors}Door" + ("s" if doors > 1 else "")
+
+
+def _main(
+    root: ET.Element, elements: Sequence[InstallElement], crossings: Mapping[str, list[Crossing]]
+) -> None:
     tree = _node(root, "BehaviorTree", ID="Install")
     seq = _node(tree, "Sequence", name="install_in_schedule_order")
     _node(seq, "Script", name="count_elements",
@@ -51,9 +64,14 @@ def _main(root: ET.Element, elements: Sequence[InstallElement]) -> None:
     for e in elements:
         t = e.target
         opening = min(e.size[0], e.size[1]) + FINGER_PLAY
+        doors = {}
+        for j, c in enumerate(crossings.get(e.object, []), start=1):
+            doors[f"door{j}_near"] = c.near
+            doors[f"door{j}_far"] = c.far
         _node(
-            seq, "SubTree", ID="InstallElement", name=f"{e.order}_{e.object}",
+            seq, "SubTree", ID=install_id(len(doors) // 2), name=f"{e.order}_{e.object}",
             element=e.object,
+            **doors,
             global_id=e.global_id,
             target=f"{t['x']:.4f};{t['y']:.4f};{t['z']:.4f};{t['yaw']:.4f}",
             opening=f"{opening:.4f}",
@@ -65,11 +83,14 @@ def _main(root: ET.Element, elements: Sequence[InstallElement]) -> None:
         )
 
 
-def _install_element(root: ET.Element) -> None:
-    tree = _node(root, "BehaviorTree", ID="InstallElement")
+def _install_element(root: ET.Element, doors: int) -> None:
+    tree = _node(root, "BehaviorTree", ID=install_id(doors))
     seq = _node(tree, "Sequence", name="install_element")
     fetch = _node(seq, "RetryUntilSuccessful", name="fetch_attempts", num_attempts="3")
     _node(fetch, "SubTree", ID="FetchElement", element="{element}", opening="{opening}")
+    for j in range(1, doors + 1):
+        _node(seq, "SubTree", ID="CarryThroughDoor", name=f"door_{j}", element="{element}",
+              near=f"{{door{j}_near}}", far=f"{{door{j}_far}}")
     place = _node(seq, "RetryUntilSuccessful", name="place_attempts", num_attempts="2")
     _node(place, "SubTree", ID="PlaceElement", element="{element}", target="{target}",
           placed_pose="{placed_pose}", deviation_mm="{deviation_mm}",
@@ -104,6 +125,17 @@ def _drive(parent: ET.Element, name: str, goal: str, tolerance: str = "0.05") ->
     _node(seq, "AlwaysFailure", name=f"{name}_failed")
 
 
+def _carry_through_door(root: ET.Element) -> None:
+    tree = _node(root, "BehaviorTree", ID="CarryThroughDoor")
+    seq = _node(tree, "Sequence", name="carry_through_door")
+    _node(seq, "IsAttached", name="element_in_hand", object="{element}")
+    _drive(seq, "to_door", "{near}", "0.15")
+    # straight through: a follower correcting its heading in the doorway would sweep the
+    # element's ends into the jambs
+    _node(seq, "DriveStraight", name="through_door", goal="{far}", xy_tolerance="0.1",
+          yaw_tolerance="0.1")
+
+
 def _fetch_element(root: ET.Element) -> None:
     tree = _node(root, "BehaviorTree", ID="FetchElement")
     fb = _node(tree, "Fallback", name="fetch_or_back_off")
@@ -126,9 +158,17 @@ def _fetch_element(root: ET.Element) -> None:
     _node(seq, "IsAttached", name="element_attached", object="{element}")
     _node(seq, "ObjectAbove", name="element_off_floor", object="{element}", height="0.1")
     # pulled in towards the robot for the carry: at the place the robot stops short of the
-    # wall with the element clear of it, and the arm reaches out again to set it down
-    _node(seq, "MoveToolBy", name="pull_in", offset=f"{-PULL_IN:g};0;0", speed="0.2",
-          via_tolerance="0.02")
+    # wall with the element clear of it, and the arm reaches out again to set it down (the
+    # place is planned from wherever the element is in the hand: a pull that stops short is
+    # no reason to put it back)
+    force = _node(seq, "ForceSuccess")
+    _node(force, "MoveToolBy", name="pull_in", offset=f"{-PULL_IN:g};0;0", speed="0.2",
+          via_tolerance="0.02", tolerance="0.02")
+    # out of the stock the way the robot came in, before the carry is planned among the
+    # elements still standing there
+    force = _node(seq, "ForceSuccess")
+    _node(force, "DriveStraight", name="back_out_with_it", goal="{staging_pose}",
+          direction="backward", xy_tolerance="0.1", yaw_tolerance="0.1")
     _back_off(fb, "put_back", 0.12)
 
 
@@ -139,7 +179,7 @@ def _place_element(root: ET.Element) -> None:
     _node(seq, "IsAttached", name="element_in_hand", object="{element}")
     _node(seq, "PlanBaseForPlace", name="plan_place_base", object="{element}",
           target="{target}", base_pose="{place_base}", staging_pose="{place_staging}")
-    _drive(seq, "carry_to_staging", "{place_staging}", "0.08")
+    _drive(seq, "carry_to_staging", "{place_staging}", "0.1")
     # straight in: a path follower turning on the spot at the goal would sweep the load round
     _node(seq, "DriveStraight", name="drive_to_place", goal="{place_base}", xy_tolerance="0.04",
           yaw_tolerance="0.08")
@@ -173,12 +213,20 @@ HEADER = """Generated by `bt-manip bim {source}`: installs the {count} elements 
      and deviation_deg_OBJECT. Run it with the world.yaml written beside it."""
 
 
-def install_tree(elements: Sequence[InstallElement], source: str) -> str:
-    """The text of ``install.xml`` for ``elements`` (in schedule order)."""
+def install_tree(
+    elements: Sequence[InstallElement], source: str,
+    crossings: Mapping[str, list[Crossing]] | None = None,
+) -> str:
+    """The text of ``install.xml`` for ``elements`` (in schedule order), each carried through
+    the doors of its ``crossings`` (by world object; :mod:`~bt_manip.bim.doorways`)."""
+    crossings = crossings or {}
     root = ET.Element("root", {"BTCPP_format": "4", "main_tree_to_execute": "Install"})
     root.append(ET.Comment(" " + HEADER.format(source=source, count=len(elements)) + " "))
-    _main(root, elements)
-    _install_element(root)
+    _main(root, elements, crossings)
+    for doors in sorted({len(crossings.get(e.object, [])) for e in elements}):
+        _install_element(root, doors)
+    if any(crossings.get(e.object) for e in elements):
+        _carry_through_door(root)
     _fetch_element(root)
     _place_element(root)
     ET.indent(root, space="  ")
