@@ -42,10 +42,10 @@ from bt_manip.bim.stock import (
     element_entry,
     footprint,
     slots,
-    stock_poses,
     stand_entry,
     stand_rects,
     stock_group,
+    stock_poses,
 )
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.errors import InputError

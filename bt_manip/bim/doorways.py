@@ -67,7 +67,7 @@ class Crossing:
 
 def doors_of(building: Building) -> list[Door]:
     """Every passage of the building, in the floor grid's door order."""
-    out = []
+    out: list[Door] = []
     for wall in building.walls:
         length = wall.length
         ux = (wall.end[0] - wall.start[0]) / length
