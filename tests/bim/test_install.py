@@ -103,9 +103,13 @@ def test_bim_report_needs_an_as_built_table(tmp_path, capsys):
 CHECKS = """<root BTCPP_format="4" main_tree_to_execute="Checks">
   <BehaviorTree ID="Checks">
     <Sequence>
-      <ForceSuccess><Place name="place_not_held" object="panel_w2" target="{target}"/></ForceSuccess>
+      <ForceSuccess>
+        <Place name="place_not_held" object="panel_w2" target="{target}"/>
+      </ForceSuccess>
       <SubTree ID="FetchElement" element="panel_w2" opening="0.021"/>
-      <ForceSuccess><Place name="place_far" object="panel_w2" target="8.0;5.0;0.15;0"/></ForceSuccess>
+      <ForceSuccess>
+        <Place name="place_far" object="panel_w2" target="8.0;5.0;0.15;0"/>
+      </ForceSuccess>
       <PlanBaseForPlace object="panel_w2" target="{target}" base_pose="{b}" staging_pose="{s}"/>
       <Navigate goal="{s}" xy_tolerance="0.08" yaw_tolerance="0.08"/>
       <DriveStraight goal="{b}" xy_tolerance="0.04" yaw_tolerance="0.08"/>
@@ -113,7 +117,9 @@ CHECKS = """<root BTCPP_format="4" main_tree_to_execute="Checks">
         <Place name="place_tight" object="panel_w2" target="{target}" position_tolerance="0.0005"
                deviation_mm="{dev_mm}"/>
       </ForceSuccess>
-      <ForceSuccess><Fasten name="fasten_off" object="panel_w2" target="{off_target}"/></ForceSuccess>
+      <ForceSuccess>
+        <Fasten name="fasten_off" object="panel_w2" target="{off_target}"/>
+      </ForceSuccess>
       <Fasten name="fasten_ok" object="panel_w2" target="{target}" fastened_to="{to}"/>
       <ForceSuccess><Fasten name="fasten_again" object="panel_w2" target="{target}"/></ForceSuccess>
     </Sequence>
