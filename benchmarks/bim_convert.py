@@ -2,7 +2,7 @@
 
 Run: ``.venv/bin/python benchmarks/bim_convert.py [--rooms N] [--keep DIR]``
 
-Generates with ``ifcopenshell.api`` (in millimetres, IFC4) a storey of N x N rooms of 5 m x 5 m
+Generates with ``ifcopenshell.api`` (in millimetres, IFC4) a storey of N x N rooms of 6 m x 6 m
 (default 7 x 7: 112 walls, each room side its own IfcWall, 0.2 m thick and 2.5 m high), with a
 1.6 m door in every inner wall and a window in every outer wall, a space and a table in every
 room, a slab under everything, and 8 panels (IfcPlate, 1.2 x 0.02 x 0.3 m) on walls across the
@@ -28,7 +28,7 @@ import numpy as np
 
 WALL_T = 0.2
 WALL_H = 2.5
-ROOM = 5.0
+ROOM = 6.0
 
 
 def _matrix(x: float, y: float, z: float, yaw: float) -> np.ndarray:
@@ -130,7 +130,9 @@ def main() -> None:
         ifc = folder / f"grid_{args.rooms}x{args.rooms}.ifc"
         counts = generate(args.rooms, ifc)
         wall0, cpu0 = time.perf_counter(), time.process_time()
-        conversion = convert(BimOptions(ifc, folder / "out"))
+        # the panels have no material: at the default density they weigh 3.02 kg, just over
+        # the UR3's 3 kg; the payload check is not what is timed here
+        conversion = convert(BimOptions(ifc, folder / "out", payload=5.0))
         wall1, cpu1 = time.perf_counter(), time.process_time()
         print(json.dumps({
             "bench": "bim_convert",
