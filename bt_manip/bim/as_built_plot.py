@@ -90,6 +90,8 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
                 continue
             _bar(ax, [f.pose.xyz[0], f.pose.xyz[1], 0.0, yaw_of(f.pose.quat)],
                  [part.size[0], part.size[1]], fill=False, edgecolor="0.7", linewidth=0.8)
+    ends = [p for w in spec.walls for p in (w.start, w.end)] or [(0.0, 0.0)]
+    middle = (sum(p[0] for p in ends) / len(ends), sum(p[1] for p in ends) / len(ends))
     cmap = matplotlib.colormaps["RdYlGn_r"]
     norm = colors.Normalize(0.0, SCALE_MM)
     for row in report["as_built"]:
@@ -106,8 +108,12 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
             label += f"\n{row['deviation_mm']:.1f} mm, {row['deviation_deg']:.2f} deg"
         else:
             label += f"\n{row.get('status')}"
+        # the label beside the element, on the side towards the middle of the building
+        nx, ny = -math.sin(planned[3]), math.cos(planned[3])
+        if (middle[0] - planned[0]) * nx + (middle[1] - planned[1]) * ny < 0:
+            nx, ny = -nx, -ny
         ax.annotate(label, (planned[0], planned[1]), fontsize=7, ha="center", va="center",
-                    xytext=(0, 14), textcoords="offset points")
+                    xytext=(38 * nx, 16 * ny), textcoords="offset points")
     ax.set_aspect("equal")
     ax.autoscale_view()
     ax.margins(0.05)
