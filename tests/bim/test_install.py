@@ -229,3 +229,29 @@ def test_the_stock_moves_as_one_per_seed(two_panels):
     for a, b in (("panel_w2", "panel_w3"), ("panel_w2", "stand_panel_w2")):
         assert math.dist(poses[0][a][:2], poses[0][b][:2]) == pytest.approx(
             math.dist(poses[1][a][:2], poses[1][b][:2]), abs=1e-6)
+
+
+def test_office_panels_cross_the_door_straight(tmp_path):
+    from bt_manip.sim.world_spec import parse_world
+
+    ifc = three_rooms().write(tmp_path / "b.ifc")
+    conversion = convert(BimOptions(ifc, tmp_path / "out"))
+    root = ET.parse(conversion.install_path).getroot()
+    calls = root.findall("BehaviorTree[@ID='Install']//SubTree")
+    by_element = {c.get("element"): c for c in calls}
+    for name in ("panel_w1", "panel_w2", "panel_w3"):
+        assert by_element[name].get("ID") == "InstallElement"
+    poses = parse_world(conversion.world_path).poses
+    for name in ("panel_e1", "panel_e2", "panel_s1"):
+        call = by_element[name]
+        assert call.get("ID") == "InstallElementVia1Door"
+        near, far = poses[call.get("door1_near")], poses[call.get("door1_far")]
+        # from the workshop (west of the partition at x = 5) through the 1.6 m door at
+        # y = 1.5, facing east all the way
+        assert near.x < 5.0 < far.x
+        assert near.y == pytest.approx(1.5, abs=1e-3) and far.y == pytest.approx(1.5, abs=1e-3)
+        assert near.yaw == pytest.approx(0.0, abs=1e-3) and far.yaw == pytest.approx(0.0, abs=1e-3)
+    via = root.find("BehaviorTree[@ID='InstallElementVia1Door']")
+    assert via is not None
+    ids = [n.get("ID") for n in via.iter("SubTree")]
+    assert ids == ["FetchElement", "CarryThroughDoor", "PlaceElement"]
