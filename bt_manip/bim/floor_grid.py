@@ -63,6 +63,7 @@ class FloorGrid:
         self.doors = np.zeros((ny, nx), dtype=np.int32)
         self._clearance: np.ndarray | None = None
         self._labels: dict[float, np.ndarray] = {}
+        self._trees: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
 
     # -- painting --------------------------------------------------------------------------
     def cells(self, rect: Rect) -> tuple[np.ndarray, np.ndarray]:
@@ -91,6 +92,7 @@ class FloorGrid:
         self.blocked[rows, cols] = True
         self._clearance = None
         self._labels.clear()
+        self._trees.clear()
 
     def mark_door(self, rect: Rect, index: int) -> None:
         """Label the cells of door ``index`` (0-based) so routes can name the doors they use."""
@@ -172,41 +174,58 @@ class FloorGrid:
         rb, cb = self._near(b[0], b[1], reach, ok)
         return bool(set(labels[ra, ca].tolist()) & set(labels[rb, cb].tolist()))
 
+    def _route_tree(
+        self, a: tuple[float, float], half_width: float, reach: float, ok: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Breadth-first search from the cells within ``reach`` of ``a``: each cell's parent
+        (-1 for a start, -2 not reached) and distance in steps (-1 not reached); the last
+        search is kept for the next route from the same start with the same width."""
+        key = (round(a[0], 4), round(a[1], 4), round(half_width, 4), round(reach, 4))
+        if key in self._trees:
+            return self._trees[key]
+        ny, nx = ok.shape
+        flat_ok = ok.ravel()
+        parent = np.full(ny * nx, -2, dtype=np.int32)  # at most 25 million cells
+        dist = np.full(ny * nx, -1, dtype=np.int32)
+        ra, ca = self._near(a[0], a[1], reach, ok)
+        queue: deque[int] = deque()
+        for idx in (ra * nx + ca).tolist():
+            parent[idx] = -1
+            dist[idx] = 0
+            queue.append(idx)
+        while queue:
+            idx = queue.popleft()
+            r, c = divmod(idx, nx)
+            d = dist[idx] + 1
+            for nb, valid in ((idx - nx, r > 0), (idx + nx, r < ny - 1),
+                              (idx - 1, c > 0), (idx + 1, c < nx - 1)):
+                if valid and flat_ok[nb] and parent[nb] == -2:
+                    parent[nb] = idx
+                    dist[nb] = d
+                    queue.append(nb)
+        self._trees = {key: (parent, dist)}  # the last search only: it takes 8 bytes a cell
+        return parent, dist
+
     def doors_on_route(
         self, a: tuple[float, float], b: tuple[float, float], half_width: float, reach: float,
         start_reach: float | None = None,
     ) -> list[int] | None:
         """Doors (0-based indices) crossed by a shortest route (in cells) from near ``a``
         (within ``start_reach``, default ``reach``) to near ``b`` (within ``reach``) for a robot
-        ``2 * half_width`` wide, in order; None if there is none."""
+        ``2 * half_width`` wide, in order; None if there is none. The search from ``a`` is kept
+        for the next route from there with the same width."""
         ok = self.clearance() >= half_width
-        ra, ca = self._near(a[0], a[1], reach if start_reach is None else start_reach, ok)
+        near_a = reach if start_reach is None else start_reach
+        parent, dist = self._route_tree(a, half_width, near_a, ok)
         rb, cb = self._near(b[0], b[1], reach, ok)
-        if len(ra) == 0 or len(rb) == 0:
+        if len(rb) == 0:
             return None
-        ny, nx = ok.shape
-        flat_ok = ok.ravel()
-        parent = np.full(ny * nx, -2, dtype=np.int64)
-        goal = np.zeros(ny * nx, dtype=bool)
-        goal[rb * nx + cb] = True
-        queue: deque[int] = deque()
-        for idx in (ra * nx + ca).tolist():
-            parent[idx] = -1
-            queue.append(idx)
-        found = -1
-        while queue:
-            idx = queue.popleft()
-            if goal[idx]:
-                found = idx
-                break
-            r, c = divmod(idx, nx)
-            for nb, valid in ((idx - nx, r > 0), (idx + nx, r < ny - 1),
-                              (idx - 1, c > 0), (idx + 1, c < nx - 1)):
-                if valid and flat_ok[nb] and parent[nb] == -2:
-                    parent[nb] = idx
-                    queue.append(nb)
-        if found < 0:
+        nx = ok.shape[1]
+        ends = rb * nx + cb
+        ends = ends[dist[ends] >= 0]
+        if len(ends) == 0:
             return None
+        found = int(ends[np.argmin(dist[ends])])
         doors = self.doors.ravel()
         out: list[int] = []
         idx = found
