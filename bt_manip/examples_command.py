@@ -51,9 +51,10 @@ def add_example_verbs(sub: argparse._SubParsersAction) -> None:  # type: ignore[
 def cmd_demo(args: argparse.Namespace) -> int:
     """Scenario A through ``bt-manip run``, with the shipped tree and world."""
     from bt_manip.cli import build_parser, cmd_run
+    from bt_manip.outputs import check_output_folder
 
     root = data_root()
-    out = Path(args.out)
+    out = check_output_folder("--out", args.out)
     report, replay = out / DEMO_REPORT, out / DEMO_REPLAY
     argv = ["run", str(root / DEMO_TREE), "--world", str(root / DEMO_WORLD),
             "--seed", str(args.seed), "--report", str(report), "--record", str(replay)]
