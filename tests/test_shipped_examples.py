@@ -98,6 +98,10 @@ def test_shipped_paths_are_found_from_any_folder_but_local_files_come_first(
     assert "result: SUCCESS" in capsys.readouterr().out
     assert main(["world", "worlds/panda_table.yaml"]) == 0
     assert "world 'panda_table'" in capsys.readouterr().out
+    assert main(["validate", "trees/nav2/through_poses.xml"]) == 0
+    assert capsys.readouterr().out.strip() == f"{ROOT / 'trees/nav2/through_poses.xml'}: OK"
+    assert main(["show", "trees/builtins_demo.xml"]) == 0
+    assert "third_time_lucky" in capsys.readouterr().out
 
 
 def test_demo_checks_its_output_folder_before_running(

@@ -45,7 +45,8 @@ def test_the_wheel_installs_in_a_fresh_venv_and_runs_the_demo_from_an_empty_fold
     assert wheel.name == f"bt_manip-{bt_manip.__version__}-py3-none-any.whl"
 
     # the wheel: the package, its examples as package data, nothing else of the clone
-    names = zipfile.ZipFile(wheel).namelist()
+    with zipfile.ZipFile(wheel) as archive:
+        names = archive.namelist()
     tops = {n.split("/")[0] for n in names}
     assert tops == {"bt_manip", f"bt_manip-{bt_manip.__version__}.dist-info"}
     data = {n.removeprefix("bt_manip/_data/") for n in names if n.startswith("bt_manip/_data/")}
@@ -53,7 +54,8 @@ def test_the_wheel_installs_in_a_fresh_venv_and_runs_the_demo_from_an_empty_fold
     assert "bt_manip/viz/static/replay.js" in names
     assert not any("__pycache__" in n or n.endswith(".pyc") for n in names)
     # the sdist carries the example folders the wheel is built from, not the tests
-    members = {m.split("/", 1)[1] for m in tarfile.open(sdist).getnames() if "/" in m}
+    with tarfile.open(sdist) as archive:
+        members = {m.split("/", 1)[1] for m in archive.getnames() if "/" in m}
     assert _shipped_files() <= members and "CHANGELOG.md" in members
     assert not any(m.startswith(("tests/", "out/", ".venv/")) for m in members)
 
