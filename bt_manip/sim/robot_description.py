@@ -17,7 +17,7 @@ from pathlib import Path
 import defusedxml.ElementTree as SafeET
 
 from bt_manip.errors import InputError
-from bt_manip.sim.assets import REPO_ROOT
+from bt_manip.sim.assets import data_root
 from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
 
@@ -35,7 +35,8 @@ __all__ = [
 ]
 
 # -- descriptors --------------------------------------------------------------------------------
-ROBOTS_DIR = REPO_ROOT / "robots"
+ROBOTS_DIR = data_root() / "robots"
+"""The shipped robot descriptors (the clone's ``robots/`` or the installed package data)."""
 BASE_TYPES = ("skid_steer", "fixed")
 TOP_KEYS = {
     "name",

@@ -223,3 +223,17 @@ def test_descriptor_next_to_its_own_urdf_names_it_relatively(tmp_path: Path) -> 
     # mid-range where there are limits, 0 for the continuous joint; the default speed for it
     assert desc.states["ready"] == (0.5, 0.0) and desc.states["zero"] == (0.0, 0.0)
     assert desc.arm.velocity_limits == (1.0, 1.0)
+
+
+def test_check_by_name_takes_the_descriptor_just_written_here(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["robot", "init", str(PANDA), "--base-link", "panda_link0",
+                 "--arm-tip", "panda_hand", "--gripper", "panda_finger_joint1,panda_finger_joint2",
+                 "--grasp-frame", "panda_hand_tcp", "--out", "robots/mine.yaml"]) == 0
+    assert main(["robot", "check", "mine"]) == 0
+    assert "panda_joint7" in capsys.readouterr().out
+    monkeypatch.chdir(tmp_path / "robots")  # no robots/mine.yaml here, nor a shipped 'mine'
+    assert main(["robot", "check", "mine"]) == 2
+    assert "no robot descriptor 'mine'" in capsys.readouterr().err
