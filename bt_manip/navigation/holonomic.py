@@ -107,12 +107,12 @@ class HolonomicFollower:
         self,
         path: np.ndarray,
         goal: tuple[float, ...],
-        options: FollowerOptions = FollowerOptions(),
+        options: FollowerOptions | None = None,
         *,
         path_blocked: Callable[[np.ndarray], bool] | None = None,
         replan: Callable[[Pose2D], np.ndarray | str] | None = None,
     ) -> None:
-        self.options = options
+        self.options = options or FollowerOptions()
         self.goal_xy = (float(goal[0]), float(goal[1]))
         self.goal_yaw: float | None = float(goal[2]) if len(goal) > 2 else None
         self.path_blocked = path_blocked

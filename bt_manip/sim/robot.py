@@ -284,6 +284,8 @@ class Robot:
     def base_pose2d(self) -> tuple[float, float, float]:
         """Planar pose (x, y, yaw) of the root link frame in the world (of the base link, the
         child of the yaw joint, for a holonomic base)."""
+        pos: Sequence[float]
+        quat: Sequence[float]
         if self.is_holonomic:
             state = pbq.link_state(self.client, self.body, self.base_joint_ids[2])
             pos, quat = state.frame_position, state.frame_orientation

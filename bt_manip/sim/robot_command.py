@@ -38,7 +38,8 @@ def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     )
     init.add_argument(
         "--mobile", choices=MOBILE_KINDS, default=None,
-        help="a wheeled base (wheels found from its continuous joints); default: fixed base",
+        help="a mobile base: skid or diff (wheels found from its continuous joints), or "
+        "holonomic (virtual x, y, yaw joints above --base-link); default: fixed base",
     )
     init.add_argument("--name", default="", help="robot name (default: the --out file name)")
     init.add_argument("--out", required=True, help="descriptor to write, e.g. robots/NAME.yaml")

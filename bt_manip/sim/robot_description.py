@@ -1,10 +1,10 @@
 """Robot descriptors (``robots/<name>.yaml``): where they are found and what they say.
 
 :class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
-which URDF (or composition recipe), the base (``skid_steer``, ``holonomic`` or ``fixed``), the arm joints in
-order, the gripper, the end-effector and grasp frames, named arm states and the footprint.
-Every name in it is checked against the robot's URDF. This module is pure data: nothing here
-touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
+which URDF (or composition recipe), the base (``skid_steer``, ``holonomic`` or ``fixed``), the
+arm joints in order, the gripper, the end-effector and grasp frames, named arm states and the
+footprint. Every name in it is checked against the robot's URDF. This module is pure data:
+nothing here touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
 """
 
 from __future__ import annotations
@@ -442,7 +442,16 @@ def _holonomic_base(f: _Fields, b: LineDict) -> BaseSpec:
         default = 2.0 if key == "max_yaw_accel" else None
         value = f.number(b, key, "base", default, within=(1e-6, top))
         values[key] = 0.0 if value is None else value
-    return BaseSpec("holonomic", joints=joints, **values)
+    return BaseSpec(
+        "holonomic",
+        joints=joints,
+        max_speed=values["max_speed"],
+        max_yaw_rate=values["max_yaw_rate"],
+        max_accel=values["max_accel"],
+        max_yaw_accel=values["max_yaw_accel"],
+        max_force=values["max_force"],
+        max_torque=values["max_torque"],
+    )
 
 
 def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:

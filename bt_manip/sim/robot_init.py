@@ -576,7 +576,7 @@ class _Geometry:
         height = max(0.0, -float(self.all_min[2])) + FLOOR_GAP
         return [
             f"spawn_height: {_fmt(height)}   # the base {FLOOR_GAP * 1000:g} mm clear of the floor",
-            "base:                     # virtual joints x, y, yaw from a root fixed at the spawn pose",
+            "base:                     # virtual joints x, y, yaw; the root is fixed at spawn",
             "  type: holonomic",
             f"  joints: [{x.name}, {y.name}, {yaw.name}]",
             f"  max_speed: {_fmt(speed)}        # m/s",
