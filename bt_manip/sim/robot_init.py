@@ -64,8 +64,10 @@ HOLONOMIC_ACCEL = 0.5
 PUSH_FRICTION = 0.5
 """Without URDF efforts, a holonomic base pushes with this fraction of its weight (what
 wheels with this friction coefficient could push with)."""
-FLOOR_GAP = 0.005
-"""m between the floor and the lowest collision shape of a holonomic base at spawn."""
+FLOOR_GAP = 0.03
+"""m between the floor and the lowest collision shape of a holonomic base at spawn. The
+virtual joints carry the base; closer than PyBullet's contact threshold (a few cm), the floor
+would count as touching it and its friction would tug at the base and the arm on it."""
 HOLONOMIC_AXES = (
     ("x", ("prismatic",), (1.0, 0.0, 0.0)),
     ("y", ("prismatic",), (0.0, 1.0, 0.0)),
@@ -575,7 +577,7 @@ class _Geometry:
         torque = min(yaw.effort if yaw.effort and yaw.effort > 0 else force * reach, 1e5)
         height = max(0.0, -float(self.all_min[2])) + FLOOR_GAP
         return [
-            f"spawn_height: {_fmt(height)}   # the base {FLOOR_GAP * 1000:g} mm clear of the floor",
+            f"spawn_height: {_fmt(height)}   # the base {FLOOR_GAP * 100:g} cm clear of the floor",
             "base:                     # virtual joints x, y, yaw; the root is fixed at spawn",
             "  type: holonomic",
             f"  joints: [{x.name}, {y.name}, {yaw.name}]",
