@@ -125,9 +125,9 @@ def test_cli_init_writes_and_errors_exit_2(tmp_path: Path, capsys: pytest.Captur
     assert not bad.exists()
 
 
-def test_holonomic_base_is_refused(tmp_path: Path) -> None:
+def test_holonomic_without_virtual_joints_is_refused(tmp_path: Path) -> None:
     (problem,) = _problems(_panda(tmp_path, mobile="holonomic"))
-    assert "no holonomic base controller" in problem
+    assert "0 movable joint(s) above --base-link 'panda_link0'" in problem
 
 
 def test_check_moves_every_joint_to_its_limits(tmp_path: Path) -> None:
