@@ -4,6 +4,7 @@ turning, around an obstacle to a heading, halted and braked)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 
@@ -13,8 +14,8 @@ import pytest
 
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.navigation.controller import FollowerOptions, FollowState, wrap
-from bt_manip.navigation.holonomic import HolonomicFollower, turning_footprint
 from bt_manip.navigation.footprint import PlanarFootprint
+from bt_manip.navigation.holonomic import HolonomicFollower, turning_footprint
 
 TICK = 0.05
 
@@ -69,7 +70,7 @@ def test_turns_to_the_goal_heading_on_the_way_within_the_limits() -> None:
     ]
     assert max(math.hypot(*v) for v in world_v) <= opts.max_speed + 1e-9
     assert max(abs(cmd[2]) for cmd in commands) <= opts.max_yaw_rate + 1e-9
-    steps = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in zip(world_v, world_v[1:])]
+    steps = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(world_v)]
     assert max(steps) <= opts.max_accel * TICK * 1.05  # (a turning base re-aims mid-tick)
 
 
