@@ -234,3 +234,25 @@ def test_stop_base_brakes_where_it_is(scene) -> None:  # type: ignore[no-untyped
     there = robot.base_pose2d()
     assert math.dist(here[:2], there[:2]) < 0.005 and abs(there[2] - here[2]) < 0.005
     assert max(abs(v) for v in robot.base_velocity()) < 0.01
+
+
+def test_committed_omni_sawyer_is_what_init_writes_but_its_home_and_tuck(tmp_path: Path) -> None:
+    import yaml
+
+    root = Path(__file__).resolve().parents[2] / "robots"
+    out = tmp_path / "robots" / "omni_sawyer.yaml"
+    init_descriptor(InitOptions(
+        root / "omni_sawyer.urdf", "right_arm_base_link", "right_hand", out,
+        gripper=("gripper_left_finger_joint", "gripper_right_finger_joint"),
+        grasp_frame="grasp_frame", mobile="holonomic",
+    ))
+    written = yaml.safe_load(out.read_text())
+    committed = yaml.safe_load((root / "omni_sawyer.yaml").read_text())
+    sawyer = yaml.safe_load((root / "sawyer.yaml").read_text())
+    assert committed["states"]["home"] == sawyer["states"]["home"]
+    assert committed["states"]["tuck"] == sawyer["states"]["tuck"]
+    assert committed["urdf"] == {"base": "omni_sawyer.urdf"}
+    assert written["urdf"]["base"].endswith("robots/omni_sawyer.urdf")  # relative from tmp_path
+    for d in (written, committed):
+        del d["states"]["home"], d["states"]["tuck"], d["urdf"]
+    assert written == committed
