@@ -10,10 +10,14 @@ base frame) is applied with ``robot.set_base_velocity(*status.velocity)``.
 
 Phases, as reported in ``phase`` while RUNNING:
 
-- ``drive``: toward the point ``lookahead`` metres further along the path (the goal itself once
-  the look-ahead reaches past the path's end). The speed is capped by ``max_speed`` and by the
-  braking distance to the goal; the yaw rate turns the base to the goal heading (capped by
-  ``max_yaw_rate`` and by the braking angle). The planar velocity changes by at most
+- ``drive``: toward the point further along the path by a look-ahead that grows with the speed
+  (from 0.12 m at rest up to ``lookahead``), but never past the next corner (a turn of the
+  path by more than 0.35 rad) before the base is there, and the goal itself once the look-ahead
+  reaches past the path's end. The speed is capped by ``max_speed``, by the braking distance to
+  the goal and by the corners ahead: where the path turns by an angle a the base must be down
+  to ``max_speed`` x cos(a) (0.08 m/s for a right angle or sharper), so it keeps to the path
+  there and the planner's clearance holds. The yaw rate turns the base to the goal heading
+  (capped by ``max_yaw_rate`` and by the braking angle). The planar velocity changes by at most
   ``max_accel`` x dt per tick (as a vector), the yaw rate by ``max_yaw_accel`` x dt.
 - ``settle``: within 0.9 ``xy_tolerance`` and half ``yaw_tolerance`` of the goal at the path's
   end, the command ramps to zero and stays there for ``settle_time`` seconds.
@@ -69,6 +73,17 @@ MIN_SPEED = 0.03
 BRAKE_SHARE = 0.8
 """Share of the acceleration limit the braking profile plans with (the rest absorbs a tick's
 delay)."""
+CORNER_SPEED = 0.08
+"""m/s: the speed a right-angle (or sharper) corner of the path is taken at."""
+LOOK_BASE = 0.12
+"""m: the look-ahead distance at rest; it grows by half the speed (in m per m/s)."""
+CORNER_BRAKE_SHARE = 0.5
+"""Share of the acceleration limit the base slows down with for a corner (the rest turns its
+velocity toward the look-ahead point as it nears the corner)."""
+CORNER_STEP = 0.1
+"""m: a corner closer than half this is where the base already is (the look-ahead passes it)."""
+CORNER_COS = math.cos(0.35)
+"""A turn of the path by more than 0.35 rad is a corner: the look-ahead point stops there."""
 
 
 @dataclass(frozen=True)
@@ -139,6 +154,10 @@ class HolonomicFollower:
         self.path = path
         seg = np.hypot(*np.diff(path, axis=0).T)
         self._s = np.concatenate([[0.0], np.cumsum(seg)])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            dirs = np.diff(path, axis=0) / seg[:, None]
+        self._dirs = np.where(seg[:, None] > 1e-9, dirs, np.nan)
+        """Unit direction of each segment (NaN for a segment of no length)."""
         self._index = 0
         self._best = math.inf
 
@@ -215,7 +234,10 @@ class HolonomicFollower:
         """World velocity toward the look-ahead point, braking for the goal."""
         o = self.options
         speed_now = math.hypot(*self._vel)
-        look = min(o.lookahead, o.min_lookahead + 0.5 * speed_now)
+        look = min(o.lookahead, LOOK_BASE + 0.5 * speed_now)
+        corner = self._next_corner(look)
+        if corner is not None:
+            look = corner  # drive to the corner, then along the next stretch
         if self.remaining() <= look:
             tx, ty = self.goal_xy
         else:
@@ -225,10 +247,47 @@ class HolonomicFollower:
             return 0.0, 0.0
         left = max(self.remaining(), d_goal)
         v = min(o.max_speed, math.sqrt(2.0 * BRAKE_SHARE * o.max_accel * left))
-        v = min(v, max(POSITION_GAIN * d_goal, MIN_SPEED))
+        v = min(v, self._corner_speed(), max(POSITION_GAIN * d_goal, MIN_SPEED))
         if d_goal <= 0.5 * o.xy_tolerance and self.remaining() <= look:
             v = min(v, POSITION_GAIN * d_goal)
         return v * (tx - x) / dist, v * (ty - y) / dist
+
+    def _turns_ahead(self, reach: float) -> tuple[np.ndarray, np.ndarray]:
+        """For each path segment starting within ``reach`` m ahead of the progress point: how
+        far ahead it starts (m) and the cosine of its turn from the segment that leads to the
+        progress point (the base may not have passed that point yet)."""
+        k0 = self._index
+        start = max(k0 - 1, 0)
+        end = int(np.searchsorted(self._s, self._s[k0] + reach, side="right"))
+        dirs = self._dirs[start : min(end, len(self._dirs))]
+        valid = np.flatnonzero(np.isfinite(dirs[:, 0]))
+        if len(valid) < 2:
+            return np.zeros(0), np.zeros(0)
+        here = dirs[valid[0]]
+        ahead = self._s[start + valid[1:]] - self._s[k0]
+        return ahead, dirs[valid[1:]] @ here
+
+    def _corner_speed(self) -> float:
+        """The highest speed from which the base can slow down for every corner ahead: where
+        the path turns by an angle a it must be down to ``max_speed`` x cos(a), at least
+        :data:`CORNER_SPEED`."""
+        o = self.options
+        brake = CORNER_BRAKE_SHARE * o.max_accel
+        ahead, cos_turn = self._turns_ahead(o.max_speed**2 / (2.0 * brake) + o.lookahead)
+        if len(ahead) == 0:
+            return o.max_speed
+        at_corner = np.maximum(CORNER_SPEED, o.max_speed * cos_turn)
+        return float(min(o.max_speed, np.min(np.sqrt(at_corner**2 + 2.0 * brake * ahead))))
+
+    def _next_corner(self, within: float) -> float | None:
+        """Distance along the path to the first corner (a turn of more than 0.35 rad) within
+        ``within`` metres, unless the base is already at it."""
+        ahead, cos_turn = self._turns_ahead(within)
+        sharp = np.flatnonzero(cos_turn < CORNER_COS)
+        if len(sharp) == 0:
+            return None
+        distance = float(ahead[sharp[0]])
+        return distance if distance > CORNER_STEP / 2.0 else None
 
     def _turn(self, error: float) -> float:
         """Yaw rate toward the goal heading, braking for it."""

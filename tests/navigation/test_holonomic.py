@@ -16,6 +16,7 @@ from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.navigation.controller import FollowerOptions, FollowState, wrap
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.holonomic import HolonomicFollower, turning_footprint
+from bt_manip.navigation.smoothing import densify
 
 TICK = 0.05
 
@@ -72,6 +73,21 @@ def test_turns_to_the_goal_heading_on_the_way_within_the_limits() -> None:
     assert max(abs(cmd[2]) for cmd in commands) <= opts.max_yaw_rate + 1e-9
     steps = [math.hypot(b[0] - a[0], b[1] - a[1]) for a, b in itertools.pairwise(world_v)]
     assert max(steps) <= opts.max_accel * TICK * 1.05  # (a turning base re-aims mid-tick)
+
+
+def test_keeps_to_the_path_round_a_right_angle() -> None:
+    """It slows down for the corner and does not cut it: the planner's margin (8 cm beyond the
+    swept disc) is kept."""
+    path = densify(np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 2.0]]), 0.05)
+    follower = HolonomicFollower(path, (2.0, 2.0, 0.0))
+    state, reason, poses, _ = _ideal_drive(follower, (0.0, 0.0, 0.0), 30.0)
+    assert state is FollowState.SUCCEEDED, reason
+
+    def off_path(x: float, y: float) -> float:
+        return min(math.hypot(x - min(max(x, 0.0), 2.0), y),
+                   math.hypot(x - 2.0, y - min(max(y, 0.0), 2.0)))
+
+    assert max(off_path(x, y) for x, y, _ in poses) < 0.03
 
 
 def test_a_base_that_does_not_move_is_stuck() -> None:
