@@ -256,3 +256,27 @@ def test_committed_omni_sawyer_is_what_init_writes_but_its_home_and_tuck(tmp_pat
     for d in (written, committed):
         del d["states"]["home"], d["states"]["tuck"], d["urdf"]
     assert written == committed
+
+
+def test_descriptor_errors_of_a_holonomic_base(tmp_path: Path) -> None:
+    from bt_manip.sim.robot_description import load_description
+
+    init_descriptor(_init(tmp_path))
+    good = (tmp_path / "robots" / "omni.yaml").read_text()
+    bad = tmp_path / "robots" / "bad.yaml"
+    bad.write_text(
+        good.replace("joints: [x, y, yaw]", "joints: [x, yaw]")
+        .replace("  max_speed: 0.7 ", "  max_speed: 50 ")
+        .replace("  type: holonomic", "  type: holonomic\n  track_width: 0.5")
+    )
+    with pytest.raises(InputError) as err:
+        load_description(bad)
+    text = "\n".join(str(p) for p in err.value.problems)
+    lines = bad.read_text().splitlines()
+
+    def at(key: str) -> str:
+        return f"{bad}:{next(i for i, t in enumerate(lines, 1) if t.startswith(f'  {key}:'))}: "
+
+    assert at("joints") + "base.joints of a holonomic base: three joints" in text
+    assert at("max_speed") + "base.max_speed must be within" in text
+    assert at("track_width") + "unknown key 'track_width' in base" in text
