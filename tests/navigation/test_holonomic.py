@@ -175,3 +175,11 @@ def test_halting_navigate_brakes_the_base(tmp_path: Path) -> None:
         there = robot.base_pose2d()
     assert math.dist(here[:2], there[:2]) < 0.005 and abs(there[2] - here[2]) < 0.005
     assert math.dist(moved[:2], here[:2]) < 0.1  # it stopped within its braking distance
+
+
+def test_reverse_backs_a_holonomic_base_straight(tmp_path: Path) -> None:
+    with _episode(tmp_path, '<Reverse distance="0.3" speed="0.2"/>') as episode:
+        report = episode.run()
+        assert report.status == "SUCCESS", report.reason
+        x, y, yaw = episode.world.robots["omni"].base_pose2d()
+    assert -0.4 < x <= -0.3 and abs(y) < 0.01 and abs(yaw) < 0.01
