@@ -12,7 +12,7 @@ EXTRAS_STAMP := $(VENV)/.installed-extras
 # every extra of [project.optional-dependencies], comma-separated (dev,bench,...)
 EXTRAS := $(shell sed -n '/^\[project\.optional-dependencies\]/,/^\[/s/^\([A-Za-z0-9_-]*\) *= *\[.*/\1/p' pyproject.toml | paste -sd, -)
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench dist clean
 
 $(RUNTIME_STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -44,10 +44,15 @@ lint: $(EXTRAS_STAMP)
 	$(BIN)/ruff check .
 	$(BIN)/mypy
 
+## dist: the sdist and the wheel in dist/ (the wheel carries trees/, worlds/, robots/)
+dist: $(EXTRAS_STAMP)
+	rm -rf dist
+	$(BIN)/python -m build --outdir dist .
+
 bench: $(EXTRAS_STAMP)
 	$(BIN)/python benchmarks/astar.py
 	$(BIN)/python benchmarks/ik.py
 	$(BIN)/python benchmarks/bt_tick.py
 
 clean:
-	rm -rf $(VENV) out build *.egg-info
+	rm -rf $(VENV) out build dist *.egg-info

@@ -9,6 +9,11 @@ Verbs:
   validate TREE.xml          check a tree without running it, listing every problem
   show TREE.xml              print a tree as text (or Graphviz with --dot)
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
+  demo [--out DIR]           Scenario A headless: summary, run report, replay page
+  examples [copy DIR]        list the shipped trees, worlds and robots, or copy them
+
+A tree or world named by a relative path that does not exist here but is a shipped example
+(``trees/husky_carry_wall.xml``) is read from the shipped examples (see bt_manip.bundled).
 
 Exit codes: 0 success, 1 the tree failed or ran out of budget, 2 bad input, 130 interrupted.
 """
@@ -23,6 +28,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from bt_manip.bundled import shipped_or_given
 from bt_manip.errors import InputError, Problem
 from bt_manip.interrupts import terminate_as_interrupt
 from bt_manip.plugins import add_import_flag
@@ -177,8 +183,9 @@ def build_parser() -> argparse.ArgumentParser:
     sub.required = True
 
     run = sub.add_parser("run", help="tick a tree until it succeeds, fails or runs out of budget")
-    run.add_argument("tree", help="BehaviorTree.CPP v4 XML file")
-    run.add_argument("--world", help="world file (YAML); without it only built-in nodes can run")
+    run.add_argument("tree", type=shipped_or_given, help="BehaviorTree.CPP v4 XML file")
+    run.add_argument("--world", type=shipped_or_given,
+                     help="world file (YAML); without it only built-in nodes can run")
     run.add_argument("--seed", type=int, default=0, help="seed for the world's randomisation")
     run.add_argument("--tree-id", help="which BehaviorTree to run (default: main_tree_to_execute)")
     run.add_argument(
@@ -279,8 +286,10 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run many seeded episodes of a tree and report statistics. Exit codes: 0 "
         "every episode succeeded, 1 some did not, 2 bad input, 130 interrupted (the finished "
         "episodes are kept in episodes.jsonl; --resume DIR runs the rest).")
-    bench.add_argument("tree", nargs="?", help="BehaviorTree.CPP v4 XML file")
-    bench.add_argument("--world", help="world file (YAML); required unless --resume")
+    bench.add_argument("tree", nargs="?", type=shipped_or_given,
+                       help="BehaviorTree.CPP v4 XML file")
+    bench.add_argument("--world", type=shipped_or_given,
+                       help="world file (YAML); required unless --resume")
     bench.add_argument("--runs", type=_positive(int), default=20, help="episodes (default 20)")
     bench.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     bench.add_argument("--jobs", type=_within(int, 1, 64), default=2,
@@ -324,7 +333,7 @@ def build_parser() -> argparse.ArgumentParser:
     bench.set_defaults(func=cmd_bench)
 
     world = sub.add_parser("world", help="load a world and print its summary")
-    world.add_argument("world", help="world file (YAML)")
+    world.add_argument("world", type=shipped_or_given, help="world file (YAML)")
     world.add_argument("--seed", type=int, default=0)
     world.add_argument(
         "--settle",
@@ -343,6 +352,10 @@ def build_parser() -> argparse.ArgumentParser:
     from bt_manip.sim.robot_command import add_robot_verb
 
     add_robot_verb(sub)
+
+    from bt_manip.examples_command import add_example_verbs
+
+    add_example_verbs(sub)
 
     try:
         from bt_manip.bt.cli_verbs import add_verbs

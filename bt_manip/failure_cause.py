@@ -64,5 +64,25 @@ def failure_cause(tree: Any) -> FailureCause | None:
     with_reason = [node for node in ends if node.feedback_message]
     node = max(with_reason or ends, key=lambda n: n.failure_order)
     node_id = getattr(node, "tree_id", None) or node.NODE_ID
-    reason = node.feedback_message or f"{node_id} returned FAILURE"
+    reason = node.feedback_message or _own_logic(node, node_id)
     return FailureCause(paths.get(id(node), node.name), node.name, node_id, reason)
+
+
+def _node_id(node: Any) -> str:
+    return str(getattr(node, "tree_id", None) or node.NODE_ID)
+
+
+def _own_logic(node: Any, node_id: str) -> str:
+    """What a node that failed without a reason and without a failed child did: a decorator
+    such as an Inverter failed because its child succeeded, and that child's own words (a
+    condition's reading, say) tell why."""
+    succeeded = [
+        child
+        for child in node.bt_children()
+        if child.last_status is NodeStatus.SUCCESS and child.started_order >= node.started_order
+    ]
+    if not succeeded:
+        return f"{node_id} returned FAILURE"
+    child = max(succeeded, key=lambda c: c.started_order)
+    text = f"{node_id} returned FAILURE because {_node_id(child)} '{child.name}' succeeded"
+    return f"{text}: {child.feedback_message}" if child.feedback_message else text

@@ -78,6 +78,11 @@ class RunOptions:
     same pace from where it is, without rushing to catch up."""
 
 
+REPORT_SCHEMA_VERSION = 1
+"""Version of the run report's JSON format (``--report``); bumped when a field changes meaning
+or goes away."""
+
+
 @dataclass
 class NodeReport:
     """A node's final state for the report: ``status`` now (finished nodes are IDLE again, as
@@ -92,7 +97,8 @@ class NodeReport:
 
 @dataclass
 class RunReport:
-    """What happened in a run; written as JSON by ``--report``."""
+    """What happened in a run; written as JSON by ``--report`` (with ``schema_version``
+    :data:`REPORT_SCHEMA_VERSION`, documented by docs/schemas/run-report.schema.json)."""
 
     status: str
     reason: str
@@ -120,7 +126,7 @@ class RunReport:
         return self.sim_time / self.wall_time if self.wall_time > 0 else math.inf
 
     def to_json(self) -> dict[str, Any]:
-        data = asdict(self)
+        data = {"schema_version": REPORT_SCHEMA_VERSION, **asdict(self)}
         data["real_time_factor"] = (
             round(self.real_time_factor, 3) if math.isfinite(self.real_time_factor) else None
         )

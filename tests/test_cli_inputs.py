@@ -248,7 +248,8 @@ def test_cause_of_a_built_in_failure_without_a_reason(
     )
     assert main(["run", str(tree), "--quiet"]) == 1
     assert capsys.readouterr().out.splitlines()[0] == (
-        "result: FAILURE (Sequence/must_not_hold: Inverter returned FAILURE)"
+        "result: FAILURE (Sequence/must_not_hold: Inverter returned FAILURE because "
+        "AlwaysSuccess 'AlwaysSuccess' succeeded)"
     )
 
 

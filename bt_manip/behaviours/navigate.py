@@ -22,6 +22,7 @@ from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
 from bt_manip.faults import block_route
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.grid import GridTooLarge
+from bt_manip.navigation.holonomic import HolonomicStatus
 from bt_manip.navigation.navigator import Navigator
 from bt_manip.sim import pybullet_queries as pbq
 
@@ -86,7 +87,8 @@ def _goal_text(text: Any) -> str | None:
 
 @registry.register
 class Navigate(RobotAction):
-    """Drives the base to ``goal`` (a named pose of the world, or ``x;y;yaw``).
+    """Drives the base to ``goal`` (a named pose of the world, or ``x;y;yaw``). A holonomic
+    base drives sideways as needed and turns to the goal heading on the way.
 
     - RUNNING while the base follows the planned path (re-planned when an object moves onto it);
     - SUCCESS when the base is within ``xy_tolerance`` (m) and ``yaw_tolerance`` (rad) of the
@@ -117,7 +119,7 @@ class Navigate(RobotAction):
     def start(self) -> None:
         world = self.world
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
+        if robot.description.base.type == "fixed":
             raise ActionFailed(f"{robot.description.name} has no mobile base")
         goal = parse_goal(world, self.get_input("goal"))
         nav = synced_navigator(self, robot)
@@ -160,7 +162,10 @@ class Navigate(RobotAction):
             robot.stop_base()
             x, y, _ = robot.base_pose2d()
             raise ActionFailed(f"not there after {self.timeout:.0f} s (at x={x:.2f} y={y:.2f})")
-        robot.set_base_twist(*status.cmd)
+        if isinstance(status, HolonomicStatus):
+            robot.set_base_velocity(*status.velocity)
+        else:
+            robot.set_base_twist(*status.cmd)
         return Status.RUNNING
 
     def _bumped(self) -> list[str]:
@@ -208,7 +213,7 @@ class Reverse(RobotAction):
 
     def start(self) -> None:
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
+        if robot.description.base.type == "fixed":
             raise ActionFailed(f"{robot.description.name} has no mobile base")
         self.distance = float(self.get_input("distance"))
         self.speed = abs(float(self.get_input("speed")))

@@ -16,6 +16,7 @@ from bt_manip.bt.display import render_dot, render_tree
 from bt_manip.bt.models import write_models
 from bt_manip.bt.registry import registry
 from bt_manip.bt.xml_loader import load_tree, validate
+from bt_manip.bundled import shipped_or_given
 from bt_manip.errors import InputError, Problem
 from bt_manip.outputs import check_output_file, write_text
 from bt_manip.plugins import add_import_flag, import_modules
@@ -53,13 +54,13 @@ def add_verbs(subparsers: argparse._SubParsersAction[Any]) -> None:
     p = subparsers.add_parser("validate", help="check tree files without running them",
                               description="Check everything loading checks and report ALL "
                                           "problems, each as file:line: message.")
-    p.add_argument("trees", nargs="+", metavar="TREE.xml")
+    p.add_argument("trees", nargs="+", type=shipped_or_given, metavar="TREE.xml")
     p.add_argument("--tree-id", default=None, help="main tree to check (default: the file's)")
     _common(p)
     p.set_defaults(func=validate_command)
 
     p = subparsers.add_parser("show", help="print a tree as text (and Graphviz with --dot)")
-    p.add_argument("tree", metavar="TREE.xml")
+    p.add_argument("tree", type=shipped_or_given, metavar="TREE.xml")
     p.add_argument("--tree-id", default=None)
     p.add_argument("--dot", metavar="FILE", default=None, help="write Graphviz source to FILE")
     _common(p)

@@ -26,6 +26,11 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
 
 Where a skid-steer base turns on the spot (``pivot``) matters for ending on the goal; see
 :mod:`bt_manip.navigation.controller`.
+
+A holonomic base (``base.type: holonomic``) is planned on the same grid as a disc of its
+footprint's turning radius (it may turn anywhere on the way), carrying or not, and followed by
+a :class:`~bt_manip.navigation.holonomic.HolonomicFollower`; the search over poses is for
+skid-steer bases only.
 """
 
 from __future__ import annotations
@@ -49,6 +54,7 @@ from bt_manip.navigation.costmap import CostMap, InflationOptions, clearance
 from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
+from bt_manip.navigation.holonomic import HolonomicFollower, base_limited, turning_footprint
 from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
 from bt_manip.navigation.planner import NavPlan, PlannerOptions, PlanOutcome, plan_path
 from bt_manip.navigation.segments import SegmentFollower
@@ -146,7 +152,8 @@ class Navigator:
         self.footprint = self.base_footprint
         self.attached: dict[int, str] = {}
         self.costmap = CostMap(self._compose(), options.inflation)
-        self.follower: PathFollower | SegmentFollower | None = None
+        self.follower: PathFollower | SegmentFollower | HolonomicFollower | None = None
+        self.holonomic = robot.description.base.type == "holonomic"
         self.poses: PosePlan | None = None
         self._obstacles = list(obstacles)
         self._carry: tuple | None = None
@@ -204,9 +211,15 @@ class Navigator:
         return True
 
     @property
+    def planning_footprint(self) -> PlanarFootprint:
+        """What the grid planner clears: the footprint, or the disc it sweeps when a holonomic
+        base turns on the way."""
+        return turning_footprint(self.footprint) if self.holonomic else self.footprint
+
+    @property
     def cost(self) -> np.ndarray:
         """The cost grid the planner searches for the current footprint."""
-        return self.costmap.cost_for(self.footprint)
+        return self.costmap.cost_for(self.planning_footprint)
 
     # -- what the robot carries --------------------------------------------------------------
     def attach(self, body: int, name: str | None = None) -> PlanarFootprint:
@@ -242,7 +255,7 @@ class Navigator:
         does not collide with it)."""
         self._carry = None
         self._carry_high = None
-        if not self.attached:
+        if not self.attached or self.holonomic:
             return
         c = self.client
         robot = self.robot
@@ -279,7 +292,9 @@ class Navigator:
     # -- planning and following ---------------------------------------------------------------
     def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
         """A plan from ``start`` to ``goal`` for the current footprint and map."""
-        return plan_path(self.costmap, self.footprint, start[:2], goal[:2], self.options.planner)
+        return plan_path(
+            self.costmap, self.planning_footprint, start[:2], goal[:2], self.options.planner
+        )
 
     def start(
         self,
@@ -303,6 +318,8 @@ class Navigator:
         self._goal = goal
         self._align = align
         self.follower = None
+        if self.holonomic:
+            return self._start_holonomic(pose, goal, align)
         self.plan = self.plan_to(self._pivot(pose), self._pivot_goal())
         if not self.plan.ok:
             self.plan = self.plan_to(pose, goal)  # the reason, in the caller's coordinates
@@ -333,6 +350,20 @@ class Navigator:
             path_blocked=self._path_blocked,
             replan=self._replan,
         )
+        return self.plan
+
+    def _start_holonomic(self, pose: Pose2D, goal: Pose2D, align: bool) -> NavPlan:
+        """Plan for the turning disc and get a holonomic follower ready."""
+        self.plan = self.plan_to(pose, goal)
+        if self.plan.ok:
+            self._plan_cost = self.cost
+            self.follower = HolonomicFollower(
+                cast(np.ndarray, self.plan.polyline),
+                goal if align else goal[:2],
+                base_limited(self._follower_options, self.robot.description.base),
+                path_blocked=self._path_blocked,
+                replan=self._replan,
+            )
         return self.plan
 
     def _load_fits(self, pose: Pose2D) -> bool:

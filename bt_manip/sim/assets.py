@@ -7,6 +7,11 @@ here at load time:
   ``<site-packages>/cmeel.prefix/share/``.
 - ``pybullet_data://...``: the data folder that ships with ``pybullet``.
 - plain relative paths: relative to the file that names them.
+
+The example trees, worlds and robots live at the top of a clone (``trees/``, ``worlds/``,
+``robots/``); a built wheel carries the same folders as package data under
+``bt_manip/_data/`` (see ``setup.py``). :func:`data_root` is whichever of the two this copy of
+bt_manip has.
 """
 
 from __future__ import annotations
@@ -17,6 +22,23 @@ from pathlib import Path
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
 """The checkout (or source tree) that holds ``robots/``, ``worlds/`` and ``trees/``."""
+
+PACKAGED_DATA = Path(__file__).resolve().parents[1] / "_data"
+"""Where an installed wheel keeps its copies of ``robots/``, ``worlds/`` and ``trees/``."""
+
+DATA_FOLDERS = ("trees", "worlds", "robots")
+"""The folders of examples that ship with bt-manip, in the order they are listed."""
+
+
+def data_root() -> Path:
+    """The folder that holds the shipped ``trees/``, ``worlds/`` and ``robots/``.
+
+    An installed wheel's package data when there is one, else the clone bt_manip was imported
+    from (an editable install or ``PYTHONPATH``).
+    """
+    if (PACKAGED_DATA / "robots").is_dir():
+        return PACKAGED_DATA
+    return REPO_ROOT
 
 
 @functools.cache

@@ -5,6 +5,13 @@ spawned with; nothing here touches a global client. Joints are position controll
 velocity and effort limits of the descriptor, wheels are velocity controlled. ``stop_base()``
 followed by ``hold_arm()`` leaves the robot safe (wheels braked, arm holding where it is).
 
+A holonomic base (``base.type: holonomic``) is a root link fixed to the world at the spawn pose
+with the base link hanging from it by three virtual joints: prismatic x, prismatic y and yaw,
+in that order. :meth:`Robot.set_base_velocity` drives them with velocity motors of bounded
+force (so a wall or a heavy object still stops the base), :meth:`Robot.stop_base` brakes them
+by holding their positions, and :meth:`Robot.base_pose2d` is the pose of the base link (the
+child of the yaw joint), not of the fixed root.
+
 The descriptor itself (schema, checks, lookup) is :mod:`bt_manip.sim.robot_description`; its
 names are re-exported here.
 """
@@ -90,6 +97,8 @@ class Robot:
         self._arm_links: list[int] | None = None
         self.wheel_ids_left = [self.joint_index(n) for n in description.base.left_wheels]
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
+        self.base_joint_ids = [self.joint_index(n) for n in description.base.joints]
+        """Holonomic base: PyBullet indices of the x, y and yaw joints (empty otherwise)."""
         arm = description.arm
         self._arm_velocity = [
             v if v is not None else float(self._joint_info[j].max_velocity)
@@ -115,8 +124,9 @@ class Robot:
         """Load the robot as one multibody at (x, y, yaw) and hold it still.
 
         ``z`` defaults to the descriptor's ``spawn_height`` (wheels touching z=0). Fixed-base
-        robots are welded to the world. Arm and gripper then hold their initial positions and the
-        wheels are braked, so the robot stays at rest until commanded.
+        robots are welded to the world, and so is the root of a holonomic base (the spawn pose
+        is where its virtual joints are at 0). Arm and gripper then hold their initial positions
+        and the base is braked, so the robot stays at rest until commanded.
         """
         if not isinstance(description, RobotDescription):
             description = RobotDescription.load(description)
@@ -128,7 +138,7 @@ class Robot:
                 str(path),
                 basePosition=(x, y, z),
                 baseOrientation=quat_from_yaw(yaw),
-                useFixedBase=description.base.type == "fixed",
+                useFixedBase=description.base.type in ("fixed", "holonomic"),
                 flags=flags,
                 physicsClientId=client,
             )
@@ -142,7 +152,7 @@ class Robot:
         robot._couple_fingers()
         robot.hold_arm()
         robot.set_gripper(robot.gripper_opening())
-        if robot.has_wheels:
+        if robot.has_wheels or robot.is_holonomic:
             robot.stop_base()
         return robot
 
@@ -208,6 +218,11 @@ class Robot:
     def has_wheels(self) -> bool:
         return bool(self.wheel_ids_left)
 
+    @property
+    def is_holonomic(self) -> bool:
+        """True for a base driven by virtual planar joints (x, y, yaw)."""
+        return bool(self.base_joint_ids)
+
     def joint_index(self, name: str) -> int:
         """PyBullet joint index of the joint called ``name`` (KeyError names the choices)."""
         return self._index(self._joints, name, "joint")
@@ -267,12 +282,25 @@ class Robot:
         return compose_poses((com_pos, com_quat), invert_pose(self._root_inertial))
 
     def base_pose2d(self) -> tuple[float, float, float]:
-        """Planar pose (x, y, yaw) of the root link frame in the world."""
-        pos, quat = self._root_pose()
+        """Planar pose (x, y, yaw) of the root link frame in the world (of the base link, the
+        child of the yaw joint, for a holonomic base)."""
+        pos: Sequence[float]
+        quat: Sequence[float]
+        if self.is_holonomic:
+            state = pbq.link_state(self.client, self.body, self.base_joint_ids[2])
+            pos, quat = state.frame_position, state.frame_orientation
+        else:
+            pos, quat = self._root_pose()
         return float(pos[0]), float(pos[1]), yaw_of(quat)
 
     def base_velocity(self) -> tuple[float, float, float]:
         """Forward and sideways speed (m/s, in the base heading frame) and yaw rate (rad/s)."""
+        if self.is_holonomic:
+            states = pbq.joint_states(self.client, self.body, self.base_joint_ids)
+            xd, yd, wd = (s.velocity for s in states)
+            theta = states[2].position  # heading relative to the root, whose axes x, y follow
+            c, s = math.cos(theta), math.sin(theta)
+            return c * xd + s * yd, -s * xd + c * yd, float(wd)
         lin, ang = pb.getBaseVelocity(self.body, physicsClientId=self.client)
         _, _, yaw = self.base_pose2d()
         c, s = math.cos(yaw), math.sin(yaw)
@@ -435,8 +463,11 @@ class Robot:
         """Drive the base at forward speed ``v`` (m/s) and yaw rate ``w`` (rad/s), skid-steer.
 
         If a wheel would exceed the max wheel speed, both sides are scaled down together so the
-        path curvature is kept.
+        path curvature is kept. A holonomic base drives with no sideways speed.
         """
+        if self.is_holonomic:
+            self.set_base_velocity(v, 0.0, w)
+            return
         base = self.description.base
         left = (v - w * base.track_width / 2.0) / base.wheel_radius
         right = (v + w * base.track_width / 2.0) / base.wheel_radius
@@ -445,11 +476,59 @@ class Robot:
             left, right = (left * base.max_wheel_speed / peak, right * base.max_wheel_speed / peak)
         self.set_wheel_velocities(left, right)
 
+    def set_base_velocity(self, vx: float, vy: float, w: float) -> None:
+        """Drive a holonomic base at ``vx`` forward, ``vy`` to the left (m/s, base frame) and
+        yaw rate ``w`` (rad/s).
+
+        The planar speed is scaled down to ``base.max_speed`` keeping its direction and the yaw
+        rate clipped to ``base.max_yaw_rate``. Each virtual joint gets a velocity motor of at
+        most ``base.max_force`` (``max_torque`` for yaw), so contacts can stop the base. Raises
+        ``RuntimeError`` on a base that is not holonomic.
+        """
+        if not self.is_holonomic:
+            raise RuntimeError(f"{self.name} has no holonomic base")
+        base = self.description.base
+        speed = math.hypot(vx, vy)
+        if speed > base.max_speed:
+            vx, vy = vx * base.max_speed / speed, vy * base.max_speed / speed
+        w = float(np.clip(w, -base.max_yaw_rate, base.max_yaw_rate))
+        theta = pbq.joint_states(self.client, self.body, self.base_joint_ids[2:])[0].position
+        c, s = math.cos(theta), math.sin(theta)
+        targets = (c * vx - s * vy, s * vx + c * vy, w)
+        forces = (base.max_force, base.max_force, base.max_torque)
+        for j, target, force in zip(self.base_joint_ids, targets, forces, strict=True):
+            pb.setJointMotorControl2(
+                self.body,
+                j,
+                pb.VELOCITY_CONTROL,
+                targetVelocity=float(target),
+                force=force,
+                physicsClientId=self.client,
+            )
+
     def stop_base(self) -> None:
-        """Brake: hold every wheel at its current angle with full torque (no creep).
+        """Brake: hold every wheel at its current angle with full torque (no creep); a
+        holonomic base holds its virtual joints where they are with their motors' force.
 
         Does nothing on a fixed base.
         """
+        if self.is_holonomic:
+            base = self.description.base
+            forces = (base.max_force, base.max_force, base.max_torque)
+            ids = self.base_joint_ids
+            for j, q, force in zip(ids, self._positions(ids), forces, strict=True):
+                pb.setJointMotorControl2(
+                    self.body,
+                    j,
+                    pb.POSITION_CONTROL,
+                    targetPosition=float(q),
+                    targetVelocity=0.0,
+                    force=force,
+                    positionGain=0.5,
+                    velocityGain=1.0,
+                    physicsClientId=self.client,
+                )
+            return
         if not self.has_wheels:
             return
         base = self.description.base

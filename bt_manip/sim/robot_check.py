@@ -5,8 +5,10 @@ mobile bases, none for fixed arms), puts the arm in its ``home`` state, then mov
 joint in turn to its lower limit, its upper limit (each less a margin) and back, in sim time
 with the robot's own position controllers. A move passes when the joint settles within the
 tolerance of its target before a time-out computed from the joint's speed limit. The gripper,
-when there is one, must open to its full opening and close again. The result is a table
-(:meth:`CheckReport.table`) and ``ok``.
+when there is one, must open to its full opening and close again. A holonomic base then drives
+a 0.3 m square (x, then y, then back) and turns a quarter turn and back, through
+:meth:`~bt_manip.sim.robot.Robot.set_base_velocity`; each move is one row of its virtual
+joint. The result is a table (:meth:`CheckReport.table`) and ``ok``.
 """
 
 from __future__ import annotations
@@ -31,6 +33,10 @@ GRIPPER_TOLERANCE = 0.004
 WIDE = 2.0 * math.pi
 """Half range tried for joints without limits."""
 SETTLE_S = 1.0
+BASE_SQUARE = 0.3
+"""m: side of the square a holonomic base drives."""
+BASE_GAIN = 2.0
+"""1/s: the check's proportional drive of a holonomic base toward each corner."""
 
 
 @dataclass(frozen=True)
@@ -132,7 +138,59 @@ def _run(client: int, robot: Robot) -> CheckReport:
             report.moves.append(
                 MoveResult("gripper", phase, opening, robot.gripper_opening(), took)
             )
+    if robot.is_holonomic:
+        _check_holonomic(client, robot, report)
     return report
+
+
+def _check_holonomic(client: int, robot: Robot, report: CheckReport) -> None:
+    """Drive the virtual joints around a square and through a quarter turn, one row each."""
+    names = robot.description.base.joints
+    base = robot.description.base
+    moves = (
+        (0, "+", BASE_SQUARE), (1, "+", BASE_SQUARE), (0, "back", 0.0), (1, "back", 0.0),
+        (2, "turn", math.pi / 2.0), (2, "back", 0.0),
+    )
+    goal = [0.0, 0.0, 0.0]
+    for axis, phase, value in moves:
+        goal[axis] = value
+        speed = base.max_yaw_rate if axis == 2 else base.max_speed
+        timeout = BASE_SQUARE / max(speed, 1e-3) * 3.0 + 3.0
+        took = _drive_base(client, robot, list(goal), timeout)
+        reached = float(robot._positions(robot.base_joint_ids)[axis])
+        report.moves.append(MoveResult(names[axis], phase, value, reached, took))
+    robot.stop_base()
+
+
+def _drive_base(client: int, robot: Robot, goal: list[float], timeout: float) -> float:
+    """Drive the virtual joints to ``goal`` (x, y, yaw) with a proportional base velocity;
+    sim seconds taken (``timeout`` at most). The base is braked at the end."""
+    steps = 0
+    calm = 0
+    limit = round(timeout * RATE_HZ)
+    while steps < limit:
+        q = robot._positions(robot.base_joint_ids)
+        ex, ey, ew = goal[0] - q[0], goal[1] - q[1], goal[2] - q[2]
+        ex, ey, ew = (_creep(e) for e in (ex, ey, ew))
+        c, s = math.cos(q[2]), math.sin(q[2])
+        robot.set_base_velocity(c * ex + s * ey, -s * ex + c * ey, ew)
+        pb.stepSimulation(physicsClientId=client)
+        steps += 1
+        if max(abs(ex), abs(ey), abs(ew)) <= TOLERANCE / 4.0:
+            calm += 1
+            if calm >= RATE_HZ // 10:
+                break
+        else:
+            calm = 0
+    robot.stop_base()
+    return steps / RATE_HZ
+
+
+def _creep(error: float) -> float:
+    """Proportional speed toward a target, at least 0.05 (m/s or rad/s) until very close."""
+    if abs(error) <= TOLERANCE / 8.0:
+        return 0.0
+    return math.copysign(max(BASE_GAIN * abs(error), 0.05), error)
 
 
 def _step(client: int, n: int) -> None:

@@ -38,7 +38,8 @@ def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     )
     init.add_argument(
         "--mobile", choices=MOBILE_KINDS, default=None,
-        help="a wheeled base (wheels found from its continuous joints); default: fixed base",
+        help="a mobile base: skid or diff (wheels found from its continuous joints), or "
+        "holonomic (virtual x, y, yaw joints above --base-link); default: fixed base",
     )
     init.add_argument("--name", default="", help="robot name (default: the --out file name)")
     init.add_argument("--out", required=True, help="descriptor to write, e.g. robots/NAME.yaml")
@@ -78,10 +79,19 @@ def cmd_robot_init(args: argparse.Namespace) -> int:
     return 0
 
 
+def _written_here(name_or_path: str) -> str:
+    """``robots/NAME.yaml`` of the current folder when a bare NAME has a descriptor there (the
+    one ``robot init --out robots/NAME.yaml`` just wrote), else ``name_or_path`` as given (a
+    path, or a shipped robot's name)."""
+    local = Path("robots") / f"{name_or_path}.yaml"
+    bare = Path(name_or_path).name == name_or_path and Path(name_or_path).suffix == ""
+    return str(local) if bare and local.is_file() else name_or_path
+
+
 def cmd_robot_check(args: argparse.Namespace) -> int:
     from bt_manip.sim.robot_check import check_robot
     from bt_manip.sim.robot_description import RobotDescription
 
-    report = check_robot(RobotDescription.load(args.robot))
+    report = check_robot(RobotDescription.load(_written_here(args.robot)))
     print(report.table())
     return 0 if report.ok else 1

@@ -1,10 +1,10 @@
 """Robot descriptors (``robots/<name>.yaml``): where they are found and what they say.
 
 :class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
-which URDF (or composition recipe), the base (``skid_steer`` or ``fixed``), the arm joints in
-order, the gripper, the end-effector and grasp frames, named arm states and the footprint.
-Every name in it is checked against the robot's URDF. This module is pure data: nothing here
-touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
+which URDF (or composition recipe), the base (``skid_steer``, ``holonomic`` or ``fixed``), the
+arm joints in order, the gripper, the end-effector and grasp frames, named arm states and the
+footprint. Every name in it is checked against the robot's URDF. This module is pure data:
+nothing here touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 import defusedxml.ElementTree as SafeET
 
 from bt_manip.errors import InputError
-from bt_manip.sim.assets import REPO_ROOT
+from bt_manip.sim.assets import data_root
 from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
 
@@ -35,8 +35,9 @@ __all__ = [
 ]
 
 # -- descriptors --------------------------------------------------------------------------------
-ROBOTS_DIR = REPO_ROOT / "robots"
-BASE_TYPES = ("skid_steer", "fixed")
+ROBOTS_DIR = data_root() / "robots"
+"""The shipped robot descriptors (the clone's ``robots/`` or the installed package data)."""
+BASE_TYPES = ("skid_steer", "holonomic", "fixed")
 TOP_KEYS = {
     "name",
     "urdf",
@@ -63,6 +64,16 @@ BASE_KEYS = {
     "wheel_axle_friction_scale",
     "pivot_offset",
 }
+HOLONOMIC_KEYS = {
+    "type",
+    "joints",
+    "max_speed",
+    "max_yaw_rate",
+    "max_accel",
+    "max_yaw_accel",
+    "max_force",
+    "max_torque",
+}
 ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
 GRIPPER_KEYS = {
     "joints",
@@ -78,7 +89,9 @@ FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
 
 @dataclass(frozen=True)
 class BaseSpec:
-    """The mobile base: ``skid_steer`` (wheels left/right) or ``fixed`` (welded to the world)."""
+    """The mobile base: ``skid_steer`` (wheels left/right), ``holonomic`` (virtual planar
+    joints x, y, yaw between a root fixed to the world and the base link) or ``fixed`` (welded
+    to the world)."""
 
     type: str = "fixed"
     left_wheels: tuple[str, ...] = ()
@@ -95,6 +108,20 @@ class BaseSpec:
     """Friction along the wheel axle relative to ``wheel_friction`` (< 1 lets a skid-steer turn)."""
     pivot_offset: float = 0.0
     """Where the base turns about when it turns on the spot (m ahead of its frame, measured)."""
+    joints: tuple[str, ...] = ()
+    """``holonomic``: the virtual planar joints (prismatic x, prismatic y, yaw), root first."""
+    max_speed: float = 0.0
+    """``holonomic``: largest planar speed (m/s)."""
+    max_yaw_rate: float = 0.0
+    """``holonomic``: largest yaw rate (rad/s)."""
+    max_accel: float = 0.0
+    """``holonomic``: planar acceleration limit of the path follower (m/s^2)."""
+    max_yaw_accel: float = 0.0
+    """``holonomic``: yaw acceleration limit of the path follower (rad/s^2)."""
+    max_force: float = 0.0
+    """``holonomic``: force (N) of each planar joint's motor: what the base pushes with."""
+    max_torque: float = 0.0
+    """``holonomic``: torque (N m) of the yaw joint's motor."""
 
 
 @dataclass(frozen=True)
@@ -292,7 +319,9 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     name = f.text(data, "name", "descriptor", default=path.stem)
     urdf = _parse_urdf_source(f, data, path)
 
-    b = f.section(data, "base", BASE_KEYS)
+    raw_base = data.get("base")
+    holonomic = isinstance(raw_base, dict) and raw_base.get("type") == "holonomic"
+    b = f.section(data, "base", HOLONOMIC_KEYS if holonomic else BASE_KEYS)
     base_type = b.get("type", "fixed")
     if base_type not in BASE_TYPES:
         f.fail(
@@ -314,6 +343,8 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             f.real(b, "wheel_axle_friction_scale", "base", 1.0, positive=True),
             f.real(b, "pivot_offset", "base", 0.0),
         )
+    elif base_type == "holonomic":
+        base = _holonomic_base(f, b)
     else:
         base = BaseSpec("fixed")
 
@@ -390,6 +421,39 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     return _check_against_urdf(desc, data, f)
 
 
+HOLONOMIC_BOUNDS = {
+    "max_speed": 5.0,
+    "max_yaw_rate": 10.0,
+    "max_accel": 20.0,
+    "max_yaw_accel": 50.0,
+    "max_force": 1e5,
+    "max_torque": 1e5,
+}
+"""Upper bound of each number of a holonomic base (m/s, rad/s, m/s^2, rad/s^2, N, N m)."""
+
+
+def _holonomic_base(f: _Fields, b: LineDict) -> BaseSpec:
+    """The ``base`` section of a holonomic base (keys in ``robots/README.md``)."""
+    joints = f.names(b, "joints", "base")
+    if joints and len(joints) != 3:
+        f.fail(b.line_of("joints"), "base.joints of a holonomic base: three joints, x, y and yaw")
+    values: dict[str, float] = {}
+    for key, top in HOLONOMIC_BOUNDS.items():
+        default = 2.0 if key == "max_yaw_accel" else None
+        value = f.number(b, key, "base", default, within=(1e-6, top))
+        values[key] = 0.0 if value is None else value
+    return BaseSpec(
+        "holonomic",
+        joints=joints,
+        max_speed=values["max_speed"],
+        max_yaw_rate=values["max_yaw_rate"],
+        max_accel=values["max_accel"],
+        max_yaw_accel=values["max_yaw_accel"],
+        max_force=values["max_force"],
+        max_torque=values["max_torque"],
+    )
+
+
 def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:
     value = data.get("urdf")
     if isinstance(value, str):
@@ -424,6 +488,7 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
                 )
 
     need(desc.base.left_wheels + desc.base.right_wheels, joints, "base", "left_wheels")
+    need(desc.base.joints, joints, "base", "joints")
     need(desc.arm.joints, joints, "arm", "joints")
     need((desc.arm.base_link,), links, "arm", "base_link")
     need(desc.gripper.joints, joints, "gripper", "joints")

@@ -15,7 +15,11 @@ format of ``robots/README.md``:
   arm joint moves, for a mobile base the rectangle around the base links;
 - for ``skid``/``diff`` bases the wheels (continuous joints off the arm, left / right by the
   side of the root frame they sit on), their radius, track width and the spawn height that puts
-  the wheels on the floor.
+  the wheels on the floor;
+- for a ``holonomic`` base the three virtual joints above the base link (prismatic x, prismatic
+  y, then a continuous or revolute yaw joint, see :func:`holonomic_joints`), the speed limits
+  from their URDF velocities, the motor force and torque from their URDF efforts (else from the
+  robot's weight), and a spawn height that keeps the base just clear of the floor.
 
 The file refers to the URDF by a URI (``package://example-robot-data/...``,
 ``pybullet_data://...``) or by a path relative to the descriptor, never an absolute path. The
@@ -42,7 +46,7 @@ from bt_manip.sim.assets import example_robot_data_share, pybullet_data_dir
 from bt_manip.sim.compose import MAX_URDF_BYTES, composed_urdf
 from bt_manip.sim.robot_description import RobotDescription, load_description
 
-__all__ = ["MOBILE_KINDS", "InitOptions", "init_descriptor", "urdf_uri"]
+__all__ = ["MOBILE_KINDS", "InitOptions", "holonomic_joints", "init_descriptor", "urdf_uri"]
 
 MOBILE_KINDS = ("skid", "diff", "holonomic")
 MOVABLE = ("revolute", "continuous", "prismatic")
@@ -51,6 +55,25 @@ DEFAULT_VELOCITY = 1.0
 DEFAULT_WHEEL_SPEED = 6.0
 DEFAULT_WHEEL_TORQUE = 50.0
 MAX_NAME = 64
+HOLONOMIC_SPEED = 0.5
+"""m/s of a holonomic base whose x / y joints give no velocity limit."""
+HOLONOMIC_YAW_RATE = 1.0
+"""rad/s of a holonomic base whose yaw joint gives no velocity limit."""
+HOLONOMIC_ACCEL = 0.5
+"""m/s^2: the acceleration limit written for a holonomic base's path follower."""
+PUSH_FRICTION = 0.5
+"""Without URDF efforts, a holonomic base pushes with this fraction of its weight (what
+wheels with this friction coefficient could push with)."""
+FLOOR_GAP = 0.03
+"""m between the floor and the lowest collision shape of a holonomic base at spawn. The
+virtual joints carry the base; closer than PyBullet's contact threshold (a few cm), the floor
+would count as touching it and its friction would tug at the base and the arm on it."""
+HOLONOMIC_AXES = (
+    ("x", ("prismatic",), (1.0, 0.0, 0.0)),
+    ("y", ("prismatic",), (0.0, 1.0, 0.0)),
+    ("yaw", ("continuous", "revolute"), (0.0, 0.0, 1.0)),
+)
+"""What the three virtual joints of a holonomic base must be, root first."""
 
 
 @dataclass(frozen=True)
@@ -78,6 +101,8 @@ class _Joint:
     upper: float
     velocity: float | None
     effort: float | None
+    axis: tuple[float, ...] = (1.0, 0.0, 0.0)
+    rpy: tuple[float, ...] = (0.0, 0.0, 0.0)
 
 
 class _Urdf:
@@ -122,6 +147,8 @@ class _Urdf:
                 (num("upper", 0.0) or 0.0) if bounded else math.inf,
                 num("velocity", None),
                 num("effort", None),
+                _triple(el, "axis", "xyz", (1.0, 0.0, 0.0)),
+                _triple(el, "origin", "rpy", (0.0, 0.0, 0.0)),
             )
         self.parent_joint = {j.child: j for j in self.joints.values()}
 
@@ -178,6 +205,21 @@ def _limit_value(
             str(path), line, f"joint '{name}': limit {key}={raw!r} is not a finite number"
         )
     return value
+
+
+def _triple(
+    joint: ET.Element, tag: str, key: str, default: tuple[float, ...]
+) -> tuple[float, ...]:
+    """Attribute ``key`` of the joint's ``<tag>`` as three numbers (``default`` if absent or
+    not three finite numbers: the loader reports such a file)."""
+    found = joint.find(tag)
+    try:
+        values = tuple(float(v) for v in found.get(key, "").split()) if found is not None else ()
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        return default
+    return values
 
 
 def _line(text: str, tag: str, name: str) -> int | None:
@@ -255,15 +297,54 @@ def _check_names(urdf: _Urdf, opts: InitOptions) -> list[Problem]:
         problems.append(
             urdf.problem(None, f"--mobile must be one of {', '.join(MOBILE_KINDS)}")
         )
-    if opts.mobile == "holonomic":
-        problems.append(
-            urdf.problem(
-                None,
-                "--mobile holonomic: bt-manip has no holonomic base controller yet "
-                "(base types: skid_steer, fixed); use skid or diff, or leave --mobile out",
-            )
-        )
     return problems
+
+
+def holonomic_joints(urdf: _Urdf, base_link: str) -> list[_Joint]:
+    """The virtual joints of a holonomic base above ``base_link``, root first: prismatic x,
+    prismatic y, then a continuous or revolute yaw joint (fixed joints may sit between them).
+
+    Their axes must be the x, y and z axes of their joint frames and their origins unrotated,
+    so that x and y move along the root frame's axes. Raises
+    :class:`~bt_manip.errors.InputError` with the line of the joint (or of the base link) that
+    does not fit.
+    """
+    above: list[_Joint] = []
+    link = base_link
+    for _ in range(len(urdf.joints) + 1):
+        joint = urdf.parent_joint.get(link)
+        if joint is None:
+            break
+        if joint.type != "fixed":
+            above.append(joint)
+        link = joint.parent
+    above.reverse()
+    want = "a prismatic x joint, a prismatic y joint and a continuous (or revolute) yaw joint"
+    if len(above) != 3:
+        names = ", ".join(f"'{j.name}' ({j.type})" for j in above) or "none"
+        raise InputError.single(
+            str(urdf.path), urdf.links.get(base_link),
+            f"--mobile holonomic: {len(above)} movable joint(s) above --base-link "
+            f"'{base_link}' ({names}); a holonomic base hangs from the root link by {want}, "
+            "in that order",
+        )
+    for joint, (label, types, axis) in zip(above, HOLONOMIC_AXES, strict=True):
+        kind = " or ".join(types)
+        if joint.type not in types or not np.allclose(joint.axis, axis):
+            raise InputError.single(
+                str(urdf.path), joint.line,
+                f"--mobile holonomic: joint '{joint.name}' must be the {label} joint, {kind} "
+                f"with axis {' '.join(f'{a:g}' for a in axis)}; it is {joint.type or 'untyped'} "
+                f"with axis {' '.join(f'{a:g}' for a in joint.axis)} ({want}, root first)",
+            )
+        if not np.allclose(joint.rpy, 0.0):
+            raise InputError.single(
+                str(urdf.path), joint.line,
+                f"--mobile holonomic: joint '{joint.name}' has a rotated origin (rpy "
+                f"{' '.join(f'{a:g}' for a in joint.rpy)}); the virtual joints move along the "
+                "root frame's axes, so their origins must not rotate",
+            )
+    return above
 
 
 def init_descriptor(opts: InitOptions) -> RobotDescription:
@@ -286,6 +367,7 @@ def init_descriptor(opts: InitOptions) -> RobotDescription:
     problems = _check_names(urdf, opts)
     if problems:
         raise InputError(problems)
+    virtual = holonomic_joints(urdf, opts.base_link) if opts.mobile == "holonomic" else []
     chain = urdf.chain(opts.base_link, opts.arm_tip)
     if chain is None:
         raise InputError.single(
@@ -309,12 +391,17 @@ def init_descriptor(opts: InitOptions) -> RobotDescription:
         )
     # the composed file checks every mesh (missing files reported with their line)
     composed = composed_urdf(opts.urdf)
-    text = _descriptor_text(urdf, opts, name, arm, composed)
+    text = _descriptor_text(urdf, opts, name, arm, composed, virtual)
     return _write_checked(opts.out, text)
 
 
 def _descriptor_text(
-    urdf: _Urdf, opts: InitOptions, name: str, arm: list[_Joint], composed: Path
+    urdf: _Urdf,
+    opts: InitOptions,
+    name: str,
+    arm: list[_Joint],
+    composed: Path,
+    virtual: list[_Joint],
 ) -> str:
     lower = [j.lower for j in arm]
     upper = [j.upper for j in arm]
@@ -325,7 +412,7 @@ def _descriptor_text(
     ]
     velocities = [j.velocity if j.velocity and j.velocity > 0 else DEFAULT_VELOCITY for j in arm]
     efforts = [j.effort if j.effort and j.effort > 0 else None for j in arm]
-    geometry = _Geometry(composed, urdf, opts, arm)
+    geometry = _Geometry(composed, urdf, opts, arm, virtual)
     uri = urdf_uri(opts.urdf, opts.out.parent)
     lines = [
         f"# {name}: written by `bt-manip robot init` from {Path(uri).name}.",
@@ -336,6 +423,8 @@ def _descriptor_text(
     ]
     if opts.mobile in ("skid", "diff"):
         lines += geometry.mobile_base_lines()
+    elif virtual:
+        lines += geometry.holonomic_base_lines(virtual)
     else:
         lines += ["base:", "  type: fixed"]
     lines += [
@@ -378,7 +467,14 @@ def _descriptor_text(
 class _Geometry:
     """Collision-shape extents of the robot at its zero pose (PyBullet, headless)."""
 
-    def __init__(self, composed: Path, urdf: _Urdf, opts: InitOptions, arm: list[_Joint]) -> None:
+    def __init__(
+        self,
+        composed: Path,
+        urdf: _Urdf,
+        opts: InitOptions,
+        arm: list[_Joint],
+        virtual: list[_Joint],
+    ) -> None:
         import pybullet as pb
 
         from bt_manip.sim import pybullet_queries as pbq
@@ -401,6 +497,17 @@ class _Geometry:
                 names[info.index] = info.link_name
             self.base_boxes: list[tuple[np.ndarray, np.ndarray]] = []
             self.all_min = np.full(3, np.inf)
+            self.mass = sum(
+                float(pb.getDynamicsInfo(body, i, physicsClientId=client)[0]) for i in names
+            )
+            self.origin = np.zeros(3)
+            """Where the footprint is measured from: the root frame, or a holonomic base's
+            base link (the yaw joint's child) with its joints at 0."""
+            if virtual:
+                yaw_index = next(i.index for i in infos if i.name == virtual[2].name)
+                self.origin = np.asarray(
+                    pb.getLinkState(body, yaw_index, physicsClientId=client)[4], dtype=float
+                )
             for index, link in names.items():
                 lo, hi = pb.getAABB(body, index, physicsClientId=client)
                 lo_a, hi_a = np.asarray(lo), np.asarray(hi)
@@ -455,11 +562,52 @@ class _Geometry:
             f"  wheel_max_torque: {_fmt(self.wheel_torque)}",
         ]
 
+    def holonomic_base_lines(self, virtual: list[_Joint]) -> list[str]:
+        x, y, yaw = virtual
+        speeds = [j.velocity for j in (x, y) if j.velocity and j.velocity > 0]
+        speed = min(min(speeds, default=HOLONOMIC_SPEED), 5.0)
+        yaw_rate = min(yaw.velocity if yaw.velocity and yaw.velocity > 0 else HOLONOMIC_YAW_RATE,
+                       10.0)
+        efforts = [j.effort for j in (x, y) if j.effort and j.effort > 0]
+        weight_push = PUSH_FRICTION * 9.81 * max(self.mass, 1.0)
+        force = min(min(efforts, default=weight_push), 1e5)
+        lo, hi = self._base_extent()
+        reach = max(0.1, float(np.hypot(np.maximum(abs(lo), abs(hi))[0],
+                                        np.maximum(abs(lo), abs(hi))[1])))
+        torque = min(yaw.effort if yaw.effort and yaw.effort > 0 else force * reach, 1e5)
+        height = max(0.0, -float(self.all_min[2])) + FLOOR_GAP
+        return [
+            f"spawn_height: {_fmt(height)}   # the base {FLOOR_GAP * 100:g} cm clear of the floor",
+            "base:                     # virtual joints x, y, yaw; the root is fixed at spawn",
+            "  type: holonomic",
+            f"  joints: [{x.name}, {y.name}, {yaw.name}]",
+            f"  max_speed: {_fmt(speed)}        # m/s",
+            f"  max_yaw_rate: {_fmt(yaw_rate)}     # rad/s",
+            f"  max_accel: {_fmt(HOLONOMIC_ACCEL)}        # m/s^2, path follower",
+            "  max_yaw_accel: 2.0     # rad/s^2, path follower",
+            f"  max_force: {_fmt(force)}       # N per planar joint motor",
+            f"  max_torque: {_fmt(torque)}      # N m, yaw joint motor",
+        ]
+
+    def _base_extent(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners of the base links' boxes, relative to :attr:`origin`."""
+        if not self.base_boxes:
+            return np.full(3, -0.1), np.full(3, 0.1)
+        lo = np.min([b[0] for b in self.base_boxes], axis=0) - self.origin
+        hi = np.max([b[1] for b in self.base_boxes], axis=0) - self.origin
+        return lo, hi
+
     def footprint_lines(self) -> list[str]:
         if not self.base_boxes:
             return ["footprint:                # no collision shape off the arm", "  radius: 0.1"]
-        lo = np.min([b[0] for b in self.base_boxes], axis=0)
-        hi = np.max([b[1] for b in self.base_boxes], axis=0)
+        lo, hi = self._base_extent()
+        if self.opts.mobile == "holonomic":
+            return [
+                "footprint:                # around the base links' collision shapes",
+                f"  length: {_fmt(max(hi[0] - lo[0], 0.01))}",
+                f"  width: {_fmt(max(2.0 * max(abs(hi[1]), abs(lo[1])), 0.01))}",
+                f"  x_offset: {_fmt((hi[0] + lo[0]) / 2.0)}",
+            ]
         if self.opts.mobile in ("skid", "diff"):
             return [
                 "footprint:                # around the base links' collision shapes",

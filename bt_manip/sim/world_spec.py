@@ -2,6 +2,8 @@
 
 A world file describes, in metres, radians and kilograms (see ``worlds/README.md``):
 
+``schema_version`` the format version the file is written for (optional, 1; a newer one is
+               refused before anything else is read);
 ``walls``      static wall segments (``from``/``to``, ``thickness``, ``height``) with ``doors`` cut
                into them (``at`` = distance of the door centre from ``from``, ``width``);
 ``furniture``  static bodies: a primitive ``shape``, a list of ``parts``, or a ``urdf`` file;
@@ -187,7 +189,11 @@ class WorldSpec:
     """:class:`~bt_manip.sim.groups.GroupSpec` entries: members moved together."""
 
 
+WORLD_SCHEMA_VERSION = 1
+"""The world format this bt-manip reads (``schema_version`` of a world file; absent means 1)."""
+
 TOP_KEYS = {
+    "schema_version",
     "name",
     "description",
     "physics",
@@ -580,6 +586,7 @@ def parse_world(path: str | Path) -> WorldSpec:
             1,
             "a world file must be a YAML mapping (name, walls, furniture, objects, robots, poses)",
         )
+    _check_schema_version(path, data)
     rd.unknown_keys(data, TOP_KEYS, "the world")
     base = path.resolve().parent
     physics = PhysicsSpec()
@@ -625,6 +632,27 @@ def parse_world(path: str | Path) -> WorldSpec:
     if rd.problems:
         raise InputError(rd.problems)
     return spec
+
+
+def _check_schema_version(path: Path, data: LineDict) -> None:
+    """Refuse a world written for another format version, before any other check (a newer
+    format's keys would otherwise be reported one by one as unknown)."""
+    if "schema_version" not in data:
+        return
+    version = data["schema_version"]
+    line = data.line_of("schema_version")
+    if isinstance(version, bool) or not isinstance(version, int) or version < 1:
+        raise InputError.single(
+            str(path), line,
+            f"schema_version must be a whole number >= 1, got {version!r} (this bt-manip reads "
+            f"version {WORLD_SCHEMA_VERSION})",
+        )
+    if version > WORLD_SCHEMA_VERSION:
+        raise InputError.single(
+            str(path), line,
+            f"schema_version {version} is newer than the world format this bt-manip reads "
+            f"(version {WORLD_SCHEMA_VERSION}); upgrade bt-manip to load this world",
+        )
 
 
 def _check_unique_names(rd: _Reader, spec: WorldSpec) -> None:

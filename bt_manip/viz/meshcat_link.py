@@ -130,6 +130,10 @@ class MeshcatLink:
         sock.setsockopt(zmq.LINGER, 0)
         sock.setsockopt(zmq.RCVTIMEO, int(timeout * 1000))
         sock.setsockopt(zmq.SNDTIMEO, int(timeout * 1000))
+        # a server that went away took the scene with it: never reconnect (to whatever listens
+        # on its port next, e.g. another run's server), so the next request fails and the run
+        # goes on without the live view
+        sock.setsockopt(zmq.RECONNECT_IVL, -1)
         try:
             sock.connect(self.zmq_url)
         except zmq.ZMQError as exc:

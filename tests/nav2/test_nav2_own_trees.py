@@ -109,6 +109,9 @@ def test_the_goal_update_tree_does_not_set_off_on_a_low_battery() -> None:
         assert report.status == "FAILURE"
         assert report.sim_time < 1.0
         assert "BatteryNotLow" in str(report.reason)
+        # the cause names the reading the Inverter failed on, not just the Inverter
+        assert "because IsBatteryLow" in str(report.reason)
+        assert "battery at 0.050 <= " in str(report.reason)
         assert distance_to(world, start[0], start[1]) < 0.05
 
 

@@ -125,9 +125,9 @@ def test_cli_init_writes_and_errors_exit_2(tmp_path: Path, capsys: pytest.Captur
     assert not bad.exists()
 
 
-def test_holonomic_base_is_refused(tmp_path: Path) -> None:
+def test_holonomic_without_virtual_joints_is_refused(tmp_path: Path) -> None:
     (problem,) = _problems(_panda(tmp_path, mobile="holonomic"))
-    assert "no holonomic base controller" in problem
+    assert "0 movable joint(s) above --base-link 'panda_link0'" in problem
 
 
 def test_check_moves_every_joint_to_its_limits(tmp_path: Path) -> None:
@@ -223,3 +223,17 @@ def test_descriptor_next_to_its_own_urdf_names_it_relatively(tmp_path: Path) -> 
     # mid-range where there are limits, 0 for the continuous joint; the default speed for it
     assert desc.states["ready"] == (0.5, 0.0) and desc.states["zero"] == (0.0, 0.0)
     assert desc.arm.velocity_limits == (1.0, 1.0)
+
+
+def test_check_by_name_takes_the_descriptor_just_written_here(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    assert main(["robot", "init", str(PANDA), "--base-link", "panda_link0",
+                 "--arm-tip", "panda_hand", "--gripper", "panda_finger_joint1,panda_finger_joint2",
+                 "--grasp-frame", "panda_hand_tcp", "--out", "robots/mine.yaml"]) == 0
+    assert main(["robot", "check", "mine"]) == 0
+    assert "panda_joint7" in capsys.readouterr().out
+    monkeypatch.chdir(tmp_path / "robots")  # no robots/mine.yaml here, nor a shipped 'mine'
+    assert main(["robot", "check", "mine"]) == 2
+    assert "no robot descriptor 'mine'" in capsys.readouterr().err

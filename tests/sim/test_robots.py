@@ -355,7 +355,7 @@ def test_bad_descriptor_names_file_line_and_key(tmp_path: Path, edit: tuple[str,
 
 
 def test_unknown_robot_lists_the_known_ones() -> None:
-    with pytest.raises(InputError, match="known robots: husky_ur3, panda, sawyer"):
+    with pytest.raises(InputError, match="known robots: husky_ur3, omni_sawyer, panda, sawyer"):
         RobotDescription.load("r2d2")
 
 
