@@ -79,6 +79,17 @@ def test_two_panels_installed_in_order_within_tolerance(two_panels):
     assert all(r.startswith("placed 'panel_w") for r in placed)
 
 
+def test_the_report_with_its_as_built_table_follows_the_schema(two_panels):
+    jsonschema = pytest.importorskip("jsonschema")
+    root = Path(__file__).resolve().parents[2]
+    schema = json.loads((root / "docs" / "schemas" / "run-report.schema.json").read_text())
+    report = two_panels[2]
+    jsonschema.Draft202012Validator(schema).validate(report)
+    broken = {**report, "as_built": [{**report["as_built"][0], "status": "done"}]}
+    with pytest.raises(jsonschema.ValidationError):
+        jsonschema.Draft202012Validator(schema).validate(broken)
+
+
 def test_bim_report_draws_the_floor_plan(two_panels, tmp_path, capsys):
     *_, report_path = two_panels
     png = tmp_path / "as_built.png"
