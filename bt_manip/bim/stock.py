@@ -29,7 +29,7 @@ SHIFT = 0.08
 """Largest shift (m in x and y) of the whole stock (stands and elements together), per seed."""
 TURN = 0.05
 """Largest turn (rad) of the whole stock, per seed."""
-MARGIN = 0.2
+MARGIN = 0.35
 """Free floor (m) kept around the stands and the apron when the stock is placed."""
 
 
