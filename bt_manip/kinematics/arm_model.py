@@ -49,6 +49,11 @@ class ChainJoint:
 
 
 _WIDE = 1e10  # pinocchio's "no limit" is +-1.8e308; anything beyond this counts as unlimited
+_REACH_MEMO: dict[bytes, float] = {}
+"""Reaches already maximised in this process, by :meth:`ArmModel._chain_key`: every episode
+builds its arm models afresh, and the maximisation (16 quasi-Newton runs) costs more than
+the rest of the model; the value depends on the chain's numbers only."""
+_REACH_MEMO_SIZE = 64
 
 
 class ArmModel:
@@ -236,8 +241,24 @@ class ArmModel:
         maximum: callers that reject targets with it should leave a small margin.
         """
         if self._reach is None:
-            self._reach = min(self._maximise_reach(), self.reach_bound())
+            key = self._chain_key()
+            reach = _REACH_MEMO.get(key)
+            if reach is None:
+                reach = min(self._maximise_reach(), self.reach_bound())
+                if len(_REACH_MEMO) >= _REACH_MEMO_SIZE:
+                    _REACH_MEMO.pop(next(iter(_REACH_MEMO)))
+                _REACH_MEMO[key] = reach
+            self._reach = reach
         return self._reach
+
+    def _chain_key(self) -> bytes:
+        """Every number the chain's kinematics depend on (placements, axes, kinds, limits and
+        the tip's placement), as bytes: two models with equal keys have equal reaches."""
+        parts = [self.tip_rotation, self.tip_translation]
+        for j in self.chain:
+            parts += [j.rotation, j.translation, j.axis, np.array([j.lower, j.upper])]
+        kinds = "".join(j.kind[0] for j in self.chain).encode()
+        return kinds + b"".join(np.ascontiguousarray(p, dtype=float).tobytes() for p in parts)
 
     def _maximise_reach(self, starts: int = 16) -> float:
         from scipy.optimize import minimize
