@@ -10,7 +10,8 @@ again at every load. :func:`physics_urdf` therefore writes, once, a variant of t
   the composed file, not from PyBullet);
 - every STL collision mesh replaced by an STL holding only its convex hull, whose vertices are
   vertices of the original (the same float32 values), so PyBullet builds the same convex shape
-  from far fewer points.
+  from far fewer points (a ``<collision concave="yes">`` keeps its mesh: PyBullet keeps its
+  triangles).
 
 Links, joints, inertials, contact parameters and the order of everything are untouched, so the
 body PyBullet builds has the same links, indices, masses and collision shapes. A mesh whose hull
@@ -58,6 +59,8 @@ def physics_urdf(urdf: Path) -> Path:
         for visual in link.findall("visual"):
             link.remove(visual)
         for collision in link.findall("collision"):
+            if collision.get("concave", "").lower() in ("yes", "true", "1"):
+                continue  # PyBullet keeps such a mesh's triangles, not its hull
             for mesh in collision.iter("mesh"):
                 source = Path(mesh.get("filename", ""))
                 if source.suffix.lower() == ".stl":
