@@ -92,6 +92,8 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
     wall_time = time.perf_counter() - wall0
+    if report.status == "INTERRUPTED":  # Ctrl-C while the episode ran: the runner halted the
+        raise KeyboardInterrupt         # tree; the bench stops, this episode did not finish
     if spec.btlog and report.status == "SUCCESS":
         Path(spec.btlog).unlink(missing_ok=True)
     failed_node = ""
