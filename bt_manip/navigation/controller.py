@@ -51,6 +51,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bt_manip.navigation.pivot import PivotEstimate
+
 Pose2D = tuple[float, float, float]
 
 
@@ -136,6 +138,7 @@ class PathFollower:
         path_blocked: Callable[[np.ndarray], bool] | None = None,
         replan: Callable[[Pose2D], np.ndarray | str] | None = None,
         reverse: bool = False,
+        pivot_estimate: PivotEstimate | None = None,
     ) -> None:
         self.options = options
         self.reverse = reverse
@@ -144,7 +147,10 @@ class PathFollower:
         self.path_blocked = path_blocked
         self.replan = replan
         self.replans = 0
-        self.pivot = options.pivot
+        self.pivot_estimate = (
+            pivot_estimate if pivot_estimate is not None else PivotEstimate(options.pivot)
+        )
+        """Where the base turns about (starts at ``options.pivot``, learnt while turning)."""
         self._set_path(np.asarray(path, dtype=float))
         self._cmd = (0.0, 0.0)
         self._last_time: float | None = None
@@ -183,6 +189,11 @@ class PathFollower:
             self._phase = "drive"
 
     @property
+    def pivot(self) -> float:
+        """Where the base turns about now (m ahead of its frame; see :mod:`.pivot`)."""
+        return self.pivot_estimate.value
+
+    @property
     def path_end(self) -> tuple[float, float]:
         return float(self.path[-1, 0]), float(self.path[-1, 1])
 
@@ -214,6 +225,7 @@ class PathFollower:
         if self._best_time is None:
             self._best_time = now
         x, y, yaw = pose
+        self.pivot_estimate.observe(pose, now)
 
         failure = self._maybe_replan(pose, now)
         if failure is not None:
@@ -231,7 +243,7 @@ class PathFollower:
         if self._phase == "settle":
             if now - self._settle_start < o.settle_time or self._cmd != (0.0, 0.0):
                 self._cmd = self._limit(0.0, 0.0, dt)
-                return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+                return self._running()
             if d_goal <= o.xy_tolerance and abs(yaw_err) <= o.yaw_tolerance:
                 return self._finish(FollowState.SUCCEEDED, "goal reached")
             self._phase = "align"
@@ -243,7 +255,7 @@ class PathFollower:
             self._phase = "settle"  # stop, let the base come to rest, then check again
             self._settle_start = now
             self._cmd = self._limit(0.0, 0.0, dt)
-            return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+            return self._running()
 
         phase_before = self._phase
         if self._phase in ("drive", "turn") and at_end:
@@ -289,11 +301,17 @@ class PathFollower:
                 f"stuck: no progress for {o.stuck_time:.1f} s, {d_goal:.2f} m from the goal",
             )
         self._cmd = self._limit(v_ref, w_ref, dt)
-        return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+        return self._running()
 
     # -- parts ---------------------------------------------------------------------------------
+    def _running(self) -> FollowStatus:
+        """RUNNING with the command ``self._cmd`` (the pivot estimate is told it)."""
+        self.pivot_estimate.sent(self._cmd)
+        return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+
     def _finish(self, state: FollowState, reason: str) -> FollowStatus:
         self._cmd = (0.0, 0.0)
+        self.pivot_estimate.sent(self._cmd)
         self._done = FollowStatus(state, reason, (0.0, 0.0), self._phase)
         return self._done
 
