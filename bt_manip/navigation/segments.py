@@ -4,10 +4,10 @@ A :class:`~bt_manip.navigation.lattice.PosePlan` is cut into runs of the same ki
 Each run is handed to a :class:`~bt_manip.navigation.controller.PathFollower`: forward and
 backward runs follow the pivot point's path through the run's poses and end on the run's last
 pose (heading included, within the loose tolerances), a turn on the spot turns to the run's
-last heading, and a last run brings the base exactly onto the goal with the
-follower's tolerances. Intermediate runs end within ``waypoint_tolerance`` (and 0.2 rad) without settling. All runs
-share one :class:`~bt_manip.navigation.pivot.PivotEstimate`: the point the base really turns
-about is learnt while it turns, which a carried load moves.
+last heading, and a last run brings the base exactly onto the goal with the follower's
+tolerances. Intermediate runs end within ``waypoint_tolerance`` (and 0.2 rad) without
+settling. All runs share one :class:`~bt_manip.navigation.pivot.PivotEstimate`: the point
+the base really turns about is learnt while it turns (a carried load moves it).
 
 :meth:`SegmentFollower.update` has the same contract as :meth:`PathFollower.update`.
 """
