@@ -34,7 +34,10 @@ A skid-steer base does not turn about its base frame: wheel scrub makes it pivot
 ``pivot`` metres ahead of it (measured 0.11-0.16 m on the Husky with its arm in PyBullet). The
 follower tracks the path with that pivot point, and in ``approach`` and ``align`` steers it to
 where it must be for the base frame to end on the goal, so turning to the goal heading does
-not push the base off the goal.
+not push the base off the goal. The pivot moves with the load and the arm's posture (0.21-0.27
+m holding the panel), so ``pivot`` is only where the follower starts: it learns the real one
+while the base turns (:class:`~bt_manip.navigation.pivot.PivotEstimate`, which followers of
+one pose plan share).
 
 Speed and yaw rate change at most by the acceleration limits between calls. When a
 ``path_blocked`` check is given, it is called every ``replan_period`` seconds with the part of
