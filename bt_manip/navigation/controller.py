@@ -35,9 +35,12 @@ A skid-steer base does not turn about its base frame: wheel scrub makes it pivot
 follower tracks the path with that pivot point, and in ``approach`` and ``align`` steers it to
 where it must be for the base frame to end on the goal, so turning to the goal heading does
 not push the base off the goal. The pivot moves with the load and the arm's posture (0.21-0.27
-m holding the panel), so ``pivot`` is only where the follower starts: it learns the real one
-while the base turns (:class:`~bt_manip.navigation.pivot.PivotEstimate`, which followers of
-one pose plan share).
+m holding the panel), so in ``approach`` and ``align`` the follower steers the pivot it has
+learnt while the base turned (:attr:`PathFollower.turn_pivot`, a
+:class:`~bt_manip.navigation.pivot.PivotEstimate` that the followers of one pose plan share):
+with the descriptor's value the point it steers would circle the real pivot as the base turns,
+and the base could circle its target. While driving it tracks ``path``, the path of the point
+``pivot`` ahead, as planned.
 
 Speed and yaw rate change at most by the acceleration limits between calls. When a
 ``path_blocked`` check is given, it is called every ``replan_period`` seconds with the part of
@@ -193,21 +196,30 @@ class PathFollower:
 
     @property
     def pivot(self) -> float:
-        """Where the base turns about now (m ahead of its frame; see :mod:`.pivot`)."""
+        """The point (m ahead of the base frame) whose path ``path`` is, tracked while driving."""
+        return self.options.pivot
+
+    @property
+    def turn_pivot(self) -> float:
+        """Where the base turns about now (m ahead of its frame; learnt, see :mod:`.pivot`):
+        the point steered onto its target in ``approach`` and held there in ``align``."""
         return self.pivot_estimate.value
 
     @property
     def path_end(self) -> tuple[float, float]:
         return float(self.path[-1, 0]), float(self.path[-1, 1])
 
-    def pivot_point(self, pose: Pose2D) -> tuple[float, float]:
-        """Where the pivot is for base pose ``pose``."""
-        return pose[0] + self.pivot * math.cos(pose[2]), pose[1] + self.pivot * math.sin(pose[2])
+    def pivot_point(self, pose: Pose2D, pivot: float | None = None) -> tuple[float, float]:
+        """Where the point ``pivot`` m ahead (the path's :attr:`pivot` by default) is for base
+        pose ``pose``."""
+        p = self.pivot if pivot is None else pivot
+        return pose[0] + p * math.cos(pose[2]), pose[1] + p * math.sin(pose[2])
 
     def pivot_target(self, yaw: float) -> tuple[float, float]:
-        """Where the pivot must end (``yaw``: the heading when there is no goal heading)."""
+        """Where the turning pivot (:attr:`turn_pivot`) must end (``yaw``: the heading when
+        there is no goal heading)."""
         end_yaw = yaw if self.goal_yaw is None else self.goal_yaw
-        return self.pivot_point((*self.goal_xy, end_yaw))
+        return self.pivot_point((*self.goal_xy, end_yaw), self.turn_pivot)
 
     @property
     def phase(self) -> str:
@@ -234,10 +246,12 @@ class PathFollower:
         if failure is not None:
             return self._finish(FollowState.FAILED, failure)
 
-        # the pivot point, and where it must end for the base frame to end on the goal
+        # the path's point, the point the base turns about, and where that must end for the
+        # base frame to end on the goal
         px, py = self.pivot_point(pose)
+        qx, qy = self.pivot_point(pose, self.turn_pivot)
         tx, ty = self.pivot_target(yaw)
-        d_pivot = math.hypot(tx - px, ty - py)
+        d_pivot = math.hypot(tx - qx, ty - qy)
         self._advance(px, py)
         d_goal = math.hypot(self.goal_xy[0] - x, self.goal_xy[1] - y)
         yaw_err = 0.0 if self.goal_yaw is None else wrap(self.goal_yaw - yaw)
@@ -282,12 +296,12 @@ class PathFollower:
 
         if self._phase == "align":
             # turn on the spot; creep along the heading to keep the pivot on its target
-            ahead = (tx - px) * math.cos(yaw) + (ty - py) * math.sin(yaw)
+            ahead = (tx - qx) * math.cos(yaw) + (ty - qy) * math.sin(yaw)
             v_ref = max(-o.align_creep, min(o.align_creep, 2.0 * ahead))
             w_ref = max(-o.align_yaw_rate, min(o.align_yaw_rate, self._turn_rate(yaw_err)))
             progress = d_pivot + 0.3 * abs(yaw_err)
         elif self._phase == "approach":
-            v_ref, w_ref, alpha = self._approach(px, py, yaw, tx, ty)
+            v_ref, w_ref, alpha = self._approach(qx, qy, yaw, tx, ty)
             progress = d_pivot + 0.3 * abs(alpha)
         else:
             v_ref, w_ref, alpha = self._pursue(px, py, yaw, to_end)

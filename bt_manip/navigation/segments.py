@@ -76,8 +76,8 @@ class SegmentFollower:
 
     @property
     def pivot(self) -> float:
-        """Where the base turns about now (m ahead of its frame)."""
-        return self.pivot_estimate.value
+        """The point (m ahead of the base frame) whose paths the runs track while driving."""
+        return self.options.pivot
 
     def _pivot_path(self, poses: np.ndarray) -> np.ndarray:
         p = self.pivot
