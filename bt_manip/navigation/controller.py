@@ -35,9 +35,10 @@ A skid-steer base does not turn about its base frame: wheel scrub makes it pivot
 follower tracks the path with that pivot point, and in ``approach`` and ``align`` steers it to
 where it must be for the base frame to end on the goal, so turning to the goal heading does
 not push the base off the goal. The pivot moves with the load and the arm's posture (0.21-0.27
-m holding the panel), so in ``approach`` and ``align`` the follower steers the pivot it has
-learnt while the base turned (:attr:`PathFollower.turn_pivot`, a
-:class:`~bt_manip.navigation.pivot.PivotEstimate` that the followers of one pose plan share):
+m holding the panel), so when following a pose plan (the carry), in ``approach`` and
+``align`` the follower steers the pivot learnt while the base turned
+(:attr:`PathFollower.turn_pivot`, a :class:`~bt_manip.navigation.pivot.PivotEstimate` that
+the followers of one pose plan share; a follower made without one keeps ``pivot``):
 with the descriptor's value the point it steers would circle the real pivot as the base turns,
 and the base could circle its target. While driving it tracks ``path``, the path of the point
 ``pivot`` ahead, as planned.
@@ -154,9 +155,12 @@ class PathFollower:
         self.replan = replan
         self.replans = 0
         self.pivot_estimate = (
-            pivot_estimate if pivot_estimate is not None else PivotEstimate(options.pivot)
+            pivot_estimate
+            if pivot_estimate is not None
+            else PivotEstimate(options.pivot, gain=0.0)
         )
-        """Where the base turns about (starts at ``options.pivot``, learnt while turning)."""
+        """Where the base turns about: ``options.pivot``, or learnt while turning when a
+        learning estimate is given (the pose-plan follower gives one)."""
         self._set_path(np.asarray(path, dtype=float))
         self._cmd = (0.0, 0.0)
         self._last_time: float | None = None
