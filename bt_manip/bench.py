@@ -5,7 +5,8 @@ episodes with seeds S, S+1, ..., S+N-1 (each seed draws the world's randomised s
 injected faults), in J worker processes, and reports:
 
 - the success rate with a 95 % Wilson score interval;
-- sim time, wall time and real-time factor per episode (mean, median, 95th percentile);
+- sim time, wall time (building the world and loading the tree included) and real-time factor
+  per episode (mean, median, 95th percentile);
 - failures counted by node and reason (the node whose failure ended each failed episode);
 - the actions that failed during episodes, and in how many episodes: the failures the tree
   recovered from (or did not), for instance how often a recovery branch was needed
@@ -24,6 +25,7 @@ import queue
 import signal
 import sys
 import threading
+import time
 from collections import Counter
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -76,7 +78,11 @@ def wilson_interval(successes: int, n: int, z: float = 1.959964) -> tuple[float,
 def run_one(spec: EpisodeSpec) -> EpisodeResult:
     """Run one episode (in a worker process) and condense its report.
 
+    The wall time counts the whole episode, building its world and loading its tree included
+    (the run report's own wall time counts the ticks only).
+
     With ``spec.btlog`` set, the episode's .btlog is kept only when it did not succeed."""
+    wall0 = time.perf_counter()
     with Episode(spec) as episode:
         leaf_failures = count_leaf_failures(episode.tree)
         report = episode.run()
@@ -85,6 +91,9 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
             for k, v in episode.tree.blackboard.as_dict().items()
             if isinstance(v, int | float) and not isinstance(v, bool)
         }
+    wall_time = time.perf_counter() - wall0
+    if report.status == "INTERRUPTED":  # Ctrl-C while the episode ran: the runner halted the
+        raise KeyboardInterrupt         # tree; the bench stops, this episode did not finish
     if spec.btlog and report.status == "SUCCESS":
         Path(spec.btlog).unlink(missing_ok=True)
     failed_node = ""
@@ -96,7 +105,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         status=report.status,
         reason=report.reason,
         sim_time=report.sim_time,
-        wall_time=report.wall_time,
+        wall_time=wall_time,
         ticks=report.ticks,
         failed_node=failed_node,
         injected=list(report.extra.get("injected", [])),

@@ -73,6 +73,28 @@ def test_an_interrupted_bench_keeps_its_episodes_and_resume_completes_it(
     assert len((tmp_path / "cut" / LOG_NAME).read_text().splitlines()) == 7
 
 
+def test_ctrl_c_during_an_episode_stops_a_one_process_bench(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The runner turns a Ctrl-C into an INTERRUPTED run (tree halted, robots stopped); the
+    bench then stops too, keeping only the episodes that finished."""
+    from bt_manip.sim.world import World
+
+    tree = _tree(tmp_path)
+    real_step = World.step
+
+    def ctrl_c_in_seed_2(self: World, n: int = 1) -> None:
+        if self.seed == 2 and self.time > 0.1:
+            raise KeyboardInterrupt
+        real_step(self, n)
+
+    monkeypatch.setattr(World, "step", ctrl_c_in_seed_2)
+    assert _bench(tree, tmp_path / "cut") == 130
+    logged = read_log(tmp_path / "cut")
+    assert [(r.seed, r.status in ("SUCCESS", "FAILURE")) for r in logged.results] == [
+        (0, True), (1, True)]
+    assert logged.missing == [2, 3, 4, 5]
+
+
 def test_resume_refuses_a_changed_tree_and_options_that_redefine_the_bench(
         tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     tree = _tree(tmp_path)

@@ -134,22 +134,38 @@ class CarriedClear(WorldCondition):
         return True, ""
 
 
+REST_SPEED = 0.05
+"""An object moving slower than this (m/s) ..."""
+REST_SPIN = 0.3
+"""... and turning slower than this (rad/s) is at rest."""
+
+
 @registry.register
 class ObjectUpright(WorldCondition):
     """SUCCESS when ``object`` stands as it was placed in the world file, within ``max_tilt``
-    degrees; FAILURE (the reason gives the tilt) when it has fallen over.
+    degrees, or is still moving; FAILURE (the reason gives the tilt) when it has fallen over.
 
     The tilt is the angle between the world's vertical and the object's axis that pointed most
     upwards in the world file's pose (a panel standing on its long edge: its height axis), taken
     from the ground truth. A panel lying flat has a tilt near 90 deg: its top edge is not up
     any more and a gripper coming from above cannot take it.
+
+    An object is judged at rest: one tilted beyond ``max_tilt`` that still moves (faster than
+    5 cm/s or 0.3 rad/s) is falling, and may yet come to rest leaning on something within
+    reach, so the answer is SUCCESS until it stops, or until
+    it has been tilted and moving for ``settle`` sim seconds, when it is judged as it is.
     """
 
     INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "object": OBJECT,
         "max_tilt": Port(float, False, "largest tilt that counts as upright (deg)", 30.0,
                          Accepts(0.0, 90.0)),
+        "settle": Port(float, False, "longest wait (sim s) for a tilted object to come to rest",
+                       3.0, Accepts(0.0, 60.0)),
     }
+
+    falling_since: float | None = None
+    """Sim time the object was first seen tilted and moving (None: it is not)."""
 
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")
@@ -162,7 +178,20 @@ class ObjectUpright(WorldCondition):
         tilt = math.degrees(math.acos(min(1.0, abs(float(up[2])))))
         limit = float(self.get_input("max_tilt"))
         if tilt <= limit:
+            self.falling_since = None
             return True, ""
+        linear, angular = pb.getBaseVelocity(body, physicsClientId=world.client)
+        moving = float(np.linalg.norm(linear)) > REST_SPEED or (
+            float(np.linalg.norm(angular)) > REST_SPIN
+        )
+        now = float(world.clock.now())
+        if not moving:
+            self.falling_since = None
+        else:
+            if self.falling_since is None:
+                self.falling_since = now
+            if now - self.falling_since < float(self.get_input("settle")):
+                return True, ""
         return False, (
             f"'{name}' fell over: it is tilted {tilt:.0f} deg from upright (more than "
             f"{limit:g} deg), and the gripper cannot take it from above"

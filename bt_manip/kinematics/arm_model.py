@@ -17,7 +17,10 @@ kind, axis) so that other modules can rebuild the same kinematics in another too
 
 from __future__ import annotations
 
+import hashlib
 import math
+import os
+import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
@@ -49,6 +52,11 @@ class ChainJoint:
 
 
 _WIDE = 1e10  # pinocchio's "no limit" is +-1.8e308; anything beyond this counts as unlimited
+_REACH_MEMO: dict[bytes, float] = {}
+"""Reaches already maximised in this process, by :meth:`ArmModel._chain_key`: every episode
+builds its arm models afresh, and the maximisation (16 quasi-Newton runs) costs more than
+the rest of the model; the value depends on the chain's numbers only."""
+_REACH_MEMO_SIZE = 64
 
 
 class ArmModel:
@@ -234,10 +242,33 @@ class ArmModel:
         Found once by maximising the distance with a bounded quasi-Newton method from a fixed
         set of starts (deterministic), and never above :meth:`reach_bound`. A numerical
         maximum: callers that reject targets with it should leave a small margin.
+
+        The value depends on the chain's numbers only, so it is kept per chain: in this process
+        and in the IK cache folder (``reach/``, next to the compiled IK code), where later
+        processes find it.
         """
         if self._reach is None:
-            self._reach = min(self._maximise_reach(), self.reach_bound())
+            key = self._chain_key()
+            reach = _REACH_MEMO.get(key)
+            if reach is None:
+                reach = _stored_reach(key)
+            if reach is None:
+                reach = min(self._maximise_reach(), self.reach_bound())
+                _store_reach(key, reach)
+            if len(_REACH_MEMO) >= _REACH_MEMO_SIZE:
+                _REACH_MEMO.pop(next(iter(_REACH_MEMO)))
+            _REACH_MEMO[key] = reach
+            self._reach = reach
         return self._reach
+
+    def _chain_key(self) -> bytes:
+        """Every number the chain's kinematics depend on (placements, axes, kinds, limits and
+        the tip's placement), as bytes: two models with equal keys have equal reaches."""
+        parts = [self.tip_rotation, self.tip_translation]
+        for j in self.chain:
+            parts += [j.rotation, j.translation, j.axis, np.array([j.lower, j.upper])]
+        kinds = "".join(j.kind[0] for j in self.chain).encode()
+        return kinds + b"".join(np.ascontiguousarray(p, dtype=float).tobytes() for p in parts)
 
     def _maximise_reach(self, starts: int = 16) -> float:
         from scipy.optimize import minimize
@@ -264,6 +295,42 @@ class ArmModel:
             + ", ".join(self.joint_names)
             + ")"
         )
+
+
+_REACH_VERSION = b"reach-1:16-starts:rng-12345:"
+"""Part of every stored reach's key: change it when the maximisation changes."""
+
+
+def _reach_file(key: bytes) -> Path:
+    from bt_manip.kinematics.compiled import cache_dir
+
+    digest = hashlib.sha256(_REACH_VERSION + key).hexdigest()[:32]
+    return cache_dir() / "reach" / f"{digest}.txt"
+
+
+def _stored_reach(key: bytes) -> float | None:
+    """The reach stored for this chain by an earlier process, if any (and readable)."""
+    try:
+        value = float(_reach_file(key).read_text().strip())
+    except (OSError, ValueError):
+        return None
+    return value if math.isfinite(value) and value > 0.0 else None
+
+
+def _store_reach(key: bytes, reach: float) -> None:
+    """Store the reach of a chain (atomically; a folder that cannot be written is skipped)."""
+    target = _reach_file(key)
+    try:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=".reach-", suffix=".tmp", dir=target.parent)
+    except OSError:
+        return
+    try:
+        with os.fdopen(fd, "w") as fh:
+            fh.write(repr(float(reach)) + "\n")
+        os.replace(tmp, target)
+    except OSError:
+        Path(tmp).unlink(missing_ok=True)
 
 
 def _extract_chain(

@@ -34,7 +34,14 @@ A skid-steer base does not turn about its base frame: wheel scrub makes it pivot
 ``pivot`` metres ahead of it (measured 0.11-0.16 m on the Husky with its arm in PyBullet). The
 follower tracks the path with that pivot point, and in ``approach`` and ``align`` steers it to
 where it must be for the base frame to end on the goal, so turning to the goal heading does
-not push the base off the goal.
+not push the base off the goal. The pivot moves with the load and the arm's posture (0.21-0.27
+m holding the panel), so when following a pose plan (the carry), in ``approach`` and
+``align`` the follower steers the pivot learnt while the base turned
+(:attr:`PathFollower.turn_pivot`, a :class:`~bt_manip.navigation.pivot.PivotEstimate` that
+the followers of one pose plan share; a follower made without one keeps ``pivot``):
+with the descriptor's value the point it steers would circle the real pivot as the base turns,
+and the base could circle its target. While driving it tracks ``path``, the path of the point
+``pivot`` ahead, as planned.
 
 Speed and yaw rate change at most by the acceleration limits between calls. When a
 ``path_blocked`` check is given, it is called every ``replan_period`` seconds with the part of
@@ -50,6 +57,8 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+
+from bt_manip.navigation.pivot import PivotEstimate
 
 Pose2D = tuple[float, float, float]
 
@@ -136,6 +145,7 @@ class PathFollower:
         path_blocked: Callable[[np.ndarray], bool] | None = None,
         replan: Callable[[Pose2D], np.ndarray | str] | None = None,
         reverse: bool = False,
+        pivot_estimate: PivotEstimate | None = None,
     ) -> None:
         self.options = options
         self.reverse = reverse
@@ -144,7 +154,13 @@ class PathFollower:
         self.path_blocked = path_blocked
         self.replan = replan
         self.replans = 0
-        self.pivot = options.pivot
+        self.pivot_estimate = (
+            pivot_estimate
+            if pivot_estimate is not None
+            else PivotEstimate(options.pivot, gain=0.0)
+        )
+        """Where the base turns about: ``options.pivot``, or learnt while turning when a
+        learning estimate is given (the pose-plan follower gives one)."""
         self._set_path(np.asarray(path, dtype=float))
         self._cmd = (0.0, 0.0)
         self._last_time: float | None = None
@@ -183,17 +199,31 @@ class PathFollower:
             self._phase = "drive"
 
     @property
+    def pivot(self) -> float:
+        """The point (m ahead of the base frame) whose path ``path`` is, tracked while driving."""
+        return self.options.pivot
+
+    @property
+    def turn_pivot(self) -> float:
+        """Where the base turns about now (m ahead of its frame; learnt, see :mod:`.pivot`):
+        the point steered onto its target in ``approach`` and held there in ``align``."""
+        return self.pivot_estimate.value
+
+    @property
     def path_end(self) -> tuple[float, float]:
         return float(self.path[-1, 0]), float(self.path[-1, 1])
 
-    def pivot_point(self, pose: Pose2D) -> tuple[float, float]:
-        """Where the pivot is for base pose ``pose``."""
-        return pose[0] + self.pivot * math.cos(pose[2]), pose[1] + self.pivot * math.sin(pose[2])
+    def pivot_point(self, pose: Pose2D, pivot: float | None = None) -> tuple[float, float]:
+        """Where the point ``pivot`` m ahead (the path's :attr:`pivot` by default) is for base
+        pose ``pose``."""
+        p = self.pivot if pivot is None else pivot
+        return pose[0] + p * math.cos(pose[2]), pose[1] + p * math.sin(pose[2])
 
     def pivot_target(self, yaw: float) -> tuple[float, float]:
-        """Where the pivot must end (``yaw``: the heading when there is no goal heading)."""
+        """Where the turning pivot (:attr:`turn_pivot`) must end (``yaw``: the heading when
+        there is no goal heading)."""
         end_yaw = yaw if self.goal_yaw is None else self.goal_yaw
-        return self.pivot_point((*self.goal_xy, end_yaw))
+        return self.pivot_point((*self.goal_xy, end_yaw), self.turn_pivot)
 
     @property
     def phase(self) -> str:
@@ -214,15 +244,18 @@ class PathFollower:
         if self._best_time is None:
             self._best_time = now
         x, y, yaw = pose
+        self.pivot_estimate.observe(pose, now)
 
         failure = self._maybe_replan(pose, now)
         if failure is not None:
             return self._finish(FollowState.FAILED, failure)
 
-        # the pivot point, and where it must end for the base frame to end on the goal
+        # the path's point, the point the base turns about, and where that must end for the
+        # base frame to end on the goal
         px, py = self.pivot_point(pose)
+        qx, qy = self.pivot_point(pose, self.turn_pivot)
         tx, ty = self.pivot_target(yaw)
-        d_pivot = math.hypot(tx - px, ty - py)
+        d_pivot = math.hypot(tx - qx, ty - qy)
         self._advance(px, py)
         d_goal = math.hypot(self.goal_xy[0] - x, self.goal_xy[1] - y)
         yaw_err = 0.0 if self.goal_yaw is None else wrap(self.goal_yaw - yaw)
@@ -231,7 +264,7 @@ class PathFollower:
         if self._phase == "settle":
             if now - self._settle_start < o.settle_time or self._cmd != (0.0, 0.0):
                 self._cmd = self._limit(0.0, 0.0, dt)
-                return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+                return self._running()
             if d_goal <= o.xy_tolerance and abs(yaw_err) <= o.yaw_tolerance:
                 return self._finish(FollowState.SUCCEEDED, "goal reached")
             self._phase = "align"
@@ -243,7 +276,7 @@ class PathFollower:
             self._phase = "settle"  # stop, let the base come to rest, then check again
             self._settle_start = now
             self._cmd = self._limit(0.0, 0.0, dt)
-            return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+            return self._running()
 
         phase_before = self._phase
         if self._phase in ("drive", "turn") and at_end:
@@ -267,12 +300,12 @@ class PathFollower:
 
         if self._phase == "align":
             # turn on the spot; creep along the heading to keep the pivot on its target
-            ahead = (tx - px) * math.cos(yaw) + (ty - py) * math.sin(yaw)
+            ahead = (tx - qx) * math.cos(yaw) + (ty - qy) * math.sin(yaw)
             v_ref = max(-o.align_creep, min(o.align_creep, 2.0 * ahead))
             w_ref = max(-o.align_yaw_rate, min(o.align_yaw_rate, self._turn_rate(yaw_err)))
             progress = d_pivot + 0.3 * abs(yaw_err)
         elif self._phase == "approach":
-            v_ref, w_ref, alpha = self._approach(px, py, yaw, tx, ty)
+            v_ref, w_ref, alpha = self._approach(qx, qy, yaw, tx, ty)
             progress = d_pivot + 0.3 * abs(alpha)
         else:
             v_ref, w_ref, alpha = self._pursue(px, py, yaw, to_end)
@@ -289,11 +322,17 @@ class PathFollower:
                 f"stuck: no progress for {o.stuck_time:.1f} s, {d_goal:.2f} m from the goal",
             )
         self._cmd = self._limit(v_ref, w_ref, dt)
-        return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+        return self._running()
 
     # -- parts ---------------------------------------------------------------------------------
+    def _running(self) -> FollowStatus:
+        """RUNNING with the command ``self._cmd`` (the pivot estimate is told it)."""
+        self.pivot_estimate.sent(self._cmd)
+        return FollowStatus(FollowState.RUNNING, "", self._cmd, self._phase)
+
     def _finish(self, state: FollowState, reason: str) -> FollowStatus:
         self._cmd = (0.0, 0.0)
+        self.pivot_estimate.sent(self._cmd)
         self._done = FollowStatus(state, reason, (0.0, 0.0), self._phase)
         return self._done
 

@@ -11,7 +11,11 @@ pose per (x, y, heading) bin. Backing up costs double, and turning on the spot c
 
 The moves are checked every few centimetres of footprint travel: every outline point must keep
 ``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a
-cell's centre, so the point's own offset in its cell is subtracted too). The heuristic is the
+cell's centre, so the point's own offset in its cell is subtracted too). A start closer than
+that but not touching (a robot that has just lifted a load out of a stand beside it) is
+accepted: within ``tight_start`` of it, moves from a pose without the margin need only keep
+the footprint off the obstacles, at three times the cost, so the plan
+gets out of the tight spot first. The heuristic is the
 obstacle-aware distance to the goal on the grid of cells with enough clearance for the
 footprint's half width, so the search heads through the right doorways.
 
@@ -59,6 +63,9 @@ class LatticeOptions:
     max_expansions: int = 400_000
     check_spacing: float = 0.05
     """Largest travel (m) of any footprint point between two collision checks."""
+    tight_start: float = 0.6
+    """Within this distance (m) of a start that lacks ``min_clearance`` (but touches nothing),
+    moves need only keep the footprint off the obstacles (see the module)."""
 
 
 @dataclass(frozen=True)
@@ -351,6 +358,53 @@ def _pose_free(
 
 
 @numba.njit(cache=True)
+def _points_margin(
+    clear: np.ndarray,
+    x0: float,
+    y0: float,
+    res: float,
+    pts: np.ndarray,
+    x: float,
+    y: float,
+    th: float,
+) -> float:
+    """The smallest clearance (m) of the cells under the points (``-inf`` off the grid)."""
+    rows, cols = clear.shape
+    c = math.cos(th)
+    s = math.sin(th)
+    low = np.inf
+    for k in range(pts.shape[0]):
+        px = x + c * pts[k, 0] - s * pts[k, 1]
+        py = y + s * pts[k, 0] + c * pts[k, 1]
+        col = math.floor((px - x0) / res)
+        row = math.floor((py - y0) / res)
+        if row < 0 or row >= rows or col < 0 or col >= cols:
+            return -np.inf
+        low = min(low, _clearance_value(clear[row, col], res))
+    return low  # type: ignore[no-any-return]  # numba body: a float
+
+
+@numba.njit(cache=True)
+def _pose_margin(
+    clear: np.ndarray,
+    clear_high: np.ndarray,
+    x0: float,
+    y0: float,
+    res: float,
+    pts: np.ndarray,
+    pts_high: np.ndarray,
+    x: float,
+    y: float,
+    th: float,
+) -> float:
+    """The smallest clearance of the footprint and the carried-object points (m)."""
+    return min(
+        _points_margin(clear, x0, y0, res, pts, x, y, th),
+        _points_margin(clear_high, x0, y0, res, pts_high, x, y, th),
+    )
+
+
+@numba.njit(cache=True)
 def _move(
     x: float, y: float, th: float, kind: int, curv: float, length: float, pivot: float, t: float
 ) -> tuple[float, float, float]:
@@ -404,6 +458,14 @@ def _search(
     maxexp = int(params[9])
     spacing = params[10]
     pivot = params[11]
+    need_low = params[12]
+    tight_radius = params[13]
+    # a start closer to obstacles than ``need`` (but not touching them): within
+    # ``tight_radius`` of it, moves need only keep ``need_low``, at three times the cost from a
+    # pose without the full margin, so the plan gets out of the tight spot at once
+    start_tight = not _pose_free(
+        clear, clear_high, x0, y0, res, pts, pts_high, start[0], start[1], start[2], need
+    )
     cols = clear.shape[1]
     bx = math.ceil(cols * res / xyb) + 1
     # States are stored in the order they are first reached (slots), found by their bin key:
@@ -475,6 +537,10 @@ def _search(
         expanded += 1
         if expanded > maxexp:
             break
+        near_start = start_tight and math.hypot(x - start[0], y - start[1]) <= tight_radius
+        tight = near_start and (
+            _pose_margin(clear, clear_high, x0, y0, res, pts, pts_high, x, y, th) < need
+        )
         for m in range(8):
             kind = kinds[m]
             length = lens[m]
@@ -486,15 +552,16 @@ def _search(
             nx = x
             ny = y
             nt = th
+            keep = need_low if tight else need
             for j in range(1, nsub + 1):
                 nx, ny, nt = _move(x, y, th, kind, curvs[m], length, pivot, j / nsub)
-                if not _pose_free(clear, clear_high, x0, y0, res, pts, pts_high, nx, ny, nt, need):
+                if not _pose_free(clear, clear_high, x0, y0, res, pts, pts_high, nx, ny, nt, keep):
                     ok = False
                     break
             if not ok:
                 continue
             bin_key = key(nx, ny, nt)
-            ng = g + costs[m]
+            ng = g + costs[m] * (3.0 if tight else 1.0)
             nk = np.int64(-1)
             if bin_key in slot_of:
                 nk = slot_of[bin_key]
@@ -571,7 +638,8 @@ def plan_poses(
     res = grid.resolution
     if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *goal, need):
         return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
-    if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *start, need):
+    need_low = grid.resolution / math.sqrt(2.0)
+    if not _pose_free(clear, high, x0, y0, res, pts, pts_high, *start, need_low):
         return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
     free = clearance_at_least(clear, res, footprint.half_width + o.min_clearance)
     gc = grid.world_to_cell(goal[0], goal[1])
@@ -590,6 +658,8 @@ def plan_poses(
             o.max_expansions,
             o.check_spacing,
             pivot,
+            need_low,
+            o.tight_start,
         ]
     )
     parent, move_of, pose, end, expanded = _search(

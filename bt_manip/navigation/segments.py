@@ -2,9 +2,12 @@
 
 A :class:`~bt_manip.navigation.lattice.PosePlan` is cut into runs of the same kind of move.
 Each run is handed to a :class:`~bt_manip.navigation.controller.PathFollower`: forward and
-backward runs follow the pivot point's path through the run's poses, a turn on the spot turns
-to the run's last heading, and a last run brings the base exactly onto the goal with the
-follower's tolerances. Intermediate runs end within ``waypoint_tolerance`` without settling.
+backward runs follow the pivot point's path through the run's poses and end on the run's last
+pose (heading included, within the loose tolerances), a turn on the spot turns to the run's
+last heading, and a last run brings the base exactly onto the goal with the follower's
+tolerances. Intermediate runs end within ``waypoint_tolerance`` (and 0.2 rad) without
+settling. All runs share one :class:`~bt_manip.navigation.pivot.PivotEstimate`: the point
+the base really turns about is learnt while it turns (a carried load moves it).
 
 :meth:`SegmentFollower.update` has the same contract as :meth:`PathFollower.update`.
 """
@@ -24,6 +27,7 @@ from bt_manip.navigation.controller import (
     Pose2D,
 )
 from bt_manip.navigation.lattice import BACKWARD, TURN, PosePlan
+from bt_manip.navigation.pivot import PivotEstimate
 from bt_manip.navigation.smoothing import densify
 
 
@@ -47,13 +51,17 @@ class SegmentFollower:
         goal: Pose2D,
         options: FollowerOptions | None = None,
         waypoint_tolerance: float = 0.15,
+        pivot_estimate: PivotEstimate | None = None,
     ) -> None:
         options = options or FollowerOptions()
         if not plan.ok or plan.poses is None or plan.moves is None:
             raise ValueError("a pose plan that found a way is needed")
         self.options = options
         self.goal = goal
-        self.pivot = options.pivot
+        self.pivot_estimate = (
+            pivot_estimate if pivot_estimate is not None else PivotEstimate(options.pivot)
+        )
+        """Where the base turns about, learnt while it turns and shared by the runs."""
         self._loose = dataclasses.replace(
             options, xy_tolerance=waypoint_tolerance, yaw_tolerance=0.2, settle_time=0.0
         )
@@ -65,6 +73,11 @@ class SegmentFollower:
         self._final = False
         self._done: FollowStatus | None = None
         self.runs = len(self._queue)
+
+    @property
+    def pivot(self) -> float:
+        """The point (m ahead of the base frame) whose paths the runs track while driving."""
+        return self.options.pivot
 
     def _pivot_path(self, poses: np.ndarray) -> np.ndarray:
         p = self.pivot
@@ -80,14 +93,25 @@ class SegmentFollower:
             here = (x + self.pivot * math.cos(yaw), y + self.pivot * math.sin(yaw))
             gx, gy, gyaw = self.goal
             there = (gx + self.pivot * math.cos(gyaw), gy + self.pivot * math.sin(gyaw))
-            return PathFollower(densify(np.array([here, there]), 0.05), self.goal, self.options)
+            return PathFollower(
+                densify(np.array([here, there]), 0.05), self.goal, self.options,
+                pivot_estimate=self.pivot_estimate,
+            )
         kind, poses = self._queue.pop(0)
         end = poses[-1]
         if kind == TURN:
             turn_path = self._pivot_path(poses[-1:])
-            return PathFollower(turn_path, (end[0], end[1], end[2]), self._loose)
+            return PathFollower(
+                turn_path, (end[0], end[1], end[2]), self._loose,
+                pivot_estimate=self.pivot_estimate,
+            )
+        # the run ends on its last pose, heading included: without a heading the follower
+        # would steer the pivot to a point ahead of the goal along the heading it has now,
+        # which moves as the base turns, and a base a little off its run could circle it
         return PathFollower(
-            self._pivot_path(poses), (end[0], end[1]), self._loose, reverse=kind == BACKWARD
+            self._pivot_path(poses), (end[0], end[1], end[2]), self._loose,
+            reverse=kind == BACKWARD,
+            pivot_estimate=self.pivot_estimate,
         )
 
     def update(self, pose: Pose2D, now: float) -> FollowStatus:

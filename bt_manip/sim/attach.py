@@ -173,7 +173,6 @@ class Attachments:
         held = self._by_object.get(object_name)
         if held is None:
             return []
-        static = self._static_names()
         supports = self._supports.get(object_name, set())
         touching = {c.body_b for c in pbq.contacts(self.client, held.object_body)}
         for support in list(supports):  # a support left once is a support no more
@@ -181,7 +180,12 @@ class Attachments:
                 self.client, held.object_body, support, LEAVE_CLEARANCE
             ):
                 supports.discard(support)
-        return sorted(static[b] for b in touching if b in static and b not in supports)
+        touching -= supports
+        touching.discard(held.robot_body)
+        if not touching:  # the common case, checked after every step: nothing to name
+            return []
+        static = self._static_names()
+        return sorted(static[b] for b in touching if b in static)
 
     def record_contacts(self) -> None:
         """Note every static body an attached object touches now (see :meth:`static_contacts`).

@@ -315,11 +315,17 @@ def _to_text(root: ET.Element) -> str:
 
 def _write_atomic(target: Path, text: str) -> None:
     """Write ``text`` to ``target`` so that readers see either nothing or the whole file."""
+    write_atomic_bytes(target, text.encode("utf-8"))
+
+
+def write_atomic_bytes(target: Path, data: bytes) -> None:
+    """Write ``data`` to ``target`` (its folder made if missing) so that readers, in this or
+    another process, see either nothing or the whole file."""
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.stem}-", suffix=".tmp", dir=target.parent)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
         os.replace(tmp, target)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)

@@ -30,6 +30,7 @@ from bt_manip.errors import InputError
 from bt_manip.geometry import compose_poses, invert_pose, pose_matrix, quat_from_yaw, yaw_of
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.compose import composed_urdf
+from bt_manip.sim.physics_urdf import physics_urdf
 from bt_manip.sim.pybullet_queries import JointInfo
 from bt_manip.sim.robot_description import (
     ArmSpec,
@@ -127,10 +128,15 @@ class Robot:
         robots are welded to the world, and so is the root of a holonomic base (the spawn pose
         is where its virtual joints are at 0). Arm and gripper then hold their initial positions
         and the base is braked, so the robot stays at rest until commanded.
+
+        Without PyBullet's own window the file loaded is :func:`physics_urdf` (no visuals,
+        collision meshes as their hulls): the same links, masses and collision shapes.
         """
         if not isinstance(description, RobotDescription):
             description = RobotDescription.load(description)
         path = composed_urdf(description)
+        if not _has_window(client):
+            path = physics_urdf(path)
         z = description.spawn_height if z is None else z
         flags = pb.URDF_USE_INERTIA_FROM_FILE
         try:
@@ -550,3 +556,9 @@ class Robot:
         """Leave the robot safe: base braked, arm holding its position, gripper unchanged."""
         self.stop_base()
         self.hold_arm()
+
+
+def _has_window(client: int) -> bool:
+    """True when ``client`` is PyBullet's GUI, which draws the URDF's own visuals."""
+    info = pb.getConnectionInfo(physicsClientId=client)
+    return bool(info.get("connectionMethod") == pb.GUI)

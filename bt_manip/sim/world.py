@@ -10,6 +10,9 @@ Randomisation: each object or robot with a ``randomize`` range gets offsets draw
 generator seeded by (world seed, entity name), so adding an entity does not change the others.
 Groups (:mod:`bt_manip.sim.groups`) move their members, named poses included, by one rigid
 motion per seed before anything is built; ``World.spec`` is the world file so placed.
+
+Movable objects at rest sleep (see :data:`SLEEP_THRESHOLD`): Bullet leaves them out of the
+solver until a moving body touches them or is fixed to them, and removing a body wakes them all.
 """
 
 from __future__ import annotations
@@ -43,6 +46,11 @@ from bt_manip.sim.world_spec import (
 
 OVERLAP_TOLERANCE = 0.002
 """Penetration (m) between two bodies at spawn beyond which they are reported as overlapping."""
+SLEEP_THRESHOLD = 1e-5
+"""A movable object sleeps once its squared speeds (m^2/s^2 + rad^2/s^2 summed) stay below this
+for two seconds of sim time (Bullet's sleeping): about 3 mm/s, some 25 times the jitter of a
+panel resting in its stand and far below anything moving. A sleeping object costs the solver
+nothing; a contact or constraint with a moving body wakes it."""
 
 
 @dataclass
@@ -229,6 +237,10 @@ class World:
         if spec.movable:
             for link in range(-1, pbq.joint_count(c, body)):
                 pb.changeDynamics(body, link, lateralFriction=spec.friction, physicsClientId=c)
+            pb.changeDynamics(
+                body, -1, activationState=pb.ACTIVATION_STATE_ENABLE_SLEEPING,
+                sleepThreshold=SLEEP_THRESHOLD, physicsClientId=c,
+            )
         return int(body)
 
     def _placed_pose(
@@ -405,7 +417,17 @@ class World:
             self.attachments.detach(name)
         pb.removeBody(info.body_id, physicsClientId=self.client)
         del self.infos[name]
+        self._wake_movables()  # whatever rested on the body removed must fall
         self.events.announce(BodyRemoved(self.time, name, info.body_id, info.kind))
+
+    def _wake_movables(self) -> None:
+        """Wake every sleeping movable object (a body removed wakes nothing by itself)."""
+        for info in self.infos.values():
+            if info.kind == "object":
+                pb.changeDynamics(
+                    info.body_id, -1, activationState=pb.ACTIVATION_STATE_WAKE_UP,
+                    physicsClientId=self.client,
+                )
 
     # -- queries ------------------------------------------------------------------------------
     def body_id(self, name: str) -> int:

@@ -204,3 +204,47 @@ def test_object_upright_tells_a_standing_panel_from_a_fallen_one(grasp_room: Wor
         "'panel' fell over: it is tilted 90 deg from upright (more than 30 deg), and the gripper "
         "cannot take it from above"
     )
+
+
+def _tip(world: World, roll: float, spin: tuple[float, float, float]) -> None:
+    """Test setup: the panel stands on its long bottom edge at ``roll`` from upright, turning
+    at ``spin`` (rad/s, world)."""
+    c, s = math.cos(0.5236), math.sin(0.5236)
+    # the bottom edge stays on the floor: the centre is half the height up the tilted panel
+    h = 0.075
+    pos = [0.5 - s * h * math.sin(roll), c * h * math.sin(roll), h * math.cos(roll) + 0.01]
+    pb.resetBasePositionAndOrientation(
+        world.movable["panel"], pos, quat_from_euler((roll, 0.0, 0.5236)),
+        physicsClientId=world.client,
+    )
+    pb.resetBaseVelocity(world.movable["panel"], [0, 0, 0], spin, physicsClientId=world.client)
+
+
+def test_object_upright_judges_a_falling_panel_once_it_is_at_rest(grasp_room: World) -> None:
+    world = grasp_room
+    c, s = math.cos(0.5236), math.sin(0.5236)
+    _tip(world, math.radians(40), (3.0 * c, 3.0 * s, 0.0))  # falling onto its face
+    report, _ = run_xml(world, '<ObjectUpright object="panel" max_tilt="30"/>')
+    assert report.status == "SUCCESS"  # still falling: not judged yet
+    # ticked until it fails: that is once the panel lies still, flat
+    report, _ = run_xml(
+        world, '<KeepRunningUntilFailure><ObjectUpright object="panel"/></KeepRunningUntilFailure>'
+    )
+    assert report.status == "FAILURE"
+    assert "'panel' fell over: it is tilted 90 deg" in reasons(report)["ObjectUpright"]
+    linear, angular = pb.getBaseVelocity(world.movable["panel"], physicsClientId=world.client)
+    assert np.linalg.norm(linear) <= 0.05 and np.linalg.norm(angular) <= 0.3
+
+
+def test_object_upright_waits_for_rest_no_longer_than_settle(grasp_room: World) -> None:
+    world = grasp_room
+    _tip(world, math.pi / 2, (0.0, 0.0, 30.0))  # lying flat, spinning fast on the floor
+    report, _ = run_xml(
+        world,
+        '<KeepRunningUntilFailure><ObjectUpright object="panel" settle="0.1"/>'
+        "</KeepRunningUntilFailure>",
+    )
+    assert report.status == "FAILURE"
+    assert "'panel' fell over" in reasons(report)["ObjectUpright"]
+    _, angular = pb.getBaseVelocity(world.movable["panel"], physicsClientId=world.client)
+    assert np.linalg.norm(angular) > 0.3  # judged while it still turns

@@ -140,3 +140,49 @@ def test_squared_distances_plan_the_same_poses_as_the_clearance_grid() -> None:
             assert np.array_equal(a.moves, b.moves)
     half = clearance(grid) >= 0.3
     assert np.array_equal(clearance_at_least(d2, grid.resolution, 0.3), half)
+
+
+def _margin(grid: OccupancyGrid, clear: np.ndarray, fp: PlanarFootprint, pose: np.ndarray) -> float:
+    """The smallest clearance (m) of the grid cells under the footprint's outline at ``pose``."""
+    pts = outline_samples(fp)
+    x, y, th = pose
+    c, s = math.cos(th), math.sin(th)
+    cols = np.floor((x + c * pts[:, 0] - s * pts[:, 1]) / grid.resolution).astype(int)
+    rows = np.floor((y + s * pts[:, 0] + c * pts[:, 1]) / grid.resolution).astype(int)
+    return float(clear[rows, cols].min())
+
+
+def test_a_start_closer_than_the_margin_is_planned_out_of_first() -> None:
+    grid = room()
+    # a low box 0.4 m long beside the front of the base's left side, 6 cm off it: within the
+    # 5 cm margin and the half cell a point may lie off its cell's centre
+    grid.occupied[46:48, 60:68] = True  # x 3.0-3.4, y 2.3-2.4
+    clear = clearance(grid)
+    fp = PlanarFootprint.rectangle(1.0, 0.6, label="base")
+    start = (3.0, 2.3 - 0.3 - 0.06, 0.0)
+    goal = (6.0, 1.0, 0.0)
+    assert _margin(grid, clear, fp, np.array(start)) < 0.05 + grid.resolution / math.sqrt(2)
+    plan = plan_poses(grid, clear, fp, start, goal)
+    assert plan.ok, plan.reason
+    assert plan.poses is not None
+    margins = [_margin(grid, clear, fp, p) for p in plan.poses]
+    need = 0.05 + grid.resolution / math.sqrt(2)
+    out = next(i for i, m in enumerate(margins) if m >= need)
+    # off the wall all the way, and once the margin is back it is kept
+    assert min(margins) >= grid.resolution / math.sqrt(2)
+    assert min(margins[out:]) >= need
+    # the margin is back within 0.6 m of the start
+    assert math.hypot(plan.poses[out][0] - start[0], plan.poses[out][1] - start[1]) <= 0.6 + 0.2
+    end = plan.poses[-1]
+    assert math.hypot(end[0] - goal[0], end[1] - goal[1]) <= 0.15
+
+
+def test_a_start_touching_an_obstacle_is_refused() -> None:
+    grid = room()
+    grid.occupied[46:48, 60:68] = True  # x 3.0-3.4, y 2.3-2.4
+    clear = clearance(grid)
+    fp = PlanarFootprint.rectangle(1.0, 0.6, label="base")
+    start = (3.0, 2.3 - 0.3 + 0.02, 0.0)  # 2 cm into the box
+    plan = plan_poses(grid, clear, fp, start, (6.0, 1.0, 0.0))
+    assert not plan.ok
+    assert plan.reason.endswith("touches obstacles at the start")

@@ -8,8 +8,12 @@ from pathlib import Path
 import pybullet as pb
 import pytest
 
+from bt_manip.bench import count_leaf_failures
+from bt_manip.bt.status import NodeStatus
+from bt_manip.bt.walk import walk_nodes
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.faults import parse_fault
+from bt_manip.groot.monitor import watch
 from bt_manip.runner import RunReport
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -101,3 +105,33 @@ def test_a_carry_that_cannot_get_through_ends_the_run_with_the_panel_in_hand() -
             "at_goal"
         ]
         assert episode.world.attachments.is_attached("panel", "husky")
+
+
+def test_a_robot_wedged_against_a_crate_gets_clear_and_the_run_goes_on() -> None:
+    # a wall 5 mm behind the robot and a crate beside its front: the first drive runs into the
+    # crate, and backing away is blocked
+    world_file = str(Path(__file__).with_name("wedged_room.yaml"))
+    with Episode(EpisodeSpec(tree=TREE, world=world_file, seed=0)) as episode:
+        world = episode.world
+        crate = world.movable["crate"]
+        crate_at = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)[0]
+        failures = count_leaf_failures(episode.tree)
+        ran_into: list[str] = []
+        for walked in walk_nodes(episode.tree.root):
+            if walked.path.endswith("/to_staging"):
+                watch(walked.node, lambda node, old, new: ran_into.append(node.feedback_message)
+                      if new is NodeStatus.FAILURE else None)
+        report = episode.run()
+        assert report.status == "SUCCESS", report.reason
+        failed = {path.split("/")[-1]: n for path, n in failures.items()}
+        assert ran_into[0] == "ran into 'crate'"
+        # GetClear got it out (it did not fail), and the drive went on: no failed grasp
+        # attempt, no backing into the wall
+        assert set(failed) == {"to_staging", "drive_failed"}
+        crate_now = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)[0]
+        assert math.dist(crate_at[:2], crate_now[:2]) < 0.1
+        assert world.attachments.is_attached("panel", "husky")
+        assert world.attachments.touched("panel") == []
+        x, y, _ = world.robots["husky"].base_pose2d()
+        goal = world.poses["goal"]
+        assert math.hypot(x - goal.x, y - goal.y) <= 0.15

@@ -30,12 +30,20 @@ class StandInServer:
         self._ready = threading.Event()
         self._thread = threading.Thread(target=self._serve, daemon=True)
         self._thread.start()
-        assert self._ready.wait(5)
+        assert self._ready.wait(15)
 
     def _serve(self) -> None:
         sock = zmq.Context.instance().socket(zmq.REP)
         sock.setsockopt(zmq.LINGER, 0)
-        sock.bind(self.url)
+        deadline = time.monotonic() + 10
+        while True:  # the port a server before this one had is freed a moment after it closed
+            try:
+                sock.bind(self.url)
+                break
+            except zmq.ZMQError:
+                if time.monotonic() > deadline:
+                    raise
+                time.sleep(0.02)
         self._ready.set()
         try:
             while not self._stop.is_set():
