@@ -8,7 +8,6 @@ bytes, BLACKBOARD content, hook dumps, recorded transitions and error replies.
 
 from __future__ import annotations
 
-import gc
 import json
 import time
 from pathlib import Path
@@ -221,12 +220,21 @@ def _btcpp_btlog(path: Path) -> list[tuple[int, int]]:
     for _ in range(TICKS):
         tree.tick_once()
     tree.halt_tree()
-    logger.flush()
-    # FileLogger2 writes from a thread of its own; destroying the logger joins that thread and
-    # writes what is left, so the file is whole once it is gone
+    # FileLogger2 writes (and flushes) from a thread of its own, which a busy machine may not
+    # run for a while, and which, destroyed before it ever ran, writes nothing: wait until the
+    # file holds transitions and has not changed for half a second, all ticks being long done.
+    # No logger.flush() from here: it races that thread's writes on one ofstream (seen as
+    # garbage records under load).
+    transitions: list[tuple[int, int]] = []
+    unchanged = 0
+    deadline = time.monotonic() + 60
+    while unchanged < 10 and time.monotonic() < deadline:
+        time.sleep(0.05)
+        found = [(uid, status) for _, uid, status in read_btlog(path).transitions]
+        unchanged = unchanged + 1 if found and found == transitions else 0
+        transitions = found
     del logger
-    gc.collect()
-    return [(uid, status) for _, uid, status in read_btlog(path).transitions]
+    return transitions
 
 
 def test_btlog_has_the_transition_sequence_of_file_logger2(tmp_path: Path) -> None:
