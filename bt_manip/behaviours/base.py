@@ -34,6 +34,18 @@ class ActionFailed(Exception):
     """Raised inside a behaviour to end it with FAILURE and this reason."""
 
 
+def skid_steer_refusal(robot: Any, node_id: str) -> str | None:
+    """Why ``node_id`` cannot drive ``robot`` (a :class:`bt_manip.sim.robot.Robot`), or None when
+    its base is a skid-steer base, the only kind the node drives."""
+    kind = robot.description.base.type
+    if kind == "skid_steer":
+        return None
+    if kind == "fixed":
+        return f"{robot.description.name} has no mobile base"
+    return (f"{robot.description.name} has a {kind} base; {node_id} drives skid-steer bases only "
+            "(Navigate and Reverse drive every mobile base)")
+
+
 class _Node(Protocol):
     """What :class:`WorldAccess` uses of the node class it is mixed into (a ``BtNode``)."""
 

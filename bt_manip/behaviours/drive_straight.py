@@ -15,7 +15,7 @@ from typing import ClassVar
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, RobotAction
+from bt_manip.behaviours.base import ActionFailed, RobotAction, skid_steer_refusal
 from bt_manip.behaviours.navigate import parse_goal
 from bt_manip.bt import registry
 from bt_manip.bt.ports import POSITIVE, Accepts, Port
@@ -68,8 +68,9 @@ class DriveStraight(RobotAction):
 
     def start(self) -> None:
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
-            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        refusal = skid_steer_refusal(robot, "DriveStraight")
+        if refusal is not None:
+            raise ActionFailed(refusal)
         self.goal = parse_goal(self.world, self.get_input("goal"))
         self.back = self.get_input("direction") == "backward"
         x, y, yaw = robot.base_pose2d()

@@ -20,7 +20,7 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, RobotAction
+from bt_manip.behaviours.base import ActionFailed, RobotAction, skid_steer_refusal
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
 from bt_manip.sim import pybullet_queries as pbq
@@ -106,8 +106,9 @@ class GetClear(RobotAction):
 
     def start(self) -> None:
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
-            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        refusal = skid_steer_refusal(robot, "GetClear")
+        if refusal is not None:
+            raise ActionFailed(refusal)
         self.distance = float(self.get_input("distance"))
         self.speed = float(self.get_input("speed"))
         self.timeout = float(self.get_input("timeout"))

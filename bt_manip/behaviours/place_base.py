@@ -28,7 +28,7 @@ import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess
+from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess, skid_steer_refusal
 from bt_manip.behaviours.base_placement import (
     Candidate,
     Placement,
@@ -311,8 +311,9 @@ class PlanBaseForPlace(RobotAction):
 
     def start(self) -> None:
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
-            raise ActionFailed(f"{robot.description.name} has no mobile base")
+        refusal = skid_steer_refusal(robot, "PlanBaseForPlace")
+        if refusal is not None:
+            raise ActionFailed(refusal)
         name = self.get_input("object")
         options = PlacementOptions(
             approach=float(self.get_input("approach")),

@@ -20,7 +20,7 @@ import pybullet as pb
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, RobotAction
+from bt_manip.behaviours.base import ActionFailed, RobotAction, skid_steer_refusal
 from bt_manip.behaviours.navigate import sync_navigator, synced_navigator
 from bt_manip.bt.node import PortError
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Port
@@ -113,8 +113,9 @@ class Nav2Action(RobotAction):
 
     def base(self) -> Any:
         robot = self.robot()
-        if robot.description.base.type != "skid_steer":
-            self.fail(self.UNKNOWN, f"{robot.description.name} has no mobile base")
+        refusal = skid_steer_refusal(robot, self.NODE_ID)
+        if refusal is not None:
+            self.fail(self.UNKNOWN, refusal)
         return robot
 
     def start(self) -> None:

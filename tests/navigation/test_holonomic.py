@@ -11,7 +11,9 @@ from pathlib import Path
 import numpy as np
 import pybullet as pb
 import pytest
+from tree_files import write_tree
 
+from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.navigation.controller import FollowerOptions, FollowState, wrap
 from bt_manip.navigation.footprint import PlanarFootprint
@@ -183,3 +185,20 @@ def test_reverse_backs_a_holonomic_base_straight(tmp_path: Path) -> None:
         assert report.status == "SUCCESS", report.reason
         x, y, yaw = episode.world.robots["omni"].base_pose2d()
     assert -0.4 < x <= -0.3 and abs(y) < 0.01 and abs(yaw) < 0.01
+
+
+@pytest.mark.parametrize(("node", "attrs"), [
+    ("GetClear", ""),
+    ("PlanBaseForGrasp", ' object="block_0" base_pose="{b}"'),
+])
+def test_skid_steer_only_nodes_say_why_they_refuse_a_holonomic_base(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], node: str, attrs: str
+) -> None:
+    tree = write_tree(tmp_path, f'<{node} name="n"{attrs}/>')
+    world = Path(__file__).resolve().parents[2] / "worlds" / "omni_sawyer_room.yaml"
+    assert main(["run", str(tree), "--world", str(world), "--quiet"]) == 1
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first == (
+        f"result: FAILURE (n: omni_sawyer has a holonomic base; {node} drives skid-steer "
+        "bases only (Navigate and Reverse drive every mobile base))"
+    )
