@@ -374,20 +374,35 @@ def plan_base(
         return Placement(
             True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), grasp, q, counts
         )
+    budget_spent = (ik_checks >= options.max_ik_candidates
+                    or path_checks >= options.max_path_checks)
+    return Placement(False, rejections_text(counts, REJECTIONS, budget_spent, last_ik),
+                     counts=counts)
+
+
+REJECTIONS = {
+    "collide": "too close to an obstacle",
+    "no room to line up": "with no room to line up behind them",
+    "reach over": "would reach over an obstacle",
+    "IK": "out of the arm's reach",
+    "no path": "with no path to them",
+}
+"""Why sampled base poses were turned down, by their key in a search's counts."""
+
+
+def rejections_text(
+    counts: dict[str, int], labels: dict[str, str], budget_spent: bool, last_ik: str
+) -> str:
+    """The reason a base-pose search found nothing: how many poses it sampled, how many it
+    turned down for each reason in ``labels`` (in their order), whether its check budget ran
+    out, and the last IK failure."""
     parts = [f"{counts['sampled']} poses sampled"]
-    labels = {
-        "collide": "too close to an obstacle",
-        "no room to line up": "with no room to line up behind them",
-        "reach over": "would reach over an obstacle",
-        "IK": "out of the arm's reach",
-        "no path": "with no path to them",
-    }
     parts += [f"{counts[k]} {text}" for k, text in labels.items() if counts[k]]
-    if ik_checks >= options.max_ik_candidates or path_checks >= options.max_path_checks:
+    if budget_spent:
         parts.append("check budget spent")
     if last_ik:
         parts.append(f"last IK failure: {last_ik}")
-    return Placement(False, "; ".join(parts), counts=counts)
+    return "; ".join(parts)
 
 
 def pose_text(values: Any) -> str:

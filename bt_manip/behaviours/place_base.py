@@ -30,12 +30,14 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess, skid_steer_refusal
 from bt_manip.behaviours.base_placement import (
+    REJECTIONS,
     Candidate,
     Placement,
     PlacementOptions,
     footprint_free,
     planar,
     pose_text,
+    rejections_text,
     sample,
     staging,
     staging_free,
@@ -256,21 +258,18 @@ def plan_place_base(
             counts["no path"] += 1
             continue
         return Placement(True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), frame, q, counts)
-    parts = [f"{counts['sampled']} poses sampled"]
-    labels = {
-        "collide": "too close to an obstacle",
-        "load collides": "with the load too close to an obstacle",
-        "no room to line up": "with no room to line up behind them",
-        "reach over": "would reach over an obstacle",
-        "IK": "out of the arm's reach",
-        "no path": "with no path to them",
-    }
-    parts += [f"{counts[k]} {text}" for k, text in labels.items() if counts[k]]
-    if ik_checks >= options.max_ik_candidates or path_checks >= options.max_path_checks:
-        parts.append("check budget spent")
-    if last_ik:
-        parts.append(f"last IK failure: {last_ik}")
-    return Placement(False, "; ".join(parts), counts=counts)
+    budget_spent = (ik_checks >= options.max_ik_candidates
+                    or path_checks >= options.max_path_checks)
+    return Placement(False, rejections_text(counts, PLACE_REJECTIONS, budget_spent, last_ik),
+                     counts=counts)
+
+
+PLACE_REJECTIONS = {
+    "collide": REJECTIONS["collide"],
+    "load collides": "with the load too close to an obstacle",
+    **{key: text for key, text in REJECTIONS.items() if key != "collide"},
+}
+"""A grasp search's reasons, and the held load's clearance."""
 
 
 @registry.register
