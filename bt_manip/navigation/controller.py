@@ -127,7 +127,58 @@ def wrap(a: float) -> float:
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
-class PathFollower:
+class PathProgress:
+    """What the path followers share: progress along their path and replanning when it is
+    blocked. A follower sets these attributes, and its ``_set_path`` sets ``path``, ``_s``
+    (arc length at each point) and ``_index`` (the progress point)."""
+
+    options: FollowerOptions
+    path: np.ndarray
+    _s: np.ndarray
+    _index: int
+    _phase: str
+    _last_check: float | None
+    replans: int
+    path_blocked: Callable[[np.ndarray], bool] | None
+    replan: Callable[[Pose2D], np.ndarray | str] | None
+
+    def _set_path(self, path: np.ndarray) -> None:
+        raise NotImplementedError
+
+    @property
+    def phase(self) -> str:
+        return self._phase
+
+    def remaining(self) -> float:
+        """Path length (m) from the current progress point to the end."""
+        return float(self._s[-1] - self._s[self._index])
+
+    def _maybe_replan(self, pose: Pose2D, now: float) -> str | None:
+        if self.path_blocked is None or self.replan is None:
+            return None
+        if self._last_check is not None and now - self._last_check < self.options.replan_period:
+            return None
+        self._last_check = now
+        if not self.path_blocked(self.path[self._index :]):
+            return None
+        new = self.replan(pose)
+        if isinstance(new, str):
+            return f"path blocked and no new path: {new}"
+        self.replans += 1
+        self._set_path(np.asarray(new, dtype=float))
+        self._phase = "drive"
+        return None
+
+    def _advance(self, x: float, y: float) -> None:
+        """Move the progress index to the closest path point within a window ahead."""
+        lo = self._index
+        hi = int(np.searchsorted(self._s, self._s[lo] + 1.5, side="right"))
+        hi = min(max(hi, lo + 2), len(self.path))
+        d = np.hypot(self.path[lo:hi, 0] - x, self.path[lo:hi, 1] - y)
+        self._index = lo + int(np.argmin(d))
+
+
+class PathFollower(PathProgress):
     """Pure pursuit of the pivot point along ``path`` (n, 2), then a turn to the goal heading.
 
     ``goal`` is the base frame's goal, (x, y, yaw) or (x, y) for no final turn. ``path`` is
@@ -224,14 +275,6 @@ class PathFollower:
         there is no goal heading)."""
         end_yaw = yaw if self.goal_yaw is None else self.goal_yaw
         return self.pivot_point((*self.goal_xy, end_yaw), self.turn_pivot)
-
-    @property
-    def phase(self) -> str:
-        return self._phase
-
-    def remaining(self) -> float:
-        """Path length (m) from the current progress point to the end."""
-        return float(self._s[-1] - self._s[self._index])
 
     # -- one tick -----------------------------------------------------------------------------
     def update(self, pose: Pose2D, now: float) -> FollowStatus:
@@ -344,30 +387,6 @@ class PathFollower:
             return self.remaining()
         ex, ey = self.path_end
         return (ex - x) * self._end_dir[0] + (ey - y) * self._end_dir[1]
-
-    def _maybe_replan(self, pose: Pose2D, now: float) -> str | None:
-        if self.path_blocked is None or self.replan is None:
-            return None
-        if self._last_check is not None and now - self._last_check < self.options.replan_period:
-            return None
-        self._last_check = now
-        if not self.path_blocked(self.path[self._index :]):
-            return None
-        new = self.replan(pose)
-        if isinstance(new, str):
-            return f"path blocked and no new path: {new}"
-        self.replans += 1
-        self._set_path(np.asarray(new, dtype=float))
-        self._phase = "drive"
-        return None
-
-    def _advance(self, x: float, y: float) -> None:
-        """Move the progress index to the closest path point within a window ahead."""
-        lo = self._index
-        hi = int(np.searchsorted(self._s, self._s[lo] + 1.5, side="right"))
-        hi = min(max(hi, lo + 2), len(self.path))
-        d = np.hypot(self.path[lo:hi, 0] - x, self.path[lo:hi, 1] - y)
-        self._index = lo + int(np.argmin(d))
 
     def _lookahead_point(self, distance: float) -> tuple[float, float]:
         """The path point ``distance`` ahead of the progress point; past the end, the path's

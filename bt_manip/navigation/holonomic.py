@@ -53,6 +53,7 @@ from bt_manip.navigation.controller import (
     FollowerOptions,
     FollowState,
     FollowStatus,
+    PathProgress,
     Pose2D,
     wrap,
 )
@@ -114,7 +115,7 @@ def base_limited(options: FollowerOptions, base: Any) -> FollowerOptions:
     )
 
 
-class HolonomicFollower:
+class HolonomicFollower(PathProgress):
     """Follows ``path`` (n, 2) of the base frame to ``goal`` (x, y, yaw), or (x, y) to keep the
     heading, driving sideways as needed; see the module docstring."""
 
@@ -160,14 +161,6 @@ class HolonomicFollower:
         """Unit direction of each segment (NaN for a segment of no length)."""
         self._index = 0
         self._best = math.inf
-
-    @property
-    def phase(self) -> str:
-        return self._phase
-
-    def remaining(self) -> float:
-        """Path length (m) from the current progress point to the end."""
-        return float(self._s[-1] - self._s[self._index])
 
     # -- one tick -----------------------------------------------------------------------------
     def update(self, pose: Pose2D, now: float) -> HolonomicStatus:
@@ -333,30 +326,6 @@ class HolonomicFollower:
         self._w = 0.0
         self._done = HolonomicStatus(state, reason, (0.0, 0.0), self._phase)
         return self._done
-
-    def _maybe_replan(self, pose: Pose2D, now: float) -> str | None:
-        if self.path_blocked is None or self.replan is None:
-            return None
-        if self._last_check is not None and now - self._last_check < self.options.replan_period:
-            return None
-        self._last_check = now
-        if not self.path_blocked(self.path[self._index :]):
-            return None
-        new = self.replan(pose)
-        if isinstance(new, str):
-            return f"path blocked and no new path: {new}"
-        self.replans += 1
-        self._set_path(np.asarray(new, dtype=float))
-        self._phase = "drive"
-        return None
-
-    def _advance(self, x: float, y: float) -> None:
-        """Move the progress index to the closest path point within a window ahead."""
-        lo = self._index
-        hi = int(np.searchsorted(self._s, self._s[lo] + 1.5, side="right"))
-        hi = min(max(hi, lo + 2), len(self.path))
-        d = np.hypot(self.path[lo:hi, 0] - x, self.path[lo:hi, 1] - y)
-        self._index = lo + int(np.argmin(d))
 
     def _lookahead_point(self, distance: float) -> tuple[float, float]:
         """The path point ``distance`` ahead of the progress point (the end at most)."""
