@@ -16,10 +16,9 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction, skid_steer_refusal
-from bt_manip.behaviours.navigate import parse_goal
+from bt_manip.behaviours.navigate import base_contacts, parse_goal
 from bt_manip.bt import registry
 from bt_manip.bt.ports import POSITIVE, Accepts, Port
-from bt_manip.sim import pybullet_queries as pbq
 
 DRIVE_OVER = 0.02
 """Bodies lower than this (m) are driven over: the navigator maps nothing lower either."""
@@ -91,19 +90,7 @@ class DriveStraight(RobotAction):
     def _contacts(self) -> set[str]:
         """Bodies the robot or its load touch now, except the floor and what is low enough to
         drive over (the rails of an empty stand)."""
-        world = self.world
-        robot = self.robot()
-        ground = world.body_id("ground")
-        mine = {robot.body} | {a.object_body for a in world.attachments.held_by(self.robot_name())}
-        out = set()
-        for body in mine:
-            for other in pbq.touching(world.client, body):
-                if other == ground or other in mine:
-                    continue
-                if pbq.aabb(world.client, other).upper[2] < DRIVE_OVER:
-                    continue
-                out.add(world.name_of(other) or str(other))
-        return out
+        return base_contacts(self.world, self.robot(), self.robot_name(), DRIVE_OVER)
 
     def step(self) -> Status:
         robot = self.robot()

@@ -192,6 +192,22 @@ class Navigate(RobotAction):
             self.overlay.show_path("base_plan", np.asarray(polyline)[:, :2])
 
 
+def base_contacts(world: Any, robot: Any, robot_name: str, drive_over: float = 0.0) -> set[str]:
+    """Names of the bodies other than the floor that ``robot`` or the objects it holds touch
+    now, leaving out bodies whose top is lower than ``drive_over`` (m) above the floor (what
+    the base can drive over)."""
+    ground = world.body_id("ground")
+    mine = {robot.body} | {a.object_body for a in world.attachments.held_by(robot_name)}
+    out = set()
+    for body in mine:
+        for other in pbq.touching(world.client, body):
+            if other == ground or other in mine:
+                continue
+            if drive_over > 0.0 and pbq.aabb(world.client, other).upper[2] < drive_over:
+                continue
+            out.add(world.name_of(other) or str(other))
+    return out
+
 @registry.register
 class Reverse(RobotAction):
     """Drives the base straight backwards by ``distance`` metres at ``speed`` (a recovery to
@@ -224,16 +240,7 @@ class Reverse(RobotAction):
 
     def _contacts(self) -> set[str]:
         """Bodies other than the floor that the robot or its load touch now."""
-        world = self.world
-        robot = self.robot()
-        ground = world.body_id("ground")
-        mine = {robot.body} | {a.object_body for a in world.attachments.held_by(self.robot_name())}
-        out = set()
-        for body in mine:
-            for other in pbq.touching(world.client, body):
-                if other != ground and other not in mine:
-                    out.add(world.name_of(other) or str(other))
-        return out
+        return base_contacts(self.world, self.robot(), self.robot_name())
 
     def step(self) -> Status:
         robot = self.robot()

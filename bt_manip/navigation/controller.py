@@ -145,6 +145,18 @@ class PathProgress:
     def _set_path(self, path: np.ndarray) -> None:
         raise NotImplementedError
 
+    def _take_path(self, path: np.ndarray) -> np.ndarray:
+        """Check ``path`` (n, 2), keep it (one point becomes a path of two) with its arc
+        lengths ``_s``; returns the lengths of its stretches."""
+        if path.ndim != 2 or path.shape[1] != 2 or len(path) == 0:
+            raise ValueError("path must be an (n, 2) array with at least one point")
+        if len(path) == 1:
+            path = np.vstack([path, path])
+        self.path = path
+        seg: np.ndarray = np.hypot(*np.diff(path, axis=0).T)
+        self._s = np.concatenate([[0.0], np.cumsum(seg)])
+        return seg
+
     @property
     def phase(self) -> str:
         return self._phase
@@ -224,13 +236,8 @@ class PathFollower(PathProgress):
         self._done: FollowStatus | None = None
 
     def _set_path(self, path: np.ndarray) -> None:
-        if path.ndim != 2 or path.shape[1] != 2 or len(path) == 0:
-            raise ValueError("path must be an (n, 2) array with at least one point")
-        if len(path) == 1:
-            path = np.vstack([path, path])
-        self.path = path
-        seg = np.hypot(*np.diff(path, axis=0).T)
-        self._s = np.concatenate([[0.0], np.cumsum(seg)])
+        self._take_path(path)
+        path = self.path
         self._index = 0
         self._best = math.inf
         # direction of the path's last stretch (from 0.2 m before the end)

@@ -148,13 +148,8 @@ class HolonomicFollower(PathProgress):
         self._done: HolonomicStatus | None = None
 
     def _set_path(self, path: np.ndarray) -> None:
-        if path.ndim != 2 or path.shape[1] != 2 or len(path) == 0:
-            raise ValueError("path must be an (n, 2) array with at least one point")
-        if len(path) == 1:
-            path = np.vstack([path, path])
-        self.path = path
-        seg = np.hypot(*np.diff(path, axis=0).T)
-        self._s = np.concatenate([[0.0], np.cumsum(seg)])
+        seg = self._take_path(path)
+        path = self.path
         with np.errstate(invalid="ignore", divide="ignore"):
             dirs = np.diff(path, axis=0) / seg[:, None]
         self._dirs = np.where(seg[:, None] > 1e-9, dirs, np.nan)
