@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -296,6 +297,124 @@ def reach(
     return np.asarray(q, dtype=float), ""
 
 
+@dataclass(frozen=True)
+class SearchSite:
+    """What a base-pose search checks its candidates against: the navigator's grid and the
+    robot's footprint on it, where the robot stands now and where its arm sits on the base."""
+
+    nav: Any
+    """The robot's navigator: its grid planner gives the path check (``plan_to``)."""
+    clear: np.ndarray
+    """Clearance (m) of each cell of the navigator's occupancy grid."""
+    occupied: np.ndarray
+    origin: np.ndarray
+    res: float
+    pts: np.ndarray
+    """Points (x, y; robot frame) round the footprint the poses are checked with."""
+    turning: float
+    """Clearance (m) around the pivot the robot needs to turn on the spot at a staging pose."""
+    pose: tuple[float, float, float]
+    """Where the robot stands now (x, y, yaw)."""
+    arm_in_base: np.ndarray
+    """The arm's base in the robot's planar frame (4x4)."""
+
+    @classmethod
+    def of(cls, nav: Any, robot: Any, footprint: Any) -> SearchSite:
+        """The site of ``robot`` on its (refreshed) navigator ``nav``, checked with
+        ``footprint`` (a PlanarFootprint)."""
+        grid = nav.costmap.grid
+        x0, y0, yaw0 = robot.base_pose2d()
+        arm = robot.link_transform(robot.description.arm.base_link)
+        return cls(
+            nav, nav.costmap.clear, grid.occupied, np.asarray(grid.origin, dtype=float),
+            float(grid.resolution), outline_samples(footprint), float(footprint.circumradius),
+            (x0, y0, yaw0), np.linalg.inv(planar(x0, y0, yaw0)) @ arm,
+        )
+
+
+@dataclass(frozen=True)
+class ExtraCheck:
+    """A check a base-pose search makes besides its own (PlanBaseForPlace: the held load)."""
+
+    key: str
+    """What a pose :attr:`at_pose` turns down is counted as (a key of the search's labels)."""
+    at_pose: Callable[[Candidate], bool]
+    """Whether the pose passes; asked right after the footprint check."""
+    lines_up: Callable[[Candidate, tuple[float, float, float]], bool]
+    """Whether the robot lines up at the staging pose (the second argument) and drives in to
+    the pose; asked with the footprint's line-up check, turned down as "no room to line up"."""
+
+
+Reach = Callable[[Candidate, np.ndarray], tuple[np.ndarray | None, np.ndarray | None, str]]
+"""The IK check of a search: for a candidate and where the arm's base is then (4x4, world),
+the joint values and the frame the arm reaches (None, None when it reaches none) and the last
+IK failure on the way ("" when there was none)."""
+
+
+def search_bases(
+    candidates: list[Candidate],
+    site: SearchSite,
+    options: PlacementOptions,
+    goal_xy: np.ndarray,
+    reach: Reach,
+    labels: dict[str, str],
+    extra: ExtraCheck | None = None,
+) -> Placement:
+    """The first of ``candidates`` that passes every check, in this order: the footprint's
+    clearance, ``extra``'s check of the pose, room to line up at the staging pose (the
+    footprint's and ``extra``'s), the arm's way to ``goal_xy`` clear of obstacles, ``reach``
+    (at most :attr:`PlacementOptions.max_ik_candidates` times) and a path from where the robot
+    stands to the staging pose (at most :attr:`PlacementOptions.max_path_checks` times).
+    Otherwise a Placement that is not ok, whose reason counts the poses turned down under
+    each key of ``labels`` (the checks' keys: "collide", "no room to line up", "reach over",
+    "IK", "no path" and ``extra``'s)."""
+    counts = {"sampled": len(candidates), **dict.fromkeys(labels, 0)}
+    s = site
+    x0, y0, yaw0 = s.pose
+    pivot = options.pivot
+    ik_checks = path_checks = 0
+    last_ik = ""
+    for cand in candidates:
+        if not footprint_free(s.clear, s.origin, s.res, s.pts, cand, options.clearance):
+            counts["collide"] += 1
+            continue
+        if extra is not None and not extra.at_pose(cand):
+            counts[extra.key] += 1
+            continue
+        sx, sy, syaw = staging(cand, options)
+        if not staging_free(s.clear, s.origin, s.res, s.pts, cand, options, s.turning) or (
+            extra is not None and not extra.lines_up(cand, (sx, sy, syaw))
+        ):
+            counts["no room to line up"] += 1
+            continue
+        arm_world = planar(cand.x, cand.y, cand.yaw) @ s.arm_in_base
+        if not way_clear(s.occupied, s.origin, s.res, arm_world[:2, 3], goal_xy):
+            counts["reach over"] += 1
+            continue
+        if ik_checks >= options.max_ik_candidates:
+            break
+        ik_checks += 1
+        q, frame, why = reach(cand, arm_world)
+        if why:
+            last_ik = why
+        if q is None:
+            counts["IK"] += 1
+            continue
+        if path_checks >= options.max_path_checks:
+            break
+        path_checks += 1
+        start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
+        goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
+        if not s.nav.plan_to(start, goal).ok:
+            counts["no path"] += 1
+            continue
+        return Placement(True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), frame, q, counts)
+    budget_spent = (ik_checks >= options.max_ik_candidates
+                    or path_checks >= options.max_path_checks)
+    return Placement(False, rejections_text(counts, labels, budget_spent, last_ik),
+                     counts=counts)
+
+
 def plan_base(
     node: WorldAccess,
     robot: Any,
@@ -310,14 +429,8 @@ def plan_base(
     nav = synced_navigator(node, robot)
     nav.refresh()
     options = dataclasses.replace(options, pivot=float(nav.pivot))
-    grid = nav.costmap.grid
-    clear = nav.costmap.clear
-    origin = np.asarray(grid.origin, dtype=float)
-    res = float(grid.resolution)
-    pts = outline_samples(nav.footprint)
-    x0, y0, yaw0 = robot.base_pose2d()
-    arm = robot.link_transform(robot.description.arm.base_link)
-    arm_in_base = np.linalg.inv(planar(x0, y0, yaw0)) @ arm
+    site = SearchSite.of(nav, robot, nav.footprint)
+    x0, y0, yaw0 = site.pose
     services = node.run_context.robot_services(node.robot_name_of(robot))
     ik = arm_ik(services, robot.description.grasp_frame)
     seed = robot.arm_positions()
@@ -331,53 +444,18 @@ def plan_base(
     grasp0 = object_grasp(node, robot, name, kind, yaw0)
     grasp_xy = grasp0[:2, 3]
     candidates = sample(
-        grasp_xy, arm_in_base[:2, 3], np.array([x0, y0]), options,
+        grasp_xy, site.arm_in_base[:2, 3], np.array([x0, y0]), options,
         long_side(node, name),
     )
-    counts = {
-        "sampled": len(candidates), "collide": 0, "no room to line up": 0, "reach over": 0,
-        "IK": 0, "no path": 0,
-    }
-    turning = float(nav.footprint.circumradius)
-    ik_checks = path_checks = 0
-    last_ik = ""
-    pivot = float(nav.pivot)
-    for cand in candidates:
-        if not footprint_free(clear, origin, res, pts, cand, options.clearance):
-            counts["collide"] += 1
-            continue
-        if not staging_free(clear, origin, res, pts, cand, options, turning):
-            counts["no room to line up"] += 1
-            continue
-        arm_world = planar(cand.x, cand.y, cand.yaw) @ arm_in_base
-        if not way_clear(grid.occupied, origin, res, arm_world[:2, 3], grasp_xy):
-            counts["reach over"] += 1
-            continue
-        if ik_checks >= options.max_ik_candidates:
-            break
-        ik_checks += 1
+
+    def reach_grasp(
+        cand: Candidate, arm_world: np.ndarray
+    ) -> tuple[np.ndarray | None, np.ndarray | None, str]:
         grasp = object_grasp(node, robot, name, kind, cand.yaw)
         q, why = reach(ik, arm_world, grasp, options.approach, seed)
-        if q is None:
-            counts["IK"] += 1
-            last_ik = why
-            continue
-        if path_checks >= options.max_path_checks:
-            break
-        path_checks += 1
-        sx, sy, syaw = staging(cand, options)
-        start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
-        goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
-        if not nav.plan_to(start, goal).ok:
-            counts["no path"] += 1
-            continue
-        return Placement(
-            True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), grasp, q, counts
-        )
-    budget_spent = (ik_checks >= options.max_ik_candidates
-                    or path_checks >= options.max_path_checks)
-    return Placement(False, rejections_text(counts, REJECTIONS, budget_spent, last_ik),
-                     counts=counts)
+        return q, (grasp if q is not None else None), why
+
+    return search_bases(candidates, site, options, grasp_xy, reach_grasp, REJECTIONS)
 
 
 REJECTIONS = {

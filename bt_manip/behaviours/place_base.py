@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -32,16 +33,16 @@ from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess, ski
 from bt_manip.behaviours.base_placement import (
     REJECTIONS,
     Candidate,
+    ExtraCheck,
     Placement,
     PlacementOptions,
+    SearchSite,
     footprint_free,
     planar,
     pose_text,
-    rejections_text,
     sample,
-    staging,
+    search_bases,
     staging_free,
-    way_clear,
 )
 from bt_manip.behaviours.cartesian import STEP, arm_ik
 from bt_manip.behaviours.place import (
@@ -57,7 +58,7 @@ from bt_manip.behaviours.place import (
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
 from bt_manip.grasps import GraspError, box_size
-from bt_manip.navigation.lattice import outline_samples
+from bt_manip.navigation.lattice import LatticeOptions, outline_samples, pose_free
 from bt_manip.perception import true_pose
 from bt_manip.placing import Target, yaw_of_matrix
 
@@ -143,27 +144,45 @@ def load_samples(size: tuple[float, float, float], object_in_base: np.ndarray) -
     return out
 
 
-def carry_fits(nav: Any) -> Any:
+def carry_fits(nav: Any) -> Callable[[Candidate], bool] | None:
     """A test of whether the carrying robot fits at a candidate pose as the navigator checks a
     goal when it plans over poses with a load (its own layers and clearance), or None when the
     navigator has no load layers."""
-    from bt_manip.navigation.lattice import LatticeOptions, _pose_free
-
-    nav._build_carry_layers()  # the layers hold the movable objects where they are now
-    carry = getattr(nav, "_carry", None)
+    carry = nav.carry_layers()  # the layers hold the movable objects where they are now
     if carry is None:
         return None
     low_fp, high_fp, low, clear_low, clear_high = carry
     pts = outline_samples(low_fp, 0.05)
     pts_high = outline_samples(high_fp, 0.05)
     need = LatticeOptions().min_clearance + low.resolution / math.sqrt(2.0)
-    x0, y0 = low.origin
 
     def fits(cand: Candidate) -> bool:
-        return bool(_pose_free(clear_low, clear_high, x0, y0, low.resolution, pts, pts_high,
-                               cand.x, cand.y, cand.yaw, need))
+        return pose_free(clear_low, clear_high, low.origin, low.resolution, pts, pts_high,
+                         (cand.x, cand.y, cand.yaw), need)
 
     return fits
+
+
+def load_check(
+    site: SearchSite, load: np.ndarray, options: PlacementOptions,
+    fits: Callable[[Candidate], bool] | None,
+) -> ExtraCheck:
+    """The held load's check: its outline ``load`` (robot frame) :data:`LOAD_CLEARANCE` from
+    every obstacle of the grid at the pose and all the way in from the staging pose, and the
+    robot with its load fitting at both as the navigator plans a carry (``fits``)."""
+    load_options = dataclasses.replace(options, clearance=LOAD_CLEARANCE)
+
+    def at_pose(cand: Candidate) -> bool:
+        return footprint_free(site.clear, site.origin, site.res, load, cand, LOAD_CLEARANCE) and (
+            fits is None or fits(cand)
+        )
+
+    def lines_up(cand: Candidate, staged: tuple[float, float, float]) -> bool:
+        return staging_free(site.clear, site.origin, site.res, load, cand, load_options, 0.0) and (
+            fits is None or fits(Candidate(*staged, 0.0, 0.0, 0.0))
+        )
+
+    return ExtraCheck("load collides", at_pose, lines_up)
 
 
 def plan_place_base(
@@ -178,15 +197,9 @@ def plan_place_base(
     nav = synced_navigator(node, robot)
     nav.refresh()
     options = dataclasses.replace(options, pivot=float(nav.pivot))
-    grid = nav.costmap.grid
-    clear = nav.costmap.clear
-    origin = np.asarray(grid.origin, dtype=float)
-    res = float(grid.resolution)
-    pts = outline_samples(nav.base_footprint)
-    x0, y0, yaw0 = robot.base_pose2d()
+    site = SearchSite.of(nav, robot, nav.base_footprint)
+    x0, y0, yaw0 = site.pose
     base_now = planar(x0, y0, yaw0)
-    arm = robot.link_transform(robot.description.arm.base_link)
-    arm_in_base = np.linalg.inv(base_now) @ arm
     services = node.run_context.robot_services(node.robot_name_of(robot))
     tip = robot.description.grasp_frame
     ik = arm_ik(services, tip)
@@ -198,8 +211,7 @@ def plan_place_base(
     except GraspError as exc:
         raise ActionFailed(f"cannot place '{name}': {exc}") from None
     load = load_samples(size, np.linalg.inv(base_now) @ object_now)
-    load_options = dataclasses.replace(options, clearance=LOAD_CLEARANCE)
-    fits = carry_fits(nav)
+    extra = load_check(site, load, options, carry_fits(nav))
     frames = [lifted(f, gap) for f in place_frames(target, np.linalg.inv(hand) @ object_now, hand)]
     goal_xy = frames[0][:2, 3]
     relative_now = yaw_of_matrix(object_now) - yaw0
@@ -207,61 +219,22 @@ def plan_place_base(
     def turn(cand: Candidate) -> float:
         return abs(wrap_half(target.yaw - cand.yaw - relative_now))
 
-    rings = sample(goal_xy, arm_in_base[:2, 3], np.array([x0, y0]), options)
+    rings = sample(goal_xy, site.arm_in_base[:2, 3], np.array([x0, y0]), options)
     rings.sort(key=lambda c: c.score(options.preferred_distance) + turn(c) / TURN_WEIGHT)
     candidates = mirrored(target, object_now, base_now, goal_xy) + rings
-    counts = {
-        "sampled": len(candidates), "collide": 0, "load collides": 0, "no room to line up": 0,
-        "reach over": 0, "IK": 0, "no path": 0,
-    }
-    turning = float(nav.base_footprint.circumradius)
-    ik_checks = path_checks = 0
-    last_ik = ""
-    pivot = float(nav.pivot)
-    for cand in candidates:
-        if not footprint_free(clear, origin, res, pts, cand, options.clearance):
-            counts["collide"] += 1
-            continue
-        if not footprint_free(clear, origin, res, load, cand, LOAD_CLEARANCE) or (
-            fits is not None and not fits(cand)
-        ):
-            counts["load collides"] += 1
-            continue
-        sx, sy, syaw = staging(cand, options)
-        if not staging_free(clear, origin, res, pts, cand, options, turning) or not (
-            staging_free(clear, origin, res, load, cand, load_options, 0.0)
-        ) or (fits is not None and not fits(Candidate(sx, sy, syaw, 0.0, 0.0, 0.0))):
-            counts["no room to line up"] += 1
-            continue
-        arm_world = planar(cand.x, cand.y, cand.yaw) @ arm_in_base
-        if not way_clear(grid.occupied, origin, res, arm_world[:2, 3], goal_xy):
-            counts["reach over"] += 1
-            continue
-        if ik_checks >= options.max_ik_candidates:
-            break
-        ik_checks += 1
-        q = None
+
+    def reach_place(
+        cand: Candidate, arm_world: np.ndarray
+    ) -> tuple[np.ndarray | None, np.ndarray | None, str]:
+        last = ""
         for frame in frames:
             q, why = reach_down(ik, arm_world, frame, options.approach, seed)
             if q is not None:
-                break
-            last_ik = why
-        if q is None:
-            counts["IK"] += 1
-            continue
-        if path_checks >= options.max_path_checks:
-            break
-        path_checks += 1
-        start = (x0 + pivot * math.cos(yaw0), y0 + pivot * math.sin(yaw0), yaw0)
-        goal = (sx + pivot * math.cos(syaw), sy + pivot * math.sin(syaw), syaw)
-        if not nav.plan_to(start, goal).ok:
-            counts["no path"] += 1
-            continue
-        return Placement(True, "", (cand.x, cand.y, cand.yaw), (sx, sy, syaw), frame, q, counts)
-    budget_spent = (ik_checks >= options.max_ik_candidates
-                    or path_checks >= options.max_path_checks)
-    return Placement(False, rejections_text(counts, PLACE_REJECTIONS, budget_spent, last_ik),
-                     counts=counts)
+                return q, frame, last
+            last = why
+        return None, None, last
+
+    return search_bases(candidates, site, options, goal_xy, reach_place, PLACE_REJECTIONS, extra)
 
 
 PLACE_REJECTIONS = {

@@ -357,6 +357,17 @@ def _pose_free(
     )
 
 
+def pose_free(
+    clear: np.ndarray, clear_high: np.ndarray, origin: tuple[float, float], res: float,
+    pts: np.ndarray, pts_high: np.ndarray, pose: tuple[float, float, float], need: float,
+) -> bool:
+    """Whether the robot at ``pose`` keeps ``need`` m from obstacles as :func:`plan_poses`
+    checks a goal: points ``pts`` (robot frame) on the clearance grid ``clear``, carried-object
+    points ``pts_high`` on ``clear_high`` (grids of origin ``origin``, cells of ``res`` m)."""
+    x0, y0 = origin
+    return bool(_pose_free(clear, clear_high, x0, y0, res, pts, pts_high, *pose, need))
+
+
 @numba.njit(cache=True)
 def _points_margin(
     clear: np.ndarray,

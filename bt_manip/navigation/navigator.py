@@ -289,6 +289,13 @@ class Navigator:
         self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
         self._carry_high = high
 
+    def carry_layers(self) -> tuple | None:
+        """The carrying robot's layers (chassis footprint, arm-and-load footprint, chassis grid,
+        its clearance, the upper slab's clearance) rebuilt where the movable objects are now;
+        None when nothing is carried or the base is holonomic."""
+        self._build_carry_layers()
+        return self._carry
+
     # -- planning and following ---------------------------------------------------------------
     def plan_to(self, start: Pose2D, goal: Pose2D) -> NavPlan:
         """A plan from ``start`` to ``goal`` for the current footprint and map."""

@@ -16,6 +16,7 @@ import pybullet as pb
 import pytest
 
 from bt_manip.navigation.controller import FollowState, wrap
+from bt_manip.navigation.lattice import outline_samples, pose_free
 from bt_manip.navigation.navigator import Navigator, NavigatorOptions
 from bt_manip.navigation.planner import PlanOutcome
 from bt_manip.sim.world import World
@@ -310,3 +311,25 @@ def test_a_crate_that_fell_after_the_attach_is_avoided_while_carrying() -> None:
         assert d.status is FollowState.SUCCEEDED, d.reason
         assert d.touched == set(), f"robot or panel touched {d.touched}"
         assert crate in world.movable.values()
+
+
+def test_carry_layers_and_pose_free_check_the_robot_with_its_load() -> None:
+    with World(WORLD, seed=0) as world:
+        lift_panel(world)
+        robot = world.robots["husky"]
+        nav = make_nav(world)
+        assert nav.carry_layers() is None  # nothing carried yet
+        nav.attach(world.movable["panel"], "panel")
+        layers = nav.carry_layers()
+        assert layers is not None
+        low_fp, high_fp, low, clear_low, clear_high = layers
+        pts, pts_high = outline_samples(low_fp), outline_samples(high_fp)
+        need = low.resolution / math.sqrt(2.0)
+        here = robot.base_pose2d()
+        assert pose_free(clear_low, clear_high, low.origin, low.resolution, pts, pts_high,
+                         here, need)
+        row, col = np.argwhere(low.occupied)[0]
+        wall = (low.origin[0] + (col + 0.5) * low.resolution,
+                low.origin[1] + (row + 0.5) * low.resolution, 0.0)
+        assert not pose_free(clear_low, clear_high, low.origin, low.resolution, pts, pts_high,
+                             wall, need)
