@@ -11,6 +11,7 @@ Verbs:
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
   demo [--out DIR]           Scenario A headless: summary, run report, replay page
   examples [copy DIR]        list the shipped trees, worlds and robots, or copy them
+  schema [NAME]              list the JSON Schemas of the output files, or print one
 
 A tree or world named by a relative path that does not exist here but is a shipped example
 (``trees/husky_carry_wall.xml``) is read from the shipped examples (see bt_manip.bundled).
@@ -356,6 +357,10 @@ def build_parser() -> argparse.ArgumentParser:
     from bt_manip.examples_command import add_example_verbs
 
     add_example_verbs(sub)
+
+    from bt_manip.schemas import add_schema_verb
+
+    add_schema_verb(sub)
 
     try:
         from bt_manip.bt.cli_verbs import add_verbs

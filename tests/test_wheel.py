@@ -29,9 +29,17 @@ def _run(argv: list[str], cwd: Path, timeout: float) -> subprocess.CompletedProc
                           timeout=timeout, stdin=subprocess.DEVNULL)
 
 
+SCHEMAS = ROOT / "docs" / "schemas"
+
+
 def _shipped_files() -> set[str]:
     return {p.relative_to(ROOT).as_posix() for folder in SHIPPED
             for p in (ROOT / folder).rglob("*") if p.is_file()}
+
+
+def _schema_files() -> set[str]:
+    """The JSON Schemas, as the wheel keeps them (``bt_manip/_data/schemas/...``)."""
+    return {f"schemas/{p.name}" for p in SCHEMAS.iterdir() if p.is_file()}
 
 
 def test_the_wheel_installs_in_a_fresh_venv_and_runs_the_demo_from_an_empty_folder(
@@ -50,13 +58,15 @@ def test_the_wheel_installs_in_a_fresh_venv_and_runs_the_demo_from_an_empty_fold
     tops = {n.split("/")[0] for n in names}
     assert tops == {"bt_manip", f"bt_manip-{bt_manip.__version__}.dist-info"}
     data = {n.removeprefix("bt_manip/_data/") for n in names if n.startswith("bt_manip/_data/")}
-    assert data == _shipped_files()
+    assert data == _shipped_files() | _schema_files()
+    assert "schemas/run-report.schema.json" in data
     assert "bt_manip/viz/static/replay.js" in names
     assert not any("__pycache__" in n or n.endswith(".pyc") for n in names)
     # the sdist carries the example folders the wheel is built from, not the tests
     with tarfile.open(sdist) as archive:
         members = {m.split("/", 1)[1] for m in archive.getnames() if "/" in m}
     assert _shipped_files() <= members and "CHANGELOG.md" in members
+    assert {f"docs/{name}" for name in _schema_files()} <= members
     assert not any(m.startswith(("tests/", "out/", ".venv/")) for m in members)
 
     venv = tmp_path / "venv"
@@ -72,10 +82,14 @@ def test_the_wheel_installs_in_a_fresh_venv_and_runs_the_demo_from_an_empty_fold
     version = _run([cli, "--version"], empty, 120)
     assert version.stdout.strip() == f"bt-manip {bt_manip.__version__}", version.stderr
     where = _run([str(venv / "bin" / "python"), "-c",
-                  "import site, bt_manip.sim.assets as a; "
-                  "print(a.data_root()); print(site.getsitepackages()[0])"], empty, 120)
-    data_root, site_packages = where.stdout.split()
+                  "import site, bt_manip.sim.assets as a, bt_manip.schemas as s; "
+                  "print(a.data_root()); print(site.getsitepackages()[0]); "
+                  "print(s.schema_path('run-report'))"], empty, 120)
+    data_root, site_packages, schema = where.stdout.split()
     assert Path(data_root) == Path(site_packages) / "bt_manip" / "_data", where.stderr
+    # what `bt-manip schema run-report` prints: the wheel's copy of the run report's schema
+    assert Path(schema) == Path(data_root) / "schemas" / "run-report.schema.json"
+    assert Path(schema).read_bytes() == (SCHEMAS / "run-report.schema.json").read_bytes()
 
     demo = _run([cli, "demo", "--quiet"], empty, 600)
     assert demo.returncode == 0, demo.stdout[-3000:] + demo.stderr[-3000:]
