@@ -43,6 +43,7 @@ from bt_manip.bt.ports import (
     convert_literal,
     format_literal,
     parse_reference,
+    takes_infinity,
     value_problem,
 )
 from bt_manip.bt.script import Script, ScriptRuntimeError, ScriptSyntaxError, parse_script
@@ -206,7 +207,7 @@ class BtNode(PortsMixin):
                 check.texts[port] = value
                 return
             try:
-                converted = convert_literal(value, info.data_type)
+                converted = convert_literal(value, info.data_type, takes_infinity(info))
             except ValueError as e:
                 check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {e}", None))
                 return
@@ -271,7 +272,7 @@ class BtNode(PortsMixin):
                 f"'{binding.key}', which {state}") from None
         if isinstance(value, str) and info.data_type is not str:
             try:
-                value = convert_literal(value, info.data_type)
+                value = convert_literal(value, info.data_type, takes_infinity(info))
             except ValueError as e:
                 raise PortError(
                     f"{self.describe()}: input port '{port_name}' (entry '{binding.key}'): {e}"

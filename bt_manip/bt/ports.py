@@ -32,8 +32,10 @@ class Accepts:
     ``low``/``high`` bound a number (inclusive, unless ``low_open``/``high_open``); ``choices``
     lists the only values allowed; ``also`` lists values allowed outside the range (such as a
     ``-1`` meaning "all"). For a list port the rule applies to each item. Numbers of a ``float``
-    port must be finite whatever the rule. ``check`` is a further test of the whole value for
-    rules a range cannot say: it returns what is wrong, or None.
+    port must be finite unless ``also`` holds ``math.inf`` (or ``-math.inf``): such a port
+    takes that infinity, written ``inf`` or ``infinity`` in any case, with a sign or not, as
+    BT.CPP's ``convertFromString<double>`` (``std::stod``) reads them. ``check`` is a further
+    test of the whole value for rules a range cannot say: it returns what is wrong, or None.
     """
 
     low: float | None = None
@@ -82,6 +84,10 @@ class Accepts:
 
 NON_NEGATIVE = Accepts(low=0)
 POSITIVE = Accepts(low=0, low_open=True)
+NON_NEGATIVE_OR_INF = Accepts(low=0, also=(math.inf,))
+"""A length or a time that may be unbounded: ``inf`` (or ``infinity``) in XML."""
+INFINITY_TEXTS = ("inf", "infinity")
+"""How an infinite number is written in a port literal (any case, with a sign or not)."""
 
 
 @dataclass(frozen=True)
@@ -104,6 +110,14 @@ def count_of(*counts: int) -> Accepts:
     return Accepts(check=check)
 
 
+def takes_infinity(info: PortInformation) -> bool:
+    """Whether the port ``info`` takes an infinite number (its rule's ``also`` holds one)."""
+    rule: Accepts | None = getattr(info, "accepts", None)
+    return rule is not None and any(
+        isinstance(a, float) and math.isinf(a) for a in rule.also
+    )
+
+
 def value_problem(info: PortInformation, value: Any, text: str | None = None) -> str | None:
     """Why ``value`` cannot go through the port ``info``, or None when it can.
 
@@ -113,9 +127,10 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
     many = isinstance(value, list | tuple)
     numeric = _carries_floats(info.data_type)
     rule: Accepts | None = getattr(info, "accepts", None)
+    infinite = takes_infinity(info)
     for item in value if many else [value]:
         if (numeric and isinstance(item, numbers.Real) and not isinstance(item, bool)
-                and not math.isfinite(item)):
+                and not math.isfinite(item) and not (infinite and math.isinf(item))):
             return f"must be a finite number, got {shown}"
         if rule is not None and not rule.allows(item):
             each = "each value " if many else ""
@@ -160,8 +175,13 @@ def parse_reference(text: str) -> str | None:
     return None
 
 
-def convert_literal(text: str, data_type: Any) -> Any:
-    """Convert ``text`` to ``data_type``; raises ValueError saying what was expected."""
+def convert_literal(text: str, data_type: Any, infinite: bool = False) -> Any:
+    """Convert ``text`` to ``data_type``; raises ValueError saying what was expected.
+
+    A number must be finite, unless ``infinite`` (the port :func:`takes_infinity`) and the text
+    is an infinity spelled out (:data:`INFINITY_TEXTS`): a number too large for a double
+    (``1e999``) is refused as ``std::stod`` refuses it, and ``nan`` always.
+    """
     if data_type is str or data_type is object or data_type is typing.Any:
         return text
     s = text.strip()
@@ -180,7 +200,9 @@ def convert_literal(text: str, data_type: Any) -> Any:
             number = float(s)
         except ValueError:
             raise ValueError(f"expected a number, got '{text}'") from None
-        if not math.isfinite(number):
+        if not math.isfinite(number) and not (
+            infinite and s.lstrip("+-").lower() in INFINITY_TEXTS
+        ):
             raise ValueError(f"expected a finite number, got '{text}'")
         return number
     if data_type is NodeStatus:
@@ -190,12 +212,12 @@ def convert_literal(text: str, data_type: Any) -> Any:
         (item_type,) = get_args(data_type) or (str,)
         if s == "":
             return []
-        return [convert_literal(part, item_type) for part in s.split(";")]
+        return [convert_literal(part, item_type, infinite) for part in s.split(";")]
     if origin is typing.Union or str(origin) == "<class 'types.UnionType'>":
         errors = []
         for option in get_args(data_type):
             try:
-                return convert_literal(text, option)
+                return convert_literal(text, option, infinite)
             except ValueError as e:
                 errors.append(str(e))
         raise ValueError("; ".join(errors))

@@ -20,7 +20,7 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldAccess
 from bt_manip.bt.node import PortError, SyncActionNode
-from bt_manip.bt.ports import Accepts, Port
+from bt_manip.bt.ports import NON_NEGATIVE_OR_INF, Accepts, Port
 from bt_manip.bt.registry import registry
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose
 
@@ -86,7 +86,7 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
         "max_robot_pose_search_dist": Port(float, False, "Maximum forward integrated distance "
                                            "along the path (starting from the last detected "
                                            "pose) to bound the search for the closest pose to "
-                                           "the robot", math.inf, Accepts(low=0)),
+                                           "the robot", math.inf, NON_NEGATIVE_OR_INF),
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "output_path": PortInformation(Nav2Path, False, "Truncated Path"),

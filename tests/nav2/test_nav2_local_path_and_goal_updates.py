@@ -11,6 +11,7 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import Tree, TreeContext, load_tree_string
 from bt_manip.clock import ManualClock
+from bt_manip.errors import InputError
 from bt_manip.nav2.path import Nav2Path
 from bt_manip.nav2.smoothing import Smoothed, SmootherOptions, smooth_points
 
@@ -88,6 +89,41 @@ def test_truncate_path_local_search_distance_follows_the_path_in_order() -> None
     # the outbound leg (heading 0) though the return leg is as near
     assert [s[2] for s in seen] == [0.0, 0.0, 0.0, 0.0]
     assert [s[0] for s in seen] == pytest.approx([0.0, 0.5, 1.0, 1.5])
+
+
+@pytest.mark.parametrize("written", ["inf", "Infinity", "+INF", " inf "])
+def test_truncate_path_local_takes_an_infinite_search_distance_as_leaving_it_out(
+        written: str) -> None:
+    # as Nav2 reads the port (std::stod): "inf" is no bound, the nearest pose of the whole path
+    # is taken, here on the return leg of the hairpin (heading pi), as without the port
+    path = loop_path()
+    unbounded = truncate(path, (1.0, 0.06, 0.0), distance_forward="0", distance_backward="0")
+    given = truncate(path, (1.0, 0.06, 0.0), distance_forward="0", distance_backward="0",
+                     max_robot_pose_search_dist=written)
+    assert given.poses.tolist() == unbounded.poses.tolist()
+    assert given.poses[:, 2].tolist() == pytest.approx([math.pi])
+    # the same text read from the blackboard
+    tree = tree_of('<TruncatePathLocal input_path="{path}" output_path="{out}" pose="{pose}" '
+                   'distance_forward="0" distance_backward="0" '
+                   'max_robot_pose_search_dist="{search}"/>',
+                   {"path": path, "pose": (1.0, 0.06, 0.0), "search": written})
+    assert tree.tick().value == "SUCCESS", tree.root.feedback_message
+    assert tree.blackboard.get("out").poses.tolist() == unbounded.poses.tolist()
+
+
+@pytest.mark.parametrize("written, problem", [
+    ("-inf", "must be >= 0 or inf, got -inf"),
+    ("nan", "expected a finite number, got 'nan'"),
+    ("1e999", "expected a finite number, got '1e999'"),
+    ("infinite", "expected a number, got 'infinite'"),
+])
+def test_truncate_path_local_refuses_other_non_finite_search_distances(
+        written: str, problem: str) -> None:
+    with pytest.raises(InputError) as refused:
+        tree_of(f'<TruncatePathLocal input_path="{{path}}" output_path="{{out}}" '
+                f'max_robot_pose_search_dist="{written}"/>')
+    assert (f"bad value for port 'max_robot_pose_search_dist' of TruncatePathLocal: {problem}"
+            in str(refused.value))
 
 
 def test_truncate_path_local_fails_without_a_path_or_a_pose() -> None:
