@@ -199,9 +199,9 @@ class ArmModel:
         if q.shape != (self.nq,):
             raise ValueError(f"expected {self.nq} joint values, got shape {q.shape}")
         qp = self._to_pin(q)
-        jac = pin.computeFrameJacobian(
+        jac = _six_rows(pin.computeFrameJacobian(
             self.model, self.data, qp, self._tip_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-        )
+        ))
         jac = jac[:, self._columns]
         out = np.empty((6, self.nq))
         out[:3] = self._base_rot_t @ jac[:3]
@@ -333,6 +333,12 @@ def _store_reach(key: bytes, reach: float) -> None:
         Path(tmp).unlink(missing_ok=True)
 
 
+def _six_rows(jacobian: np.ndarray) -> np.ndarray:
+    """A Jacobian from Pinocchio as 6 x nv: Pinocchio gives the 6 x 1 Jacobian of a model with
+    one degree of freedom as a flat vector of 6."""
+    return np.asarray(jacobian, dtype=float).reshape(6, -1)
+
+
 def _extract_chain(
     model: pin.Model, ids: list[int], base_link: str, tip_link: str, source: str
 ) -> tuple[list[ChainJoint], np.ndarray, np.ndarray]:
@@ -355,7 +361,7 @@ def _extract_chain(
                 f"{source}: joint {name!r} ({jm.shortname()}) has {jm.nv} degrees of freedom; "
                 "an arm chain may hold revolute, continuous and prismatic joints only"
             )
-        motion = pin.computeJointJacobian(model, data, q0, jid)[:, jm.idx_v]
+        motion = _six_rows(pin.computeJointJacobian(model, data, q0, jid))[:, jm.idx_v]
         lin, ang = motion[:3], motion[3:]
         if np.linalg.norm(ang) > 1e-12 and np.linalg.norm(lin) < 1e-12:
             kind, axis = "revolute", ang / np.linalg.norm(ang)
