@@ -38,6 +38,10 @@ their score and the first that passes every check is taken, so the work is bound
 :attr:`PlacementOptions.max_ik_candidates` IK checks (each at most ``2 + approach / 0.02``
 solves) and :attr:`PlacementOptions.max_path_checks` path plans. Everything is deterministic:
 the same world and robot pose give the same base pose.
+
+The checks and their budgets are one search, :func:`search_bases`, which PlanBaseForPlace
+(:mod:`bt_manip.behaviours.place_base`) runs too, with its own candidates, its own IK check and
+an :class:`ExtraCheck` for the load it holds.
 """
 
 from __future__ import annotations
