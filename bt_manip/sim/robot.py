@@ -192,6 +192,7 @@ class Robot:
                 rollingFriction=base.wheel_rolling_friction,
                 anisotropicFriction=anisotropic.tolist(),
                 frictionAnchor=1,
+                contactProcessingThreshold=WHEEL_CONTACT_GAP,
                 physicsClientId=self.client,
             )
         gripper = self.description.gripper
@@ -602,6 +603,13 @@ class Robot:
         """Leave the robot safe: base braked, arm holding its position, gripper unchanged."""
         self.stop_base()
         self.hold_arm()
+
+
+WHEEL_CONTACT_GAP = 0.0
+"""m: a wheel's contact points further from the floor than this are not solved. A rolling wheel
+leaves behind points its contact manifold keeps for a while, a few tenths of a millimetre up
+(two to four per wheel); solving them changes nothing (they are apart and closing at the speed
+of a rolling rim) and they were most of a driving robot's contact rows."""
 
 
 def _has_window(client: int) -> bool:

@@ -145,6 +145,7 @@ class World:
         pb.setGravity(*ph.gravity, physicsClientId=c)
         pb.setPhysicsEngineParameter(
             numSolverIterations=ph.solver_iterations,
+            solverResidualThreshold=ph.solver_tolerance**2,
             enableConeFriction=0,
             deterministicOverlappingPairs=1,
             physicsClientId=c,
