@@ -145,11 +145,14 @@ class World:
         pb.setGravity(*ph.gravity, physicsClientId=c)
         pb.setPhysicsEngineParameter(
             numSolverIterations=ph.solver_iterations,
-            solverResidualThreshold=ph.solver_tolerance**2,
             enableConeFriction=0,
             deterministicOverlappingPairs=1,
             physicsClientId=c,
         )
+        if ph.solver_tolerance is not None:
+            pb.setPhysicsEngineParameter(
+                solverResidualThreshold=ph.solver_tolerance**2, physicsClientId=c
+            )
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
         ground = pb.createMultiBody(0, plane, -1, [0, 0, 0], physicsClientId=c)
         pb.changeDynamics(ground, -1, lateralFriction=ph.ground_friction, physicsClientId=c)

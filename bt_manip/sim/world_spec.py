@@ -167,9 +167,11 @@ class PhysicsSpec:
     rate_hz: float = 240.0
     gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
     solver_iterations: int = 50
-    solver_tolerance: float = 0.01
+    solver_tolerance: float | None = None
     """m/s: the constraint solver stops iterating once a sweep changes no constraint's velocity
-    by more than this (PyBullet's solverResidualThreshold is its square)."""
+    by more than this (PyBullet's solverResidualThreshold is its square); None keeps PyBullet's
+    own threshold (1e-7, about 0.3 mm/s). A looser one makes steps cheaper and contacts less
+    exact: 0.01 saves about 15 % of a step and changes which way a touching crate goes."""
     ground_friction: float = 1.0
 
 
@@ -607,10 +609,10 @@ def parse_world(path: str | Path) -> WorldSpec:
             physics.solver_iterations = int(
                 rd.number(ph, "solver_iterations", "physics", 50, within=SOLVER_ITERATIONS) or 50
             )
-            tolerance = rd.number(
-                ph, "solver_tolerance", "physics", physics.solver_tolerance, within=SOLVER_TOLERANCE
-            )
-            physics.solver_tolerance = float(tolerance if tolerance is not None else 0.0)
+            if "solver_tolerance" in ph:
+                physics.solver_tolerance = rd.number(
+                    ph, "solver_tolerance", "physics", None, within=SOLVER_TOLERANCE
+                )
             physics.ground_friction = (
                 rd.number(ph, "ground_friction", "physics", 1.0, non_negative=True) or 0.0
             )
