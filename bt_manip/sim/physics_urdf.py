@@ -1,4 +1,5 @@
-"""The robot file PyBullet loads when it draws nothing: no visuals, collision meshes as hulls.
+"""The robot file PyBullet loads when it draws nothing: no visuals, collision meshes as hulls,
+fixed links merged.
 
 A composed robot URDF (:mod:`bt_manip.sim.compose`) names visual meshes (COLLADA files of
 hundreds of kilobytes) and collision meshes (STL files of thousands of triangles). Headless,
@@ -13,11 +14,15 @@ again at every load. :func:`physics_urdf` therefore writes, once, a variant of t
   from far fewer points (a ``<collision concave="yes">`` keeps its mesh: PyBullet keeps its
   triangles).
 
-Links, joints, inertials, contact parameters and the order of everything are untouched, so the
-body PyBullet builds has the same links, indices, masses and collision shapes. A mesh whose hull
-cannot be computed (flat or degenerate) is kept as it is. The files are written under the URDF
-cache folder (``physics/`` and ``hulls/``), keyed by a hash of the URDF text and of each mesh's
-path, size and modification time; writes are atomic.
+- every child of a fixed joint folded into its parent (:mod:`bt_manip.sim.fixed_links`): the
+  same rigid assembly with fewer PyBullet links, which makes each physics step cheaper. The
+  merged links' frames are kept beside the file (:class:`PhysicsModel`), so
+  :class:`~bt_manip.sim.robot.Robot` still gives the pose of every URDF link by name.
+
+Movable joints, masses, inertia, collision shapes and contact parameters are those of the
+composed file. A mesh whose hull cannot be computed (flat or degenerate) is kept as it is. The
+files are written under the URDF cache folder (``physics/`` and ``hulls/``), keyed by a hash of
+the URDF text and of each mesh's path, size and modification time; writes are atomic.
 
 PyBullet's own window (``World(gui=True)``) loads the composed file with its visuals.
 """
@@ -25,8 +30,10 @@ PyBullet's own window (``World(gui=True)``) loads the composed file with its vis
 from __future__ import annotations
 
 import hashlib
+import json
 import struct
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import defusedxml.ElementTree as SafeET
@@ -34,18 +41,34 @@ import numpy as np
 
 from bt_manip.input_files import read_bounded
 from bt_manip.sim.compose import MAX_URDF_BYTES, cache_dir, write_atomic_bytes
+from bt_manip.sim.fixed_links import MergedFrame, merge_fixed_links
 from bt_manip.sim.mesh_check import MAX_MESH_BYTES
 
-PHYSICS_VERSION = 1
+PHYSICS_VERSION = 2
 """Bumped whenever the output for the same inputs changes."""
 
 
+@dataclass(frozen=True)
+class PhysicsModel:
+    """The file PyBullet loads and the frames of the links merged into others (by URDF link
+    name; empty when nothing was merged)."""
+
+    path: Path
+    merged: dict[str, MergedFrame] = field(default_factory=dict)
+
+
 def physics_urdf(urdf: Path) -> Path:
+    """Path of :func:`physics_model`'s file."""
+    return physics_model(urdf).path
+
+
+def physics_model(urdf: Path) -> PhysicsModel:
     """The variant of ``urdf`` (a composed or plain robot URDF with absolute mesh paths) that
-    PyBullet loads headless, see the module docstring; ``urdf`` itself when it names no mesh."""
+    PyBullet loads headless, see the module docstring; ``urdf`` itself when it names no mesh
+    and has no fixed joint."""
     data = read_bounded(urdf, MAX_URDF_BYTES, "URDF file")
-    if b"<mesh" not in data:
-        return urdf
+    if b"<mesh" not in data and b'"fixed"' not in data and b"'fixed'" not in data:
+        return PhysicsModel(urdf)
     root: ET.Element = SafeET.fromstring(data)
     meshes = [m for m in root.iter("mesh") if m.get("filename")]
     digest = hashlib.sha256(f"physics-{PHYSICS_VERSION}".encode())
@@ -53,8 +76,12 @@ def physics_urdf(urdf: Path) -> Path:
     for mesh in meshes:
         digest.update(_file_stamp(Path(mesh.get("filename", ""))))
     target = cache_dir() / "physics" / f"{urdf.stem}-{digest.hexdigest()[:16]}.urdf"
-    if target.is_file():
-        return target
+    frames_file = target.with_suffix(".frames.json")
+    if target.is_file() and frames_file.is_file():
+        try:
+            return PhysicsModel(target, _read_frames(frames_file))
+        except (OSError, ValueError, KeyError, TypeError):
+            pass  # written by something else: write it again
     for link in root.iter("link"):
         for visual in link.findall("visual"):
             link.remove(visual)
@@ -65,10 +92,28 @@ def physics_urdf(urdf: Path) -> Path:
                 source = Path(mesh.get("filename", ""))
                 if source.suffix.lower() == ".stl":
                     mesh.set("filename", str(hull_stl(source)))
+    merged = merge_fixed_links(root)
     ET.indent(root, space="  ")
     text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    frames = {
+        name: {"carrier": f.carrier, "position": list(f.position), "quat": list(f.quat)}
+        for name, f in merged.items()
+    }
+    write_atomic_bytes(frames_file, json.dumps(frames, indent=1).encode())
     write_atomic_bytes(target, text.encode())
-    return target
+    return PhysicsModel(target, merged)
+
+
+def _read_frames(path: Path) -> dict[str, MergedFrame]:
+    raw = json.loads(path.read_text())
+    return {
+        str(name): MergedFrame(
+            str(f["carrier"]),
+            tuple(float(v) for v in f["position"]),  # type: ignore[arg-type]
+            tuple(float(v) for v in f["quat"]),  # type: ignore[arg-type]
+        )
+        for name, f in raw.items()
+    }
 
 
 def hull_stl(source: Path) -> Path:

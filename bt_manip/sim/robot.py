@@ -30,7 +30,8 @@ from bt_manip.errors import InputError
 from bt_manip.geometry import compose_poses, invert_pose, pose_matrix, quat_from_yaw, yaw_of
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.compose import composed_urdf
-from bt_manip.sim.physics_urdf import physics_urdf
+from bt_manip.sim.fixed_links import MergedFrame
+from bt_manip.sim.physics_urdf import physics_model
 from bt_manip.sim.pybullet_queries import JointInfo
 from bt_manip.sim.robot_description import (
     ArmSpec,
@@ -76,7 +77,13 @@ class Robot:
     the URDF link frame (not the centre of mass).
     """
 
-    def __init__(self, client: int, body: int, description: RobotDescription) -> None:
+    def __init__(
+        self,
+        client: int,
+        body: int,
+        description: RobotDescription,
+        merged: dict[str, MergedFrame] | None = None,
+    ) -> None:
         self.client = client
         self.body = body
         self.description = description
@@ -92,6 +99,13 @@ class Robot:
             self._joints[info.name] = info.index
             self._links[info.link_name] = info.index
             self._joint_info[info.index] = info
+        self.merged_frames: dict[str, tuple[int, MergedFrame]] = {
+            name: (self._links[frame.carrier], frame)
+            for name, frame in (merged or {}).items()
+            if frame.carrier in self._links and name not in self._links
+        }
+        """URDF links folded into another link of the loaded file (see
+        :mod:`bt_manip.sim.fixed_links`): the carrier's PyBullet index and the frame's offset."""
         self.arm_joint_ids = [self.joint_index(n) for n in description.arm.joints]
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
@@ -129,14 +143,17 @@ class Robot:
         is where its virtual joints are at 0). Arm and gripper then hold their initial positions
         and the base is braked, so the robot stays at rest until commanded.
 
-        Without PyBullet's own window the file loaded is :func:`physics_urdf` (no visuals,
-        collision meshes as their hulls): the same links, masses and collision shapes.
+        Without PyBullet's own window the file loaded is :func:`physics_model`'s (no visuals,
+        collision meshes as their hulls, fixed links merged): the same rigid parts, masses and
+        collision shapes; the merged links' frames stay reachable by name.
         """
         if not isinstance(description, RobotDescription):
             description = RobotDescription.load(description)
         path = composed_urdf(description)
+        merged: dict[str, MergedFrame] = {}
         if not _has_window(client):
-            path = physics_urdf(path)
+            model = physics_model(path)
+            path, merged = model.path, model.merged
         z = description.spawn_height if z is None else z
         flags = pb.URDF_USE_INERTIA_FROM_FILE
         try:
@@ -153,7 +170,7 @@ class Robot:
                 str(description.path), None,
                 f"PyBullet cannot load the robot's URDF {path} (check its links and meshes)"
             ) from None
-        robot = cls(client, body, description)
+        robot = cls(client, body, description, merged)
         robot._apply_friction()
         robot._couple_fingers()
         robot.hold_arm()
@@ -175,6 +192,7 @@ class Robot:
                 rollingFriction=base.wheel_rolling_friction,
                 anisotropicFriction=anisotropic.tolist(),
                 frictionAnchor=1,
+                contactProcessingThreshold=WHEEL_CONTACT_GAP,
                 physicsClientId=self.client,
             )
         gripper = self.description.gripper
@@ -250,8 +268,16 @@ class Robot:
         return list(self._arm_links)
 
     def link_index(self, name: str) -> int:
-        """PyBullet link index of the URDF link ``name`` (-1 for the root link)."""
+        """PyBullet link index of the URDF link ``name`` (-1 for the root link); for a link merged
+        into another, the index of the link that carries it."""
+        merged = self.merged_frames.get(name)
+        if merged is not None:
+            return merged[0]
         return self._index(self._links, name, "link")
+
+    def has_link(self, name: str) -> bool:
+        """Whether the URDF has a link ``name`` (merged or not)."""
+        return name in self._links or name in self.merged_frames
 
     def _index(self, table: dict[str, int], name: str, what: str) -> int:
         try:
@@ -272,11 +298,17 @@ class Robot:
     def link_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World pose of URDF link ``name``: position (3,) and quaternion (x, y, z, w)."""
         index = self.link_index(name)
+        pos: Sequence[float]
+        quat: Sequence[float]
         if index == -1:
             pos, quat = self._root_pose()
-            return np.array(pos), np.array(quat)
-        state = pbq.link_state(self.client, self.body, index)
-        return np.array(state.frame_position), np.array(state.frame_orientation)
+        else:
+            state = pbq.link_state(self.client, self.body, index)
+            pos, quat = state.frame_position, state.frame_orientation
+        merged = self.merged_frames.get(name)
+        if merged is not None:
+            pos, quat = compose_poses((pos, quat), (merged[1].position, merged[1].quat))
+        return np.array(pos), np.array(quat)
 
     def link_transform(self, name: str) -> np.ndarray:
         """World pose of URDF link ``name`` as a 4x4 homogeneous matrix."""
@@ -308,9 +340,24 @@ class Robot:
             c, s = math.cos(theta), math.sin(theta)
             return c * xd + s * yd, -s * xd + c * yd, float(wd)
         lin, ang = pb.getBaseVelocity(self.body, physicsClientId=self.client)
-        _, _, yaw = self.base_pose2d()
+        # PyBullet gives the velocity of the root's centre of mass; the root frame moves with
+        # v + w x (frame - centre of mass)
+        com, _ = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        frame, quat = self._root_pose()
+        arm = np.subtract(frame, com)
+        v = np.asarray(lin) + np.cross(ang, arm)
+        yaw = yaw_of(quat)
         c, s = math.cos(yaw), math.sin(yaw)
-        return c * lin[0] + s * lin[1], -s * lin[0] + c * lin[1], float(ang[2])
+        return float(c * v[0] + s * v[1]), float(-s * v[0] + c * v[1]), float(ang[2])
+
+    def reset_base_pose(self, x: float, y: float, yaw: float, z: float | None = None) -> None:
+        """Put the root link frame at (x, y, z) with heading ``yaw`` at rest (``z`` defaults to
+        the descriptor's spawn height): a set-up step for tools and tests, not a motion. Not for
+        a holonomic base (its root is welded to the world)."""
+        z = self.description.spawn_height if z is None else z
+        pos, quat = compose_poses(((x, y, z), quat_from_yaw(yaw)), self._root_inertial)
+        pb.resetBasePositionAndOrientation(self.body, pos, quat, physicsClientId=self.client)
+        pb.resetBaseVelocity(self.body, [0, 0, 0], [0, 0, 0], physicsClientId=self.client)
 
     # -- arm ----------------------------------------------------------------------------------
     def _positions(self, ids: Sequence[int]) -> np.ndarray:
@@ -556,6 +603,13 @@ class Robot:
         """Leave the robot safe: base braked, arm holding its position, gripper unchanged."""
         self.stop_base()
         self.hold_arm()
+
+
+WHEEL_CONTACT_GAP = 0.0
+"""m: a wheel's contact points further from the floor than this are not solved. A rolling wheel
+leaves behind points its contact manifold keeps for a while, a few tenths of a millimetre up
+(two to four per wheel); solving them changes nothing (they are apart and closing at the speed
+of a rolling rim) and they were most of a driving robot's contact rows."""
 
 
 def _has_window(client: int) -> bool:

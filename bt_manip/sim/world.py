@@ -149,6 +149,10 @@ class World:
             deterministicOverlappingPairs=1,
             physicsClientId=c,
         )
+        if ph.solver_tolerance is not None:
+            pb.setPhysicsEngineParameter(
+                solverResidualThreshold=ph.solver_tolerance**2, physicsClientId=c
+            )
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
         ground = pb.createMultiBody(0, plane, -1, [0, 0, 0], physicsClientId=c)
         pb.changeDynamics(ground, -1, lateralFriction=ph.ground_friction, physicsClientId=c)

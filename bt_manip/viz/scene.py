@@ -68,6 +68,9 @@ class _BodyFrames:
     body_id: int
     base_offset: np.ndarray  # URDF root frame in the base centre-of-mass frame (4x4)
     link_ids: list[int]
+    link_offsets: list[np.ndarray | None] = field(default_factory=list)
+    """Per entry of ``link_ids``: the drawn link's frame in that PyBullet link's frame, for a
+    link merged into another (:mod:`bt_manip.sim.fixed_links`); None for the link itself."""
 
 
 @dataclass
@@ -99,11 +102,18 @@ class SceneBody:
         base = pose_matrix(pos, quat) @ body.base_offset
         out[0] = matrix_row(base)
         if body.link_ids:
-            states = pbq.link_states(client, body.body_id, body.link_ids)
+            carriers = sorted({j for j in body.link_ids if j >= 0})
+            read = pbq.link_states(client, body.body_id, carriers)
+            states = dict(zip(carriers, read, strict=True))
             inv = inverse_matrix(base)
-            for k, state in enumerate(states):
-                link = pose_matrix(state.frame_position, state.frame_orientation)
-                out[1 + k] = matrix_row(inv @ link)
+            offsets = body.link_offsets or [None] * len(body.link_ids)
+            for k, (j, offset) in enumerate(zip(body.link_ids, offsets, strict=True)):
+                if j == -1:
+                    link = base
+                else:
+                    state = states[j]
+                    link = pose_matrix(state.frame_position, state.frame_orientation)
+                out[1 + k] = matrix_row(inv @ (link if offset is None else link @ offset))
         return out
 
 
@@ -153,7 +163,8 @@ class Scene:
         body = SceneBody(info.name, path or f"{ROOT}/{info.name}")
         if urdf is not None:
             scale = float(getattr(info.spec, "scale", 1.0) or 1.0)
-            _add_urdf_body(body, self.client, info.body_id, urdf, scale, movable)
+            merged = world.robots[info.name].merged_frames if info.kind == "robot" else {}
+            _add_urdf_body(body, self.client, info.body_id, urdf, scale, movable, merged)
         else:
             _add_primitive_body(body, self.client, info, movable)
         self.bodies[info.name] = body
@@ -318,16 +329,32 @@ def _urdf_of(info: Any, world: Any) -> Path | None:
 
 
 def _add_urdf_body(
-    body: SceneBody, c: int, body_id: int, urdf: Path, scale: float, movable: bool
+    body: SceneBody,
+    c: int,
+    body_id: int,
+    urdf: Path,
+    scale: float,
+    movable: bool,
+    merged: dict[str, Any] | None = None,
 ) -> None:
+    """``merged``: a robot's :attr:`~bt_manip.sim.robot.Robot.merged_frames`; a merged link
+    keeps its own node, placed at its carrier's frame times its offset."""
     links = {pbq.root_link_name(c, body_id): -1}
     for joint in pbq.joint_infos(c, body_id):
         links[joint.link_name] = joint.index
+    offsets: dict[str, np.ndarray] = {}
+    for name, (carrier, frame) in (merged or {}).items():
+        links[name] = carrier
+        offsets[name] = frame.matrix()
     dyn = pbq.dynamics_info(c, body_id, -1)
     inertial = pose_matrix(dyn.local_inertial_position, dyn.local_inertial_orientation)
     base_offset = inverse_matrix(inertial)
     visuals = [v for v in read_visuals(urdf) if v.link in links]
-    drawn_links = sorted({links[v.link] for v in visuals if links[v.link] >= 0})
+    order = {name: k for k, name in enumerate(links)}
+    drawn = sorted(
+        {v.link for v in visuals if links[v.link] >= 0 or v.link in offsets},
+        key=lambda n: (links[n], order[n]),
+    )
     counts: dict[str, int] = {}
     for visual in visuals:
         k = counts.get(visual.link, 0)
@@ -335,9 +362,10 @@ def _add_urdf_body(
         obj = _visual_object(f"{body.path}/{visual.link}/v{k}", body.name, visual, scale)
         if obj is not None:
             body.objects.append(obj)
-    link_names = {j: n for n, j in links.items()}
-    body.frames = _BodyFrames(body_id, base_offset, drawn_links)
-    body.tracks = [body.path] + [f"{body.path}/{link_names[j]}" for j in drawn_links]
+    body.frames = _BodyFrames(
+        body_id, base_offset, [links[n] for n in drawn], [offsets.get(n) for n in drawn]
+    )
+    body.tracks = [body.path] + [f"{body.path}/{n}" for n in drawn]
     if not movable:
         # fixed bodies: read once, then place statically
         rows = body.read_poses(c)

@@ -7,7 +7,6 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TypeVar
 
-import pybullet as pb
 import pytest
 
 import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
@@ -20,14 +19,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def place_robot(world: World, name: str, x: float, y: float, yaw: float) -> None:
-    robot = world.robots[name]
-    z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
-    pb.resetBasePositionAndOrientation(
-        robot.body,
-        [x, y, z],
-        pb.getQuaternionFromEuler([0, 0, yaw]),
-        physicsClientId=world.client,
-    )
+    world.robots[name].reset_base_pose(x, y, yaw)
     world.step(24)
 
 

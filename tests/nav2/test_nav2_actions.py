@@ -144,13 +144,8 @@ def test_clear_entire_costmap_forgets_what_the_map_marked(room: World) -> None:
 
 
 def place(world: World, x: float, y: float, yaw: float = 0.0) -> None:
-    import pybullet as pb
 
-    robot = world.robots["husky"]
-    z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
-    pb.resetBasePositionAndOrientation(robot.body, [x, y, z],
-                                       pb.getQuaternionFromEuler([0, 0, yaw]),
-                                       physicsClientId=world.client)
+    world.robots["husky"].reset_base_pose(x, y, yaw)
     world.step(24)
 
 

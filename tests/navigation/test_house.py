@@ -181,14 +181,8 @@ def test_twenty_random_goals_across_rooms(house: World) -> None:
 def lift_panel(world: World) -> None:
     """Scenario A up to the lift: base at the pre-grasp pose, grasp, attach, lift."""
     robot = world.robots["husky"]
-    c = world.client
     pg = world.poses["pregrasp_panel"]
-    pb.resetBasePositionAndOrientation(
-        robot.body,
-        [pg.x, pg.y, robot.description.spawn_height],
-        pb.getQuaternionFromEuler([0, 0, pg.yaw]),
-        physicsClientId=c,
-    )
+    robot.reset_base_pose(pg.x, pg.y, pg.yaw)
     q = np.radians([70.0, 11.0, 78.0, -56.0, 85.0, 4.0])
     robot.reset_arm(q)
     robot.open_gripper()

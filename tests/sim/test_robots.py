@@ -64,7 +64,7 @@ def test_loads_as_one_multibody(client: int, descriptions: dict, name: str) -> N
     d = descriptions[name]
     assert len(robot.arm_joint_ids) == len(d.arm.joints)
     for link in (d.end_effector, d.grasp_frame, d.arm.base_link, *d.gripper.finger_links):
-        assert robot.link_index(link) >= 0
+        assert robot.has_link(link)
     x, y, yaw = robot.base_pose2d()
     assert (x, y, yaw) == pytest.approx((0.5, -0.5, 0.2), abs=1e-6)
 

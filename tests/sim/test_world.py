@@ -113,3 +113,20 @@ def test_sim_clock_follows_steps() -> None:
         world.step(12)
         assert world.clock.now() == pytest.approx(12 / 240)
         assert world.step_count == 12
+
+
+def test_solver_tolerance_is_read_and_bounded(tmp_path: Path) -> None:
+    from bt_manip.errors import InputError
+    from bt_manip.sim.world_spec import parse_world
+
+    ok = tmp_path / "ok.yaml"
+    ok.write_text("name: ok\nphysics: {solver_tolerance: 0.01}\n")
+    assert parse_world(ok).physics.solver_tolerance == 0.01
+    plain = tmp_path / "plain.yaml"
+    plain.write_text("name: plain\n")
+    assert parse_world(plain).physics.solver_tolerance is None  # PyBullet's own
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\nphysics:\n  solver_tolerance: 5\n")
+    with pytest.raises(InputError) as err:
+        parse_world(bad)
+    assert f"{bad}:3: physics.solver_tolerance must be within 0..1, got 5" in str(err.value)

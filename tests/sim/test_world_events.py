@@ -77,12 +77,7 @@ def test_unsubscribed_listeners_hear_nothing_more() -> None:
 def _grasp_panel(world: World) -> str:
     """Place the Husky at the panel's pre-grasp pose, grasp and attach it; the run's result."""
     p = world.poses["pregrasp_panel"]
-    robot = world.robots["husky"]
-    z = pb.getBasePositionAndOrientation(robot.body, physicsClientId=world.client)[0][2]
-    pb.resetBasePositionAndOrientation(
-        robot.body, [p.x, p.y, z], pb.getQuaternionFromEuler([0, 0, p.yaw]),
-        physicsClientId=world.client,
-    )
+    world.robots["husky"].reset_base_pose(p.x, p.y, p.yaw)
     world.step(24)
     xml = (
         '<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence><OpenGripper/>'
