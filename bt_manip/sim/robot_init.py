@@ -41,6 +41,7 @@ import defusedxml.ElementTree as SafeET
 import numpy as np
 
 from bt_manip.errors import InputError, Problem
+from bt_manip.geometry import rpy_matrix
 from bt_manip.input_files import read_bounded
 from bt_manip.sim.assets import example_robot_data_share, pybullet_data_dir
 from bt_manip.sim.compose import MAX_URDF_BYTES, composed_urdf
@@ -123,9 +124,15 @@ class _Urdf:
         self.robot_name = root.get("name", "") or path.stem
         text = data.decode("utf-8", errors="replace")
         self.links: dict[str, int | None] = {}
+        self.round_shapes: dict[str, tuple[float, tuple[float, float, float] | None]] = {}
+        """Links whose only collision shape is a cylinder or a sphere: its radius and, for a
+        cylinder, its axis in the link frame."""
         for el in root.findall("link"):
             name = el.get("name", "")
             self.links[name] = _line(text, "link", name)
+            round_shape = _round_shape(el)
+            if round_shape is not None:
+                self.round_shapes[name] = round_shape
         self.joints: dict[str, _Joint] = {}
         for el in root.findall("joint"):
             name = el.get("name", "")
@@ -205,6 +212,44 @@ def _limit_value(
             str(path), line, f"joint '{name}': limit {key}={raw!r} is not a finite number"
         )
     return value
+
+
+def _round_shape(link: ET.Element) -> tuple[float, tuple[float, float, float] | None] | None:
+    """The radius (and a cylinder's axis) of a link's single cylinder or sphere collision."""
+    collisions = link.findall("collision")
+    if len(collisions) != 1:
+        return None
+    geometry = collisions[0].find("geometry")
+    shapes = list(geometry) if geometry is not None else []
+    if len(shapes) != 1 or shapes[0].tag not in ("cylinder", "sphere"):
+        return None
+    try:
+        radius = float(shapes[0].get("radius", ""))
+    except ValueError:
+        return None
+    if not math.isfinite(radius) or radius <= 0.0:
+        return None
+    if shapes[0].tag == "sphere":
+        return radius, None
+    roll, pitch, yaw = _triple(collisions[0], "origin", "rpy", (0.0, 0.0, 0.0))
+    axis = rpy_matrix(roll, pitch, yaw)[:, 2]
+    return radius, (float(axis[0]), float(axis[1]), float(axis[2]))
+
+
+def _rolling_radius(urdf: _Urdf, joint: _Joint) -> float | None:
+    """A wheel's radius from its URDF shape: a sphere, or a cylinder turning about its own
+    axis; None otherwise (the caller measures the shape instead)."""
+    shape = urdf.round_shapes.get(joint.child)
+    if shape is None:
+        return None
+    radius, axis = shape
+    if axis is None:
+        return radius
+    turn = np.asarray(joint.axis, dtype=float)
+    norm = float(np.linalg.norm(turn))
+    if norm == 0.0 or abs(float(np.dot(axis, turn))) < 0.99 * norm:
+        return None
+    return radius
 
 
 def _triple(
@@ -526,7 +571,8 @@ class _Geometry:
                         continue
                     lo, hi = pb.getAABB(body, info.index, physicsClientId=client)
                     pos = pb.getLinkState(body, info.index, physicsClientId=client)[4]
-                    radius = (hi[2] - lo[2]) / 2.0
+                    # the URDF's own radius where it has one: PyBullet's box is a few mm larger
+                    radius = _rolling_radius(urdf, joint) or (hi[2] - lo[2]) / 2.0
                     if radius <= 0.0:
                         continue
                     self.wheels.append((info.name, float(pos[1]), float(radius)))

@@ -194,7 +194,7 @@ def test_mobile_base_wheels_track_and_footprint(tmp_path: Path) -> None:
     assert set(desc.base.left_wheels) == {"front_left_wheel", "rear_left_wheel"}
     assert set(desc.base.right_wheels) == {"front_right_wheel", "rear_right_wheel"}
     assert desc.base.track_width == pytest.approx(0.5708, abs=0.01)
-    assert desc.base.wheel_radius == pytest.approx(0.17775, abs=0.01)
+    assert desc.base.wheel_radius == pytest.approx(0.17775, abs=1e-4)  # the URDF cylinder
     assert desc.footprint.length == pytest.approx(0.99, abs=0.05)
     assert desc.footprint.width == pytest.approx(0.67, abs=0.05)
     assert 0.0 <= desc.spawn_height < 0.02
