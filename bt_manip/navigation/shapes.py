@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 import pybullet as pb
@@ -72,24 +73,38 @@ Outline = Disc | Polygon
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
-    pts = np.unique(np.round(np.asarray(points, dtype=float), 12), axis=0)
-    if len(pts) <= 2:
-        return pts
-
-    def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
-
-    lower: list[np.ndarray] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list[np.ndarray] = []
-    for p in pts[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
+    rounded = np.round(np.asarray(points, dtype=float), 12)
+    rows = _sorted_unique_rows(rounded)
+    if len(rows) <= 2:
+        return np.unique(rounded, axis=0)
+    lower = _half_hull(rows)
+    upper = _half_hull(rows[::-1])
     return np.array(lower[:-1] + upper[:-1])
+
+
+def _sorted_unique_rows(pts: np.ndarray) -> list[list[float]]:
+    """The distinct rows of an (n, 2) array, sorted by x then y, as lists of plain floats
+    (what ``np.unique(pts, axis=0)`` gives, without its cost on small arrays). Arrays holding
+    a zero (0.0 and -0.0 compare equal, and which one ``np.unique`` keeps is its own choice)
+    or a NaN go through ``np.unique`` itself."""
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(pts != 0.0):  # also catches NaN
+        return cast(list[list[float]], np.unique(pts, axis=0).tolist())
+    return [list(p) for p in sorted(set(map(tuple, pts.tolist())))]
+
+
+def _half_hull(rows: list[list[float]]) -> list[list[float]]:
+    """One chain of the monotone chain hull: each point kept while the chain turns left."""
+    chain: list[list[float]] = []
+    for p in rows:
+        px, py = p
+        while len(chain) >= 2:
+            ox, oy = chain[-2]
+            ax, ay = chain[-1]
+            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0:
+                break
+            chain.pop()
+        chain.append(p)
+    return chain
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:
@@ -98,25 +113,32 @@ def planar_frame(x: float, y: float, yaw: float) -> Frame:
     return np.array([x, y, 0.0]), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+_BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+"""The eight corners of a box as signs of its half extents; corner ``i`` and ``i ^ bit``
+(bit 1, 2 or 4) share an edge."""
+_BOX_EDGES = [(i, i ^ bit) for i in range(8) for bit in (1, 2, 4) if (i ^ bit) > i]
+
+
 def _box_slice(frame: Frame, half: np.ndarray, band: ZBand) -> np.ndarray | None:
-    """Plane points of the part of a box inside the z band (None if it misses the band)."""
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    corners = frame[0] + (signs * half) @ frame[1].T
+    """Plane points of the part of a box inside the z band (None if it misses the band): the
+    corners inside it and where the edges cross its two planes."""
+    corners = frame[0] + (_BOX_SIGNS * half) @ frame[1].T
     z = corners[:, 2]
     lo, hi = band
     if z.max() < lo or z.min() > hi:
         return None
     pts = [corners[(z >= lo) & (z <= hi), :2]]
-    for i in range(8):
-        for bit in (1, 2, 4):
-            j = i ^ bit
-            if j < i:
-                continue
-            za, zb = z[i], z[j]
-            for plane in (lo, hi):
-                if (za - plane) * (zb - plane) < 0.0:
-                    t = (plane - za) / (zb - za)
-                    pts.append((corners[i, :2] + t * (corners[j, :2] - corners[i, :2]))[None])
+    c = corners.tolist()  # plain floats: the same arithmetic, less overhead per corner
+    crossings = []
+    for i, j in _BOX_EDGES:
+        xa, ya, za = c[i]
+        xb, yb, zb = c[j]
+        for plane in (lo, hi):
+            if (za - plane) * (zb - plane) < 0.0:
+                t = (plane - za) / (zb - za)
+                crossings.append((xa + t * (xb - xa), ya + t * (yb - ya)))
+    if crossings:
+        pts.append(np.array(crossings, dtype=float))
     pts_all = np.concatenate(pts)
     return pts_all if len(pts_all) else None
 

@@ -174,7 +174,7 @@ class Attachments:
         if held is None:
             return []
         supports = self._supports.get(object_name, set())
-        touching = {c.body_b for c in pbq.contacts(self.client, held.object_body)}
+        touching = self._touching(held.object_body)
         for support in list(supports):  # a support left once is a support no more
             if support not in touching and not pbq.closest_points(
                 self.client, held.object_body, support, LEAVE_CLEARANCE
@@ -186,6 +186,12 @@ class Attachments:
             return []
         static = self._static_names()
         return sorted(static[b] for b in touching if b in static)
+
+    def _touching(self, body: int) -> set[int]:
+        """The bodies ``body`` has contact points with after the last step (read straight from
+        ``getContactPoints``, index 2 being body B: this runs after every physics step)."""
+        points = pb.getContactPoints(bodyA=body, physicsClientId=self.client)
+        return {p[2] for p in points}
 
     def record_contacts(self) -> None:
         """Note every static body an attached object touches now (see :meth:`static_contacts`).
