@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import cast
 
+import numba
 import numpy as np
 import pybullet as pb
 
@@ -73,38 +73,55 @@ Outline = Disc | Polygon
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
-    rounded = np.round(np.asarray(points, dtype=float), 12)
-    rows = _sorted_unique_rows(rounded)
-    if len(rows) <= 2:
-        return np.unique(rounded, axis=0)
-    lower = _half_hull(rows)
-    upper = _half_hull(rows[::-1])
-    return np.array(lower[:-1] + upper[:-1])
+    pts = _sorted_unique_rows(np.round(np.asarray(points, dtype=float), 12))
+    if len(pts) <= 2:
+        return pts
+    return _monotone_chain(pts)
 
 
-def _sorted_unique_rows(pts: np.ndarray) -> list[list[float]]:
-    """The distinct rows of an (n, 2) array, sorted by x then y, as lists of plain floats
-    (what ``np.unique(pts, axis=0)`` gives, without its cost on small arrays). Arrays holding
-    a zero (0.0 and -0.0 compare equal, and which one ``np.unique`` keeps is its own choice)
-    or a NaN go through ``np.unique`` itself."""
+def _sorted_unique_rows(pts: np.ndarray) -> np.ndarray:
+    """The distinct rows of an (n, 2) array sorted by x then y: ``np.unique(pts, axis=0)``,
+    computed by a lexicographic sort and a comparison of neighbours (much cheaper). Arrays
+    holding a zero (0.0 and -0.0 are equal, and which one ``np.unique`` keeps is its own
+    choice) or a NaN go through ``np.unique`` itself."""
     if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(pts != 0.0):  # also catches NaN
-        return cast(list[list[float]], np.unique(pts, axis=0).tolist())
-    return [list(p) for p in sorted(set(map(tuple, pts.tolist())))]
+        return np.unique(pts, axis=0)
+    s = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
+    keep = np.ones(len(s), dtype=bool)
+    keep[1:] = (s[1:, 0] != s[:-1, 0]) | (s[1:, 1] != s[:-1, 1])
+    return s[keep]
 
 
-def _half_hull(rows: list[list[float]]) -> list[list[float]]:
-    """One chain of the monotone chain hull: each point kept while the chain turns left."""
-    chain: list[list[float]] = []
-    for p in rows:
-        px, py = p
-        while len(chain) >= 2:
-            ox, oy = chain[-2]
-            ax, ay = chain[-1]
-            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0:
+@numba.njit(cache=True)
+def _monotone_chain(pts: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """Andrew's monotone chain over distinct points sorted by x then y (at least three): the
+    lower chain left to right, then the upper chain right to left, each point kept while the
+    chain turns left (a point on a straight stretch is dropped)."""
+    n = pts.shape[0]
+    chain = np.empty((2 * n, 2))
+    k = 0
+    for i in range(n):
+        px, py = pts[i, 0], pts[i, 1]
+        while k >= 2:
+            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
+            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
+            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
                 break
-            chain.pop()
-        chain.append(p)
-    return chain
+            k -= 1
+        chain[k, 0], chain[k, 1] = px, py
+        k += 1
+    lower = k
+    for i in range(n - 1, -1, -1):
+        px, py = pts[i, 0], pts[i, 1]
+        while k - lower >= 2:
+            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
+            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
+            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
+                break
+            k -= 1
+        chain[k, 0], chain[k, 1] = px, py
+        k += 1
+    return np.concatenate((chain[: lower - 1], chain[lower : k - 1]))
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:

@@ -190,7 +190,7 @@ class Attachments:
     def _touching(self, body: int) -> set[int]:
         """The bodies ``body`` has contact points with after the last step (read straight from
         ``getContactPoints``, index 2 being body B: this runs after every physics step)."""
-        points = pb.getContactPoints(bodyA=body, physicsClientId=self.client)
+        points = pb.getContactPoints(bodyA=body, physicsClientId=self.world.client)
         return {p[2] for p in points}
 
     def record_contacts(self) -> None:
