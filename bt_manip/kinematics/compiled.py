@@ -156,7 +156,7 @@ def load_runner(function: ca.Function, key: Hashable | None = None) -> FunctionR
         path = _build(function, compiler)
         if memo is not None and path is not None:
             if len(_LIBRARY_MEMO) >= _LIBRARY_MEMO_SIZE:
-                _LIBRARY_MEMO.pop(next(iter(_LIBRARY_MEMO)))
+                _LIBRARY_MEMO.pop(next(iter(_LIBRARY_MEMO)), None)
             _LIBRARY_MEMO[memo] = path
     if path is None:
         return VirtualMachineRunner(function)

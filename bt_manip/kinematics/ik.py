@@ -338,7 +338,7 @@ def _attempt_function(arm: ArmModel, key: tuple[bytes, str, int, str]) -> ca.Fun
         _, mode, iterations, axis = key
         function = attempt_function(arm, mode, iterations, axis)
         if len(_ATTEMPT_MEMO) >= _ATTEMPT_MEMO_SIZE:
-            _ATTEMPT_MEMO.pop(next(iter(_ATTEMPT_MEMO)))
+            _ATTEMPT_MEMO.pop(next(iter(_ATTEMPT_MEMO)), None)
         _ATTEMPT_MEMO[key] = function
     return function
 

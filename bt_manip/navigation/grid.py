@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import struct
+import threading
 import zlib
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -236,6 +237,7 @@ class _HitMemo:
         self._blocks: dict[bytes, list[tuple[int, int, np.ndarray]]] = {}
         self._sizes: dict[bytes, int] = {}
         self.cells = 0
+        self._lock = threading.Lock()  # grids may be drawn from more than one thread
 
     @staticmethod
     def key(grid: OccupancyGrid, outline: Outline) -> bytes:
@@ -249,28 +251,31 @@ class _HitMemo:
         return b"p" + head + np.array(v.shape, dtype=float).tobytes() + v.tobytes()
 
     def get(self, key: bytes) -> list[tuple[int, int, np.ndarray]] | None:
-        blocks = self._blocks.pop(key, None)
-        if blocks is not None:  # most recently used last
-            self._blocks[key] = blocks
-        return blocks
+        with self._lock:
+            blocks = self._blocks.pop(key, None)
+            if blocks is not None:  # most recently used last
+                self._blocks[key] = blocks
+            return blocks
 
     def put(self, key: bytes, blocks: list[tuple[int, int, np.ndarray]], cells: int) -> None:
-        if key in self._blocks or cells > self.MAX_CELLS:
-            return
-        while self._blocks and (
-            len(self._blocks) >= self.MAX_ENTRIES or self.cells + cells > self.MAX_CELLS
-        ):
-            old = next(iter(self._blocks))
-            del self._blocks[old]
-            self.cells -= self._sizes.pop(old)
-        self._blocks[key] = blocks
-        self._sizes[key] = cells
-        self.cells += cells
+        with self._lock:
+            if key in self._blocks or cells > self.MAX_CELLS:
+                return
+            while self._blocks and (
+                len(self._blocks) >= self.MAX_ENTRIES or self.cells + cells > self.MAX_CELLS
+            ):
+                old = next(iter(self._blocks))
+                del self._blocks[old]
+                self.cells -= self._sizes.pop(old)
+            self._blocks[key] = blocks
+            self._sizes[key] = cells
+            self.cells += cells
 
     def clear(self) -> None:
-        self._blocks.clear()
-        self._sizes.clear()
-        self.cells = 0
+        with self._lock:
+            self._blocks.clear()
+            self._sizes.clear()
+            self.cells = 0
 
 
 _HIT_MEMO = _HitMemo()

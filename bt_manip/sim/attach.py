@@ -173,6 +173,10 @@ class Attachments:
         held = self._by_object.get(object_name)
         if held is None:
             return []
+        return self._static_contacts(object_name, held)
+
+    def _static_contacts(self, object_name: str, held: Attachment) -> list[str]:
+        """:meth:`static_contacts` of an attached object."""
         supports = self._supports.get(object_name, set())
         touching = self._touching(held.object_body)
         for support in list(supports):  # a support left once is a support no more
@@ -198,8 +202,10 @@ class Attachments:
 
         The World calls this after each step while anything is attached.
         """
-        for name in self._by_object:
-            self._touched[name].update(self.static_contacts(name))
+        for name, held in self._by_object.items():
+            touched = self._static_contacts(name, held)
+            if touched:
+                self._touched[name].update(touched)
 
     def touched(self, object_name: str) -> list[str]:
         """Static bodies ``object_name`` has touched since it was last attached."""
