@@ -54,6 +54,8 @@ POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
 IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
 
 _MISSING = object()
+_IMMUTABLE = frozenset({int, float, bool, str, bytes, type(None)})
+"""Types whose values ``copy.deepcopy`` gives back as they are."""
 _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 # Enum members hash in Python code: the hot path maps statuses through identity lookups.
@@ -255,7 +257,9 @@ class BtNode(PortsMixin):
         binding = self.bindings.get(port_name)
         if binding is None:
             if info.has_default:
-                return copy.deepcopy(info.default_value)
+                value = info.default_value
+                # deepcopy returns these unchanged; skip its cost on the tick path
+                return value if type(value) in _IMMUTABLE else copy.deepcopy(value)
             if default is not _MISSING:
                 return default
             raise PortError(f"{self.describe()}: input port '{port_name}' has no value")

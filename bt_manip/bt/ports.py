@@ -123,16 +123,16 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
 
     ``text`` is the value as the user wrote it, shown in the message (default: its text form).
     """
-    shown = text if text is not None else format_literal(value)
     many = isinstance(value, list | tuple)
     numeric = _carries_floats(info.data_type)
     rule: Accepts | None = getattr(info, "accepts", None)
-    infinite = takes_infinity(info)
     for item in value if many else [value]:
         if (numeric and isinstance(item, numbers.Real) and not isinstance(item, bool)
-                and not math.isfinite(item) and not (infinite and math.isinf(item))):
+                and not math.isfinite(item) and not (takes_infinity(info) and math.isinf(item))):
+            shown = text if text is not None else format_literal(value)
             return f"must be a finite number, got {shown}"
         if rule is not None and not rule.allows(item):
+            shown = text if text is not None else format_literal(value)
             each = "each value " if many else ""
             return f"{each}must be {rule.text()}, got {shown}"
     if rule is not None and rule.check is not None:
@@ -141,9 +141,27 @@ def value_problem(info: PortInformation, value: Any, text: str | None = None) ->
 
 
 def _carries_floats(data_type: Any) -> bool:
+    """Whether values of ``data_type`` hold floats (remembered per type: it is asked at
+    every read of a port)."""
+    try:
+        return _CARRIES_FLOATS[data_type]
+    except KeyError:
+        pass
+    except TypeError:  # an unhashable type description
+        return _find_floats(data_type)
+    found = _find_floats(data_type)
+    if len(_CARRIES_FLOATS) < 1024:
+        _CARRIES_FLOATS[data_type] = found
+    return found
+
+
+_CARRIES_FLOATS: dict[Any, bool] = {}
+
+
+def _find_floats(data_type: Any) -> bool:
     if data_type is float:
         return True
-    return any(_carries_floats(arg) for arg in get_args(data_type))
+    return any(_find_floats(arg) for arg in get_args(data_type))
 
 
 @dataclass(frozen=True)

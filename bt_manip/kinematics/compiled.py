@@ -28,6 +28,7 @@ import os
 import shutil
 import subprocess
 import tempfile
+from collections.abc import Hashable
 from pathlib import Path
 
 import casadi as ca
@@ -133,12 +134,30 @@ FunctionRunner = CompiledRunner | VirtualMachineRunner
 """Either way of evaluating a CasADi function (compiled C or CasADi's virtual machine)."""
 
 
-def load_runner(function: ca.Function) -> FunctionRunner:
-    """A runner for ``function``: compiled C when possible, CasADi's VM otherwise."""
+_LIBRARY_MEMO: dict[tuple[Hashable, str, str], Path] = {}
+"""Libraries already found or built in this process, by (the caller's key of the function,
+compiler, cache folder): generating the C source to find the cached file costs more than the
+rest of loading it. An entry is used only while its file exists."""
+_LIBRARY_MEMO_SIZE = 64
+
+
+def load_runner(function: ca.Function, key: Hashable | None = None) -> FunctionRunner:
+    """A runner for ``function``: compiled C when possible, CasADi's VM otherwise.
+
+    ``key``, when given, must identify the function's graph completely (two functions with
+    equal keys generate the same C source); the library found for it is then remembered for
+    the process, so later calls skip the code generation."""
     compiler = _compiler()
     if compiler is None:
         return VirtualMachineRunner(function)
-    path = _build(function, compiler)
+    memo = None if key is None else (key, compiler, str(cache_dir()))
+    path = _LIBRARY_MEMO.get(memo) if memo is not None else None
+    if path is None or not path.is_file():
+        path = _build(function, compiler)
+        if memo is not None and path is not None:
+            if len(_LIBRARY_MEMO) >= _LIBRARY_MEMO_SIZE:
+                _LIBRARY_MEMO.pop(next(iter(_LIBRARY_MEMO)), None)
+            _LIBRARY_MEMO[memo] = path
     if path is None:
         return VirtualMachineRunner(function)
     try:

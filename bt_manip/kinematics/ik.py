@@ -35,6 +35,7 @@ import math
 import time
 from dataclasses import dataclass, field
 
+import casadi as ca
 import numpy as np
 
 from bt_manip.kinematics.arm_model import ArmModel
@@ -149,9 +150,10 @@ class IKSolver:
         self.options = options or IKOptions()
         o = self.options
         axis = o.free_axis or "z"
-        function = attempt_function(arm, o.mode, o.iterations_per_attempt, axis)
+        key = (arm._chain_key(), o.mode, o.iterations_per_attempt, axis)
+        function = _attempt_function(arm, key)
         if o.compile:
-            self._runner: FunctionRunner = load_runner(function)
+            self._runner: FunctionRunner = load_runner(function, key)
         else:
             self._runner = VirtualMachineRunner(function)
         self._params = np.array(
@@ -320,6 +322,25 @@ class IKSolver:
         if found is None:
             return None
         return joint_limits(self.arm, found)
+
+
+_ATTEMPT_MEMO: dict[tuple[bytes, str, int, str], ca.Function] = {}
+"""Attempt functions already built in this process, by (the arm's chain key, mode, steps per
+attempt, free axis): every episode builds its solvers afresh, and building the CasADi graph
+costs more than the rest of a solver. The graph depends on those numbers only."""
+_ATTEMPT_MEMO_SIZE = 64
+
+
+def _attempt_function(arm: ArmModel, key: tuple[bytes, str, int, str]) -> ca.Function:
+    """:func:`attempt_function` of ``arm`` for ``key`` (see :data:`_ATTEMPT_MEMO`)."""
+    function = _ATTEMPT_MEMO.get(key)
+    if function is None:
+        _, mode, iterations, axis = key
+        function = attempt_function(arm, mode, iterations, axis)
+        if len(_ATTEMPT_MEMO) >= _ATTEMPT_MEMO_SIZE:
+            _ATTEMPT_MEMO.pop(next(iter(_ATTEMPT_MEMO)), None)
+        _ATTEMPT_MEMO[key] = function
+    return function
 
 
 def _norm3(v: np.ndarray) -> float:

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import math
 import struct
+import threading
 import zlib
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
@@ -134,9 +135,35 @@ class OccupancyGrid:
     # -- drawing ---------------------------------------------------------------------------------
     def _hit_blocks(self, outline: Outline) -> Iterator[tuple[int, int, np.ndarray]]:
         """``(first row, first column, hit)`` per block of rows of the outline's bounding box:
-        ``hit`` marks the cells whose squares overlap ``outline`` with positive area. Blocks
-        hold at most :data:`BLOCK_CELLS` cells, so a shape as large as the grid needs no
-        temporaries the size of the grid."""
+        ``hit`` (read-only) marks the cells whose squares overlap ``outline`` with positive
+        area. Blocks hold at most :data:`BLOCK_CELLS` cells, so a shape as large as the grid
+        needs no temporaries the size of the grid.
+
+        The blocks depend only on the outline's numbers and the grid's origin, resolution and
+        shape, so those of small outlines are remembered for the process (:class:`_HitMemo`):
+        the walls and furniture of a world are drawn again in every episode and every height
+        band, mostly with the very same outlines."""
+        key = _HIT_MEMO.key(self, outline)
+        known = _HIT_MEMO.get(key)
+        if known is not None:
+            yield from known
+            return
+        kept: list[tuple[int, int, np.ndarray]] | None = []
+        cells = 0
+        for ra, c0, hit in self._compute_hit_blocks(outline):
+            if kept is not None:
+                cells += hit.size
+                if cells <= _HitMemo.MAX_OUTLINE_CELLS:
+                    hit.flags.writeable = False
+                    kept.append((ra, c0, hit))
+                else:  # a large shape: not kept
+                    kept = None
+            yield ra, c0, hit
+        if kept is not None:
+            _HIT_MEMO.put(key, kept, cells)
+
+    def _compute_hit_blocks(self, outline: Outline) -> Iterator[tuple[int, int, np.ndarray]]:
+        """The blocks of :meth:`_hit_blocks`, computed."""
         rows, cols = self.shape
         res = self.resolution
         x0, y0 = self.origin
@@ -194,6 +221,66 @@ class OccupancyGrid:
         write_png(path, img[::-1])
 
 
+class _HitMemo:
+    """The hit blocks of outlines already drawn in this process (see
+    :meth:`OccupancyGrid._hit_blocks`), keyed by the outline's and the grid's numbers (their
+    bytes, so equal keys mean equal inputs bit for bit), least recently used dropped first.
+    Bounded in entries and in cells held."""
+
+    MAX_ENTRIES = 4096
+    MAX_CELLS = 8_000_000
+    """Cells (one byte each) held at most over all entries."""
+    MAX_OUTLINE_CELLS = 200_000
+    """Outlines covering more cells than this are not kept."""
+
+    def __init__(self) -> None:
+        self._blocks: dict[bytes, list[tuple[int, int, np.ndarray]]] = {}
+        self._sizes: dict[bytes, int] = {}
+        self.cells = 0
+        self._lock = threading.Lock()  # grids may be drawn from more than one thread
+
+    @staticmethod
+    def key(grid: OccupancyGrid, outline: Outline) -> bytes:
+        rows, cols = grid.shape
+        head = np.array(
+            [grid.origin[0], grid.origin[1], grid.resolution, rows, cols], dtype=float
+        ).tobytes()
+        if isinstance(outline, Disc):
+            return b"d" + head + np.array([outline.cx, outline.cy, outline.radius]).tobytes()
+        v = np.ascontiguousarray(outline.vertices, dtype=float)
+        return b"p" + head + np.array(v.shape, dtype=float).tobytes() + v.tobytes()
+
+    def get(self, key: bytes) -> list[tuple[int, int, np.ndarray]] | None:
+        with self._lock:
+            blocks = self._blocks.pop(key, None)
+            if blocks is not None:  # most recently used last
+                self._blocks[key] = blocks
+            return blocks
+
+    def put(self, key: bytes, blocks: list[tuple[int, int, np.ndarray]], cells: int) -> None:
+        with self._lock:
+            if key in self._blocks or cells > self.MAX_CELLS:
+                return
+            while self._blocks and (
+                len(self._blocks) >= self.MAX_ENTRIES or self.cells + cells > self.MAX_CELLS
+            ):
+                old = next(iter(self._blocks))
+                del self._blocks[old]
+                self.cells -= self._sizes.pop(old)
+            self._blocks[key] = blocks
+            self._sizes[key] = cells
+            self.cells += cells
+
+    def clear(self) -> None:
+        with self._lock:
+            self._blocks.clear()
+            self._sizes.clear()
+            self.cells = 0
+
+
+_HIT_MEMO = _HitMemo()
+
+
 def _disc_hits(d: Disc, lx: np.ndarray, ly: np.ndarray, res: float) -> np.ndarray:
     """Cells (lower-left corners lx (1, n), ly (m, 1)) whose square overlaps the disc's
     interior, as an (m, n) mask."""
@@ -211,16 +298,17 @@ def _polygon_hits(p: Polygon, lx: np.ndarray, ly: np.ndarray, res: float) -> np.
     hit = ((lx < xmax - _EPS) & (lx + res > xmin + _EPS)) & (
         (ly < ymax - _EPS) & (ly + res > ymin + _EPS)
     )
-    n = len(v)
+    corners = v.tolist()  # plain floats: the same arithmetic, less overhead per edge
+    n = len(corners)
     for i in range(n):
-        a = v[i]
-        b = v[(i + 1) % n]
-        nx, ny = b[1] - a[1], -(b[0] - a[0])  # outward normal of a counter-clockwise edge
+        ax, ay = corners[i]
+        bx, by = corners[(i + 1) % n]
+        nx, ny = by - ay, -(bx - ax)  # outward normal of a counter-clockwise edge
         norm = math.hypot(nx, ny)
         if norm < 1e-12:
             continue
         nx, ny = nx / norm, ny / norm
-        edge = nx * a[0] + ny * a[1]
+        edge = nx * ax + ny * ay
         # smallest projection of the square's corners on the normal
         low = nx * lx + ny * ly + min(0.0, nx * res) + min(0.0, ny * res)
         hit &= low < edge - _EPS

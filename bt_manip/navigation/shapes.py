@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 import pybullet as pb
 
@@ -72,24 +73,55 @@ Outline = Disc | Polygon
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
     """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
-    pts = np.unique(np.round(np.asarray(points, dtype=float), 12), axis=0)
+    pts = _sorted_unique_rows(np.round(np.asarray(points, dtype=float), 12))
     if len(pts) <= 2:
         return pts
+    return _monotone_chain(pts)
 
-    def cross(o: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-        return float((a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]))
 
-    lower: list[np.ndarray] = []
-    for p in pts:
-        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
-            lower.pop()
-        lower.append(p)
-    upper: list[np.ndarray] = []
-    for p in pts[::-1]:
-        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
-            upper.pop()
-        upper.append(p)
-    return np.array(lower[:-1] + upper[:-1])
+def _sorted_unique_rows(pts: np.ndarray) -> np.ndarray:
+    """The distinct rows of an (n, 2) array sorted by x then y: ``np.unique(pts, axis=0)``,
+    computed by a lexicographic sort and a comparison of neighbours (much cheaper). Arrays
+    holding a zero (0.0 and -0.0 are equal, and which one ``np.unique`` keeps is its own
+    choice) or a NaN go through ``np.unique`` itself."""
+    if pts.ndim != 2 or pts.shape[1] != 2 or not np.all(pts != 0.0):  # also catches NaN
+        return np.unique(pts, axis=0)
+    s = pts[np.lexsort((pts[:, 1], pts[:, 0]))]
+    keep = np.ones(len(s), dtype=bool)
+    keep[1:] = (s[1:, 0] != s[:-1, 0]) | (s[1:, 1] != s[:-1, 1])
+    return s[keep]
+
+
+@numba.njit(cache=True)
+def _monotone_chain(pts: np.ndarray) -> np.ndarray:  # pragma: no cover - compiled
+    """Andrew's monotone chain over distinct points sorted by x then y (at least three): the
+    lower chain left to right, then the upper chain right to left, each point kept while the
+    chain turns left (a point on a straight stretch is dropped)."""
+    n = pts.shape[0]
+    chain = np.empty((2 * n, 2))
+    k = 0
+    for i in range(n):
+        px, py = pts[i, 0], pts[i, 1]
+        while k >= 2:
+            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
+            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
+            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
+                break
+            k -= 1
+        chain[k, 0], chain[k, 1] = px, py
+        k += 1
+    lower = k
+    for i in range(n - 1, -1, -1):
+        px, py = pts[i, 0], pts[i, 1]
+        while k - lower >= 2:
+            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
+            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
+            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
+                break
+            k -= 1
+        chain[k, 0], chain[k, 1] = px, py
+        k += 1
+    return np.concatenate((chain[: lower - 1], chain[lower : k - 1]))
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:
@@ -98,25 +130,32 @@ def planar_frame(x: float, y: float, yaw: float) -> Frame:
     return np.array([x, y, 0.0]), np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
+_BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+"""The eight corners of a box as signs of its half extents; corner ``i`` and ``i ^ bit``
+(bit 1, 2 or 4) share an edge."""
+_BOX_EDGES = [(i, i ^ bit) for i in range(8) for bit in (1, 2, 4) if (i ^ bit) > i]
+
+
 def _box_slice(frame: Frame, half: np.ndarray, band: ZBand) -> np.ndarray | None:
-    """Plane points of the part of a box inside the z band (None if it misses the band)."""
-    signs = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
-    corners = frame[0] + (signs * half) @ frame[1].T
+    """Plane points of the part of a box inside the z band (None if it misses the band): the
+    corners inside it and where the edges cross its two planes."""
+    corners = frame[0] + (_BOX_SIGNS * half) @ frame[1].T
     z = corners[:, 2]
     lo, hi = band
     if z.max() < lo or z.min() > hi:
         return None
     pts = [corners[(z >= lo) & (z <= hi), :2]]
-    for i in range(8):
-        for bit in (1, 2, 4):
-            j = i ^ bit
-            if j < i:
-                continue
-            za, zb = z[i], z[j]
-            for plane in (lo, hi):
-                if (za - plane) * (zb - plane) < 0.0:
-                    t = (plane - za) / (zb - za)
-                    pts.append((corners[i, :2] + t * (corners[j, :2] - corners[i, :2]))[None])
+    c = corners.tolist()  # plain floats: the same arithmetic, less overhead per corner
+    crossings = []
+    for i, j in _BOX_EDGES:
+        xa, ya, za = c[i]
+        xb, yb, zb = c[j]
+        for plane in (lo, hi):
+            if (za - plane) * (zb - plane) < 0.0:
+                t = (plane - za) / (zb - za)
+                crossings.append((xa + t * (xb - xa), ya + t * (yb - ya)))
+    if crossings:
+        pts.append(np.array(crossings, dtype=float))
     pts_all = np.concatenate(pts)
     return pts_all if len(pts_all) else None
 

@@ -173,8 +173,12 @@ class Attachments:
         held = self._by_object.get(object_name)
         if held is None:
             return []
+        return self._static_contacts(object_name, held)
+
+    def _static_contacts(self, object_name: str, held: Attachment) -> list[str]:
+        """:meth:`static_contacts` of an attached object."""
         supports = self._supports.get(object_name, set())
-        touching = {c.body_b for c in pbq.contacts(self.client, held.object_body)}
+        touching = self._touching(held.object_body)
         for support in list(supports):  # a support left once is a support no more
             if support not in touching and not pbq.closest_points(
                 self.client, held.object_body, support, LEAVE_CLEARANCE
@@ -187,13 +191,21 @@ class Attachments:
         static = self._static_names()
         return sorted(static[b] for b in touching if b in static)
 
+    def _touching(self, body: int) -> set[int]:
+        """The bodies ``body`` has contact points with after the last step (read straight from
+        ``getContactPoints``, index 2 being body B: this runs after every physics step)."""
+        points = pb.getContactPoints(bodyA=body, physicsClientId=self.world.client)
+        return {p[2] for p in points}
+
     def record_contacts(self) -> None:
         """Note every static body an attached object touches now (see :meth:`static_contacts`).
 
         The World calls this after each step while anything is attached.
         """
-        for name in self._by_object:
-            self._touched[name].update(self.static_contacts(name))
+        for name, held in self._by_object.items():
+            touched = self._static_contacts(name, held)
+            if touched:
+                self._touched[name].update(touched)
 
     def touched(self, object_name: str) -> list[str]:
         """Static bodies ``object_name`` has touched since it was last attached."""

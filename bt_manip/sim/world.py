@@ -362,11 +362,13 @@ class World:
     # -- running ------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance physics by ``n`` periods of ``dt`` and the sim clock with it."""
+        step, client, clock, dt = pb.stepSimulation, self.client, self.clock, self.dt
+        record_contacts = self.attachments.record_contacts
         for _ in range(n):
-            pb.stepSimulation(physicsClientId=self.client)
+            step(physicsClientId=client)
             self.step_count += 1
-            self.clock.t = self.step_count * self.dt
-            self.attachments.record_contacts()
+            clock.t = self.step_count * dt
+            record_contacts()
 
     @property
     def time(self) -> float:
