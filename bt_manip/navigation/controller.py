@@ -14,7 +14,9 @@ Phases, as reported in :attr:`FollowStatus.phase` while RUNNING:
   yaw-rate limit on curves and by the braking distance to the end of the path.
 - ``approach``: the end of the path was reached more than ``xy_tolerance`` from the goal (or
   the base drifted 1.5 ``xy_tolerance`` away while turning to the heading); the base turns
-  toward the goal and drives straight to it (backwards if it is just behind).
+  toward the goal and drives straight to it (backwards if it is just behind). A goal near and
+  to the side is not turned to: the base first backs straight up until the goal lies ahead
+  (``sidestep_distance``).
 - ``align``: at the goal, the base turns on the spot to the goal heading.
 - ``settle``: well inside the tolerances, the command is zero for ``settle_time`` seconds.
 
@@ -106,6 +108,12 @@ class FollowerOptions:
     """Speed (m/s) of the straight final approach used when the path's end is missed."""
     reverse_distance: float = 0.4
     """In ``approach``, a goal closer than this (m) behind the base is reached backwards."""
+    sidestep_distance: float = 0.3
+    """In ``approach``, a target closer than this (m) that lies to the side (more than 0.5 rad
+    off both ahead and behind) is not turned to on the spot: the base first backs straight up
+    until the target lies within 0.5 rad ahead, then drives in, so a base near obstacles does
+    not sweep round by up to 90 deg (and back in ``align``) to move a few centimetres
+    sideways."""
     align_yaw_rate: float = 1.0
     """Largest yaw rate (rad/s) when turning to the goal heading."""
     align_creep: float = 0.12
@@ -445,6 +453,10 @@ class PathFollower(PathProgress):
         dist = math.hypot(tx - px, ty - py)
         alpha = wrap(math.atan2(ty - py, tx - px) - yaw)
         sign = 1.0
+        if dist < o.sidestep_distance and 0.5 < abs(alpha) < math.pi - 0.5:
+            # to the side and near: back straight up until it lies ahead, then drive in (a
+            # goal pose near an object faces it: backing moves away from the object)
+            return -min(o.approach_speed, 0.5 * o.approach_speed + dist), 0.0, alpha
         if abs(alpha) > 0.5 * math.pi and dist < o.reverse_distance:
             sign = -1.0
             alpha = wrap(alpha - math.pi)
