@@ -395,17 +395,27 @@ class Navigator:
         clear_high: np.ndarray | None = None,
     ) -> NavPlan:
         """Plan over poses with ``footprint`` (and ``carried``) and get ready to follow."""
-        poses = plan_poses(
-            grid,
-            clear,
-            footprint,
-            pose,
-            goal,
-            self.pivot,
-            self.options.lattice,
-            carried=carried,
-            clear_high=clear_high,
-        )
+
+        def plan_from(start: Pose2D) -> PosePlan:
+            return plan_poses(
+                grid,
+                clear,
+                footprint,
+                start,
+                goal,
+                self.pivot,
+                self.options.lattice,
+                carried=carried,
+                clear_high=clear_high,
+            )
+
+        def replan(start: Pose2D) -> PosePlan:
+            new = plan_from(start)
+            if new.ok:
+                self.poses = new
+            return new
+
+        poses = plan_from(pose)
         if not poses.ok:
             self.plan = NavPlan(PlanOutcome.FOOTPRINT, poses.reason)
             return self.plan
@@ -419,7 +429,10 @@ class Navigator:
         self.plan = NavPlan(PlanOutcome.OK, "ok", poly, None, path_length(poly))
         self.poses = poses
         self.follower = SegmentFollower(
-            poses, goal, dataclasses.replace(self._follower_options, pivot=self.pivot)
+            poses,
+            goal,
+            dataclasses.replace(self._follower_options, pivot=self.pivot),
+            replan=replan,
         )
         return self.plan
 
