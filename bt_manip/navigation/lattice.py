@@ -6,8 +6,11 @@ width, which is right for a base that drives along its path but not for a base t
 searches over poses instead (a hybrid A*): from each pose it tries short moves -- forward or
 backward, straight or along an arc, or a turn on the spot about the base's pivot point --
 checks the whole footprint along each move against the clearance grid, and keeps the cheapest
-pose per (x, y, heading) bin. Backing up costs double, and turning on the spot costs
-``turn_cost`` metres per radian, so the result drives forward where it can.
+pose per (x, y, heading) bin (a pose already expanded keeps its bin, so every pose of the
+result is reached from the one before by one move). Backing up costs double, turning on the
+spot costs ``turn_cost`` metres per radian, and changing from one kind of move to another
+costs ``steer_cost``, so the result drives forward where it can and keeps a heading rather
+than weaving between neighbouring ones.
 
 The moves are checked every few centimetres of footprint travel: every outline point must keep
 ``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a

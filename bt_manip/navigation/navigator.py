@@ -21,8 +21,9 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
   over poses below decides; otherwise, or when that search finds nothing, the plan fails with
   the footprint as the reason. Then a search over poses
   (:mod:`bt_manip.navigation.lattice`) finds moves, backing up where needed, that keep the whole
-  robot and its load clear, and a :class:`SegmentFollower` drives them. No replanning is done
-  in this mode yet.
+  robot and its load clear, and a :class:`SegmentFollower` drives them. When one of its runs
+  ends off its pose, the same search plans the rest of the way again from where the robot
+  stands (moved objects are not watched for in this mode).
 
 Where a skid-steer base turns on the spot (``pivot``) matters for ending on the goal; see
 :mod:`bt_manip.navigation.controller`.
