@@ -14,7 +14,9 @@ Phases, as reported in :attr:`FollowStatus.phase` while RUNNING:
   yaw-rate limit on curves and by the braking distance to the end of the path.
 - ``approach``: the end of the path was reached more than ``xy_tolerance`` from the goal (or
   the base drifted 1.5 ``xy_tolerance`` away while turning to the heading); the base turns
-  toward the goal and drives straight to it (backwards if it is just behind).
+  toward the goal and drives straight to it (backwards if it is just behind). A goal near and
+  to the side is not turned to: the base first backs straight up until the goal lies ahead
+  (``sidestep_distance``; on the first such approach only, later ones turn toward it).
 - ``align``: at the goal, the base turns on the spot to the goal heading.
 - ``settle``: well inside the tolerances, the command is zero for ``settle_time`` seconds.
 
@@ -106,6 +108,14 @@ class FollowerOptions:
     """Speed (m/s) of the straight final approach used when the path's end is missed."""
     reverse_distance: float = 0.4
     """In ``approach``, a goal closer than this (m) behind the base is reached backwards."""
+    sidestep_distance: float = 0.3
+    """In ``approach``, a target closer than this (m) that lies to the side (more than 0.5 rad
+    off both ahead and behind) is not turned to on the spot: the base first backs straight up
+    until the target lies within 0.5 rad ahead, then drives in, so a base near obstacles does
+    not sweep round by up to 90 deg (and back in ``align``) to move a few centimetres
+    sideways. Done on the first approach that finds the target there only: a base whose turns
+    to the heading drift it off the goal again turns toward it as before, rather than backing
+    up and driving in over and over."""
     align_yaw_rate: float = 1.0
     """Largest yaw rate (rad/s) when turning to the goal heading."""
     align_creep: float = 0.12
@@ -229,6 +239,8 @@ class PathFollower(PathProgress):
         self._last_time: float | None = None
         self._settle_start = 0.0
         self._switches = 0
+        self._sidestepped = False
+        self._sidestep_phase = False
         self._last_check: float | None = None
         self._phase = "drive"
         self._best = math.inf
@@ -445,6 +457,12 @@ class PathFollower(PathProgress):
         dist = math.hypot(tx - px, ty - py)
         alpha = wrap(math.atan2(ty - py, tx - px) - yaw)
         sign = 1.0
+        sideways = 0.5 < abs(alpha) < math.pi - 0.5
+        if sideways and dist < o.sidestep_distance and self._sidestepping():
+            # to the side and near: back straight up until it lies ahead, then drive in (a
+            # goal pose near an object faces it: backing moves away from the object)
+            return -min(o.approach_speed, 0.5 * o.approach_speed + dist), 0.0, alpha
+        self._sidestep_phase = False
         if abs(alpha) > 0.5 * math.pi and dist < o.reverse_distance:
             sign = -1.0
             alpha = wrap(alpha - math.pi)
@@ -453,6 +471,17 @@ class PathFollower(PathProgress):
         v = min(o.approach_speed, math.sqrt(o.max_accel * dist) + 0.02) * math.cos(alpha)
         w = self._turn_rate(alpha) if abs(alpha) > 0.05 else 0.0
         return sign * v, w, alpha
+
+    def _sidestepping(self) -> bool:
+        """Whether to back up from a goal to the side now: on the first approach that finds it
+        there (and while that backing lasts), not again, so a base whose turns on the spot
+        drift it off the goal does not back up and drive in over and over."""
+        if self._sidestep_phase:
+            return True
+        if self._sidestepped:
+            return False
+        self._sidestepped = self._sidestep_phase = True
+        return True
 
     def _turn_rate(self, error: float) -> float:
         o = self.options

@@ -6,8 +6,11 @@ width, which is right for a base that drives along its path but not for a base t
 searches over poses instead (a hybrid A*): from each pose it tries short moves -- forward or
 backward, straight or along an arc, or a turn on the spot about the base's pivot point --
 checks the whole footprint along each move against the clearance grid, and keeps the cheapest
-pose per (x, y, heading) bin. Backing up costs double, and turning on the spot costs
-``turn_cost`` metres per radian, so the result drives forward where it can.
+pose per (x, y, heading) bin (a pose already expanded keeps its bin, so every pose of the
+result is reached from the one before by one move). Backing up costs double, turning on the
+spot costs ``turn_cost`` metres per radian, and changing from one kind of move to another
+costs ``steer_cost``, so the result drives forward where it can and keeps a heading rather
+than weaving between neighbouring ones.
 
 The moves are checked every few centimetres of footprint travel: every outline point must keep
 ``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a
@@ -63,6 +66,11 @@ class LatticeOptions:
     max_expansions: int = 400_000
     check_spacing: float = 0.05
     """Largest travel (m) of any footprint point between two collision checks."""
+    steer_cost: float = 0.1
+    """Cost (m) of changing from one kind of move to another (straight to arc, arc to straight
+    or to the other side, driving to turning on the spot, forward to backward): the plan keeps
+    a heading where it can instead of weaving between neighbouring headings, which a follower
+    would cut across."""
     tight_start: float = 0.6
     """Within this distance (m) of a start that lacks ``min_clearance`` (but touches nothing),
     moves need only keep the footprint off the obstacles (see the module)."""
@@ -471,6 +479,7 @@ def _search(
     pivot = params[11]
     need_low = params[12]
     tight_radius = params[13]
+    steer_cost = params[14]
     # a start closer to obstacles than ``need`` (but not touching them): within
     # ``tight_radius`` of it, moves need only keep ``need_low``, at three times the cost from a
     # pose without the full margin, so the plan gets out of the tight spot at once
@@ -484,6 +493,7 @@ def _search(
     slot_of = numba.typed.Dict.empty(key_type=numba.types.int64, value_type=numba.types.int64)
     room = 1 << 12
     best = np.empty(room)
+    closed = np.zeros(room, np.bool_)
     parent = np.empty(room, np.int64)
     move_of = np.empty(room, np.int64)
     pose = np.empty((room, 3))
@@ -540,14 +550,15 @@ def _search(
         h, heap_d, heap_i = _heuristic(
             x, y, x0, y0, res, goal, free, dist, heap_d, heap_i, state, frontier
         )
-        if f > g + h + 1e-9:
-            continue  # stale
+        if closed[k] or f > g + h + 1e-9:
+            continue  # expanded already, or stale
         dyaw = (th - goal[2] + math.pi) % two_pi - math.pi
         if math.hypot(x - goal[0], y - goal[1]) <= gxy and abs(dyaw) <= gyaw:
             return parent, move_of, pose, k, expanded
         expanded += 1
         if expanded > maxexp:
             break
+        closed[k] = True
         near_start = start_tight and math.hypot(x - start[0], y - start[1]) <= tight_radius
         tight = near_start and (
             _pose_margin(clear, clear_high, x0, y0, res, pts, pts_high, x, y, th) < need
@@ -573,14 +584,20 @@ def _search(
                 continue
             bin_key = key(nx, ny, nt)
             ng = g + costs[m] * (3.0 if tight else 1.0)
+            prev = move_of[k]
+            if prev >= 0 and (kinds[prev] != kind or curvs[prev] != curvs[m]):
+                ng += steer_cost
             nk = np.int64(-1)
             if bin_key in slot_of:
                 nk = slot_of[bin_key]
-                if ng >= best[nk]:
+                # an expanded pose keeps its place: its successors were reached from it
+                if closed[nk] or ng >= best[nk]:
                     continue
             else:
                 if used == best.shape[0]:
                     best = _grown(best, 2 * used)
+                    closed = _grown(closed, 2 * used)
+                    closed[used:] = False
                     parent = _grown(parent, 2 * used)
                     move_of = _grown(move_of, 2 * used)
                     pose = _grown_rows(pose, 2 * used)
@@ -671,6 +688,7 @@ def plan_poses(
             pivot,
             need_low,
             o.tight_start,
+            o.steer_cost,
         ]
     )
     parent, move_of, pose, end, expanded = _search(

@@ -21,8 +21,9 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
   over poses below decides; otherwise, or when that search finds nothing, the plan fails with
   the footprint as the reason. Then a search over poses
   (:mod:`bt_manip.navigation.lattice`) finds moves, backing up where needed, that keep the whole
-  robot and its load clear, and a :class:`SegmentFollower` drives them. No replanning is done
-  in this mode yet.
+  robot and its load clear, and a :class:`SegmentFollower` drives them. When one of its runs
+  ends off its pose, the same search plans the rest of the way again from where the robot
+  stands (moved objects are not watched for in this mode).
 
 Where a skid-steer base turns on the spot (``pivot``) matters for ending on the goal; see
 :mod:`bt_manip.navigation.controller`.
@@ -402,17 +403,27 @@ class Navigator:
         clear_high: np.ndarray | None = None,
     ) -> NavPlan:
         """Plan over poses with ``footprint`` (and ``carried``) and get ready to follow."""
-        poses = plan_poses(
-            grid,
-            clear,
-            footprint,
-            pose,
-            goal,
-            self.pivot,
-            self.options.lattice,
-            carried=carried,
-            clear_high=clear_high,
-        )
+
+        def plan_from(start: Pose2D) -> PosePlan:
+            return plan_poses(
+                grid,
+                clear,
+                footprint,
+                start,
+                goal,
+                self.pivot,
+                self.options.lattice,
+                carried=carried,
+                clear_high=clear_high,
+            )
+
+        def replan(start: Pose2D) -> PosePlan:
+            new = plan_from(start)
+            if new.ok:
+                self.poses = new
+            return new
+
+        poses = plan_from(pose)
         if not poses.ok:
             self.plan = NavPlan(PlanOutcome.FOOTPRINT, poses.reason)
             return self.plan
@@ -426,7 +437,10 @@ class Navigator:
         self.plan = NavPlan(PlanOutcome.OK, "ok", poly, None, path_length(poly))
         self.poses = poses
         self.follower = SegmentFollower(
-            poses, goal, dataclasses.replace(self._follower_options, pivot=self.pivot)
+            poses,
+            goal,
+            dataclasses.replace(self._follower_options, pivot=self.pivot),
+            replan=replan,
         )
         return self.plan
 

@@ -9,6 +9,12 @@ tolerances. Intermediate runs end within ``waypoint_tolerance`` (and 0.2 rad) wi
 settling. All runs share one :class:`~bt_manip.navigation.pivot.PivotEstimate`: the point
 the base really turns about is learnt while it turns (a carried load moves it).
 
+An intermediate run that ends off its last pose (by more than 1.5 ``waypoint_tolerance``, where
+the follower would turn toward the pose and drive there: a manoeuvre planned against nothing,
+which with a long load sweeps it round) is not finished that way when a ``replan`` is given:
+the rest of the way is planned again from where the base stands (at most ``max_replans``
+times), and the new plan's runs follow.
+
 :meth:`SegmentFollower.update` has the same contract as :meth:`PathFollower.update`.
 """
 
@@ -16,6 +22,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -52,6 +59,8 @@ class SegmentFollower:
         options: FollowerOptions | None = None,
         waypoint_tolerance: float = 0.15,
         pivot_estimate: PivotEstimate | None = None,
+        replan: Callable[[Pose2D], PosePlan] | None = None,
+        max_replans: int = 3,
     ) -> None:
         options = options or FollowerOptions()
         if not plan.ok or plan.poses is None or plan.moves is None:
@@ -65,13 +74,22 @@ class SegmentFollower:
         self._loose = dataclasses.replace(
             options, xy_tolerance=waypoint_tolerance, yaw_tolerance=0.2, settle_time=0.0
         )
+        self.replan = replan
+        self.max_replans = max_replans
+        self.replans = 0
+        """How many times the rest of the way was planned again."""
         self._queue: list[tuple[int, np.ndarray]] = []
-        poses = plan.poses
-        for kind, a, b in _runs(plan.moves):
-            self._queue.append((kind, poses[a : b + 1]))
         self._current: PathFollower | None = None
         self._final = False
         self._done: FollowStatus | None = None
+        self.runs = 0
+        self._take(plan)
+
+    def _take(self, plan: PosePlan) -> None:
+        """Queue the runs of ``plan`` (an ok plan) in place of those left."""
+        assert plan.poses is not None and plan.moves is not None
+        poses = plan.poses
+        self._queue = [(kind, poses[a : b + 1]) for kind, a, b in _runs(plan.moves)]
         self.runs = len(self._queue)
 
     @property
@@ -118,10 +136,16 @@ class SegmentFollower:
         """One tick; see :meth:`PathFollower.update`."""
         if self._done is not None:
             return self._done
-        for _ in range(self.runs + 2):
+        left = self.runs + 2  # each pass ends a run, or plans again (and adds its runs)
+        while left > 0:
+            left -= 1
             if self._current is None:
                 self._current = self._next(pose)
             status = self._current.update(pose, now)
+            if status.phase == "approach" and not self._final and self._plan_again(pose):
+                self._current = None  # follow the new plan's first run in the same tick
+                left += self.runs + 1
+                continue
             if status.state is FollowState.RUNNING:
                 return status
             if status.state is FollowState.FAILED or self._final:
@@ -130,3 +154,14 @@ class SegmentFollower:
             self._current = None  # this run is done: start the next one in the same tick
         self._done = FollowStatus(FollowState.FAILED, "pose plan could not be followed", (0, 0))
         return self._done
+
+    def _plan_again(self, pose: Pose2D) -> bool:
+        """Plan the rest of the way from ``pose``; whether a new plan was taken."""
+        if self.replan is None or self.replans >= self.max_replans:
+            return False
+        self.replans += 1
+        plan = self.replan(pose)
+        if not plan.ok or plan.moves is None or len(plan.moves) == 0:
+            return False
+        self._take(plan)
+        return True

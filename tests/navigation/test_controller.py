@@ -144,3 +144,37 @@ def test_no_new_path_fails_with_the_planners_reason() -> None:
     status = follower.update((0.0, 0.0, 0.0), 0.0)
     assert status.state is FollowState.FAILED
     assert status.reason == "path blocked and no new path: goal is not connected"
+
+
+@pytest.mark.parametrize("side", [1.0, -1.0])
+def test_a_goal_a_few_centimetres_to_the_side_is_reached_without_swinging_round(
+    side: float,
+) -> None:
+    """The path ends 12 cm beside the goal (a tight pregrasp pose next to the object it is
+    for): the base backs up along its heading and drives in at a small angle, instead of
+    turning on the spot by up to 90 deg toward the goal and back, which swept the arm
+    into the object."""
+    pivot = 0.2
+    goal = (0.0, side * 0.12, 0.3 * side)
+    here = (pivot, 0.0)
+    there = (goal[0] + pivot * math.cos(goal[2]), goal[1] + pivot * math.sin(goal[2]))
+    path = densify(np.array([here, here]))  # the path ended where the base stands
+    options = FollowerOptions(pivot=pivot, xy_tolerance=0.03, yaw_tolerance=0.03)
+    follower = PathFollower(path, goal, options)
+    pose: Pose = (0.0, 0.0, 0.0)
+    headings = [0.0]
+    t = 0.0
+    status = follower.update(pose, t)
+    while status.state is FollowState.RUNNING and t < 30.0:
+        pose = step(pose, status.cmd, pivot)
+        headings.append(pose[2])
+        t += DT
+        status = follower.update(pose, t)
+    assert status.state is FollowState.SUCCEEDED, status.reason
+    assert math.hypot(pose[0] - goal[0], pose[1] - goal[1]) <= 0.03
+    assert abs(wrap(pose[2] - goal[2])) <= 0.03
+    assert math.hypot(there[0] - here[0], there[1] - here[1]) < options.sidestep_distance
+    # never turned far beyond the start and goal headings (without backing up first it turned
+    # by 2 rad the wrong way round)
+    lo, hi = sorted((0.0, goal[2]))
+    assert min(headings) >= lo - 0.8 and max(headings) <= hi + 0.8

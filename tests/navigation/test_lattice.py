@@ -13,8 +13,10 @@ from bt_manip.navigation.grid import OccupancyGrid
 from bt_manip.navigation.lattice import (
     BACKWARD,
     TURN,
+    LatticeOptions,
     _GoalField,
     _heuristic,
+    _move,
     clearance_at_least,
     outline_samples,
     plan_poses,
@@ -186,3 +188,43 @@ def test_a_start_touching_an_obstacle_is_refused() -> None:
     plan = plan_poses(grid, clear, fp, start, (6.0, 1.0, 0.0))
     assert not plan.ok
     assert plan.reason.endswith("touches obstacles at the start")
+
+
+def _reversals(poses: np.ndarray) -> int:
+    """How many times the heading changes from turning one way to the other (or to none)."""
+    d = np.diff(np.unwrap(poses[:, 2]))
+    sign = np.sign(np.where(np.abs(d) < 1e-6, 0.0, d))
+    return int(np.sum(sign[1:] != sign[:-1]))
+
+
+def test_a_carry_through_a_doorway_keeps_its_heading_and_its_moves_join_up() -> None:
+    """A base with a 1.2 m panel across its front drives through a 1.4 m door: the plan turns
+    where it must, not back and forth between neighbouring headings (which a follower cuts
+    across, swinging the panel's ends), and each pose is reached from the one before by one
+    lattice move (an expanded pose is never replaced by another of its bin)."""
+    grid = room()
+    grid.occupied[:26, 80:82] = True  # a partition at x = 4 with a door at y 1.3-2.7
+    grid.occupied[54:, 80:82] = True
+    clear = clearance(grid)
+    base = PlanarFootprint.rectangle(0.9, 0.6, label="base")
+    panel = PlanarFootprint.rectangle(0.3, 1.2, x_offset=0.6, label="panel")
+    goal = (6.0, 2.0, 0.0)
+    plan = plan_poses(
+        grid, clear, base, (1.2, 0.8, 0.5), goal, 0.2, carried=panel, clear_high=clear
+    )
+    assert plan.ok, plan.reason
+    assert plan.poses is not None and plan.moves is not None
+    end = plan.poses[-1]
+    assert math.hypot(end[0] - goal[0], end[1] - goal[1]) <= 0.15
+    # without a cost for changing moves the heading turned one way then the other 16 times
+    assert _reversals(plan.poses) <= 8
+    o = LatticeOptions()
+    moves = [(k, c, o.step) for k in (0, 1) for c in (0.0, 1 / o.turn_radius, -1 / o.turn_radius)]
+    moves += [(2, 0.0, o.turn_step), (2, 0.0, -o.turn_step)]
+    for a, b in zip(plan.poses[:-1], plan.poses[1:], strict=True):
+        reached = [_move(a[0], a[1], a[2], k, c, length, 0.2, 1.0) for k, c, length in moves]
+        gap = min(
+            math.hypot(r[0] - b[0], r[1] - b[1]) + abs(math.remainder(r[2] - b[2], math.tau))
+            for r in reached
+        )
+        assert gap < 1e-6

@@ -135,3 +135,13 @@ def test_a_robot_wedged_against_a_crate_gets_clear_and_the_run_goes_on() -> None
         x, y, _ = world.robots["husky"].base_pose2d()
         goal = world.poses["goal"]
         assert math.hypot(x - goal.x, y - goal.y) <= 0.15
+
+
+def test_the_panel_carried_from_the_south_stand_clears_the_doorway_jamb() -> None:
+    """From the stand in the south of the workshop the carry heads north-east to the doorway:
+    the plan keeps its heading instead of weaving between neighbouring headings, which the
+    follower cut across until the panel's end touched the jamb (seed 2)."""
+    world_file = str(ROOT / "worlds" / "tb3_house_panel_south.yaml")
+    with Episode(EpisodeSpec(tree=TREE, world=world_file, seed=2)) as episode:
+        report = episode.run()
+        _delivered(episode, report)

@@ -104,3 +104,21 @@ def test_the_panel_set_moved_and_turned_is_fetched_and_delivered(seed: int) -> N
         # the stand stayed where the group put it, in the workshop
         stand = world.body_pose("panel_stand").xyz
         assert stand[0] < 0.0 and stand[1] < -1.0
+
+
+def test_the_pregrasp_pose_beside_the_panel_is_reached_without_swinging_into_it() -> None:
+    """In the world with the panel set turned counter-clockwise, the drive to the pregrasp
+    pose ends a few centimetres beside it: the base backs up and drives in instead of turning
+    on the spot toward it, which swept the arm into the panel, tilted it in its stand, and
+    the arm move into the grasp pose then stopped 10 deg short against it (seed 12)."""
+    world_file = str(ROOT / "worlds" / "tb3_house_panel_turned_ccw.yaml")
+    with Episode(EpisodeSpec(tree=TREE, world=world_file, seed=12)) as episode:
+        report = episode.run()
+        world = episode.world
+        assert report.status == "SUCCESS", report.reason
+        statuses = {n.path.split("/")[-1]: n.last_status for n in report.nodes}
+        assert statuses["pregrasp_arm"] == "SUCCESS"
+        assert world.attachments.touched("panel") == []
+        goal = world.poses["goal"]
+        x, y, _ = world.robots["husky"].base_pose2d()
+        assert math.hypot(x - goal.x, y - goal.y) <= 0.10
