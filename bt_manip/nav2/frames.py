@@ -17,13 +17,7 @@ BASE_FRAMES = frozenset({"base_link", "base_footprint"})
 def known_frame(robot: Any, frame: str) -> bool:
     """Whether bt-manip can give a pose of ``frame`` for ``robot``."""
     name = frame.lstrip("/")
-    if name in WORLD_FRAMES or name in BASE_FRAMES:
-        return True
-    try:
-        robot.link_index(name)
-    except KeyError:
-        return False
-    return True
+    return name in WORLD_FRAMES or name in BASE_FRAMES or bool(robot.has_link(name))
 
 
 @registry.register
