@@ -101,27 +101,27 @@ def _monotone_chain(pts: np.ndarray) -> np.ndarray:  # pragma: no cover - compil
     chain = np.empty((2 * n, 2))
     k = 0
     for i in range(n):
-        px, py = pts[i, 0], pts[i, 1]
-        while k >= 2:
-            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
-            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
-            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
-                break
-            k -= 1
-        chain[k, 0], chain[k, 1] = px, py
-        k += 1
+        k = _chain_push(chain, k, 0, pts[i, 0], pts[i, 1])
     lower = k
     for i in range(n - 1, -1, -1):
-        px, py = pts[i, 0], pts[i, 1]
-        while k - lower >= 2:
-            ox, oy = chain[k - 2, 0], chain[k - 2, 1]
-            ax, ay = chain[k - 1, 0], chain[k - 1, 1]
-            if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
-                break
-            k -= 1
-        chain[k, 0], chain[k, 1] = px, py
-        k += 1
+        k = _chain_push(chain, k, lower, pts[i, 0], pts[i, 1])
     return np.concatenate((chain[: lower - 1], chain[lower : k - 1]))
+
+
+@numba.njit(cache=True)
+def _chain_push(
+    chain: np.ndarray, k: int, start: int, px: float, py: float
+) -> int:  # pragma: no cover - compiled
+    """Add (px, py) to the chain of ``k`` points whose current part begins at ``start``, first
+    dropping the points after which it would not turn left; the new length."""
+    while k - start >= 2:
+        ox, oy = chain[k - 2, 0], chain[k - 2, 1]
+        ax, ay = chain[k - 1, 0], chain[k - 1, 1]
+        if (ax - ox) * (py - oy) - (ay - oy) * (px - ox) > 0.0:
+            break
+        k -= 1
+    chain[k, 0], chain[k, 1] = px, py
+    return k + 1
 
 
 def planar_frame(x: float, y: float, yaw: float) -> Frame:
