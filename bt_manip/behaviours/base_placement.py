@@ -491,6 +491,17 @@ def pose_text(values: Any) -> str:
     return ";".join(f"{float(v):.4f}" for v in values)
 
 
+CLEARANCE = Port(
+    float, False, "footprint clearance from obstacles (m)", PlacementOptions.clearance,
+    Accepts(0.0, 0.5),
+)
+BASE_POSE = PortInformation(str, False, "base pose x;y;yaw for Navigate goal")
+STAGING_POSE = PortInformation(
+    str, False, "pose x;y;yaw to line up at before driving straight to base_pose"
+)
+"""Ports the base planners (PlanBaseForGrasp, PlanBaseForPlace) share."""
+
+
 @registry.register
 class PlanBaseForGrasp(RobotAction):
     """Finds a base pose from which the arm takes ``object`` with grasp ``grasp`` (``top``).
@@ -519,10 +530,7 @@ class PlanBaseForGrasp(RobotAction):
             float, False, "pre-grasp distance back along the approach axis (m)",
             PlacementOptions.approach, Accepts(0.0, 0.3),
         ),
-        "clearance": Port(
-            float, False, "footprint clearance from obstacles (m)", PlacementOptions.clearance,
-            Accepts(0.0, 0.5),
-        ),
+        "clearance": CLEARANCE,
         "arm_state": PortInformation(
             str, False, "named arm state the reach starts from (empty: the posture now)",
             PlacementOptions.arm_state,
@@ -533,10 +541,8 @@ class PlanBaseForGrasp(RobotAction):
         ),
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
-        "base_pose": PortInformation(str, False, "base pose x;y;yaw for Navigate goal"),
-        "staging_pose": PortInformation(
-            str, False, "pose x;y;yaw to line up at before driving straight to base_pose"
-        ),
+        "base_pose": BASE_POSE,
+        "staging_pose": STAGING_POSE,
         "grasp_pose": PortInformation(str, False, "grasp frame x;y;z;qx;qy;qz;qw (world)"),
     }
 

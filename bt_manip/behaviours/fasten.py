@@ -9,14 +9,19 @@ then opens the gripper and detaches: the object stays where it was fastened.
 
 from __future__ import annotations
 
-import math
 from typing import ClassVar
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction
-from bt_manip.behaviours.place import ANGLE_TOLERANCE, POSITION_TOLERANCE, TARGET, read_target
+from bt_manip.behaviours.place import (
+    ANGLE_TOLERANCE,
+    POSITION_TOLERANCE,
+    TARGET,
+    read_target,
+    tolerance_problem,
+)
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
 from bt_manip.perception import true_pose
@@ -64,13 +69,9 @@ class Fasten(RobotAction):
             raise ActionFailed(f"'{name}' is already fastened to '{done[name]}'")
         target = read_target(self)
         dev = deviation(true_pose(world, body), target)
-        pos_tol = float(self.get_input("position_tolerance"))
-        ang_tol = math.radians(float(self.get_input("angle_tolerance")))
-        if not dev.within(pos_tol, ang_tol):
-            raise ActionFailed(
-                f"'{name}' is {dev.text()} from its target {target.text()} (tolerance "
-                f"{pos_tol * 1000:g} mm and {math.degrees(ang_tol):g} deg): not fastened"
-            )
+        problem = tolerance_problem(self, name, dev, target)
+        if problem is not None:
+            raise ActionFailed(f"{problem}: not fastened")
         max_gap = float(self.get_input("max_gap"))
         near = structures_near(world, body, max_gap)
         if not near:

@@ -64,6 +64,10 @@ ANGLE_TOLERANCE = Port(
     DEFAULT_ANGLE_TOLERANCE, Accepts(0.0, 45.0, low_open=True),
 )
 OBJECT = PortInformation(str, True, "name of the movable object held (attached) by the robot")
+APPROACH = Port(
+    float, False, "length of the straight final motion down (m)", DEFAULT_APPROACH,
+    Accepts(0.02, 0.3),
+)
 
 
 def read_target(node: Any) -> Target:
@@ -72,6 +76,19 @@ def read_target(node: Any) -> Target:
         return parse_target(node.get_input("target"))
     except TargetError as exc:
         raise ActionFailed(str(exc)) from None
+
+
+def tolerance_problem(node: Any, name: str, dev: Deviation, target: Target) -> str | None:
+    """Why object ``name``, ``dev`` from ``target``, is outside the node's
+    ``position_tolerance`` / ``angle_tolerance`` ports; None when it is within them."""
+    pos_tol = float(node.get_input("position_tolerance"))
+    ang_tol = math.radians(float(node.get_input("angle_tolerance")))
+    if dev.within(pos_tol, ang_tol):
+        return None
+    return (
+        f"'{name}' is {dev.text()} from its target {target.text()} (tolerance "
+        f"{pos_tol * 1000:g} mm and {math.degrees(ang_tol):g} deg)"
+    )
 
 
 def held_body(node: Any, name: str) -> int:
@@ -137,10 +154,7 @@ class Place(JointMove):
         **JointMove.INPUT_PORTS,
         "object": OBJECT,
         "target": TARGET,
-        "approach": Port(
-            float, False, "length of the straight final motion down (m)", DEFAULT_APPROACH,
-            Accepts(0.02, 0.3),
-        ),
+        "approach": APPROACH,
         "gap": Port(
             float, False, "height above the target where the final motion ends (m)",
             DEFAULT_GAP, Accepts(0.0, 0.02),
@@ -243,13 +257,9 @@ class Place(JointMove):
         pose = true_pose(self.world, self.body_held)
         dev = deviation(pose, self.target)
         self._report(pose, dev)
-        pos_tol = float(self.get_input("position_tolerance"))
-        ang_tol = math.radians(float(self.get_input("angle_tolerance")))
-        if not dev.within(pos_tol, ang_tol):
-            raise ActionFailed(
-                f"'{name}' is {dev.text()} from its target {self.target.text()} (tolerance "
-                f"{pos_tol * 1000:g} mm and {math.degrees(ang_tol):g} deg)"
-            )
+        problem = tolerance_problem(self, name, dev, self.target)
+        if problem is not None:
+            raise ActionFailed(problem)
         self.feedback_message = f"placed '{name}' {dev.text()} from its target"
         return Status.SUCCESS
 

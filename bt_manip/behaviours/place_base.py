@@ -31,7 +31,10 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess, skid_steer_refusal
 from bt_manip.behaviours.base_placement import (
+    BASE_POSE,
+    CLEARANCE,
     REJECTIONS,
+    STAGING_POSE,
     Candidate,
     ExtraCheck,
     Placement,
@@ -46,7 +49,7 @@ from bt_manip.behaviours.base_placement import (
 )
 from bt_manip.behaviours.cartesian import STEP, arm_ik
 from bt_manip.behaviours.place import (
-    DEFAULT_APPROACH,
+    APPROACH,
     DEFAULT_GAP,
     OBJECT,
     TARGET,
@@ -56,7 +59,6 @@ from bt_manip.behaviours.place import (
     read_target,
 )
 from bt_manip.bt import registry
-from bt_manip.bt.ports import Accepts, Port
 from bt_manip.grasps import GraspError, box_size
 from bt_manip.navigation.lattice import LatticeOptions, outline_samples, pose_free
 from bt_manip.perception import true_pose
@@ -265,20 +267,12 @@ class PlanBaseForPlace(RobotAction):
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
         "target": TARGET,
-        "approach": Port(
-            float, False, "length of the straight final motion down (m)", DEFAULT_APPROACH,
-            Accepts(0.02, 0.3),
-        ),
-        "clearance": Port(
-            float, False, "footprint clearance from obstacles (m)", PlacementOptions.clearance,
-            Accepts(0.0, 0.5),
-        ),
+        "approach": APPROACH,
+        "clearance": CLEARANCE,
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
-        "base_pose": PortInformation(str, False, "base pose x;y;yaw for Navigate goal"),
-        "staging_pose": PortInformation(
-            str, False, "pose x;y;yaw to line up at before driving straight to base_pose"
-        ),
+        "base_pose": BASE_POSE,
+        "staging_pose": STAGING_POSE,
     }
 
     def start(self) -> None:
