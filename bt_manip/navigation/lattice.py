@@ -34,12 +34,18 @@ from dataclasses import dataclass
 
 import numba
 import numpy as np
-from numba import types
-from numba.extending import overload
 
 from bt_manip.navigation.costmap import CHUNK_CELLS, clearance_of
 from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import OccupancyGrid
+from bt_manip.navigation.outline_check import (
+    WindowMinima,
+    _clearance_value,
+    _groups_free,
+    _points_free,
+    point_groups,
+    window_cells,
+)
 
 FORWARD, BACKWARD, TURN = 0, 1, 2
 """Move kinds in :attr:`PosePlan.moves`."""
@@ -288,23 +294,6 @@ def _heuristic(
     return h, heap_d, heap_i
 
 
-def _clearance_value(value: float | int, res: float) -> float:
-    """A cell's clearance (m) from its entry in a clearance grid (m) or in a grid of squared
-    cell distances (integers, :func:`bt_manip.navigation.distance.squared_distances`)."""
-    if isinstance(value, float | np.floating):
-        return float(value)
-    return math.sqrt(float(value)) * res - res / math.sqrt(2.0)
-
-
-@overload(_clearance_value, jit_options={"cache": True})  # type: ignore[typeddict-unknown-key]  # numba stubs: jit_options lack "cache"
-def _clearance_value_jit(value, res):  # type: ignore[no-untyped-def]  # numba wants them bare
-    """The compiled :func:`_clearance_value` for the cell type of the grid."""
-    if isinstance(value, types.Float):
-        return lambda value, res: value
-    # the float64 operations of costmap.clearance_of, so the same value to the last bit
-    return lambda value, res: math.sqrt(float(value)) * res - res / math.sqrt(2.0)
-
-
 def clearance_at_least(clear: np.ndarray, res: float, threshold: float) -> np.ndarray:
     """Cells whose clearance is at least ``threshold`` (m), from a clearance grid or squared
     cell distances (converted a block of rows at a time)."""
@@ -316,33 +305,6 @@ def clearance_at_least(clear: np.ndarray, res: float, threshold: float) -> np.nd
         block = clear[a : a + step]
         out[a : a + step] = clearance_of(block, block.shape, res) >= threshold
     return out
-
-
-@numba.njit(cache=True)
-def _points_free(
-    clear: np.ndarray,
-    x0: float,
-    y0: float,
-    res: float,
-    pts: np.ndarray,
-    x: float,
-    y: float,
-    th: float,
-    need: float,
-) -> bool:
-    rows, cols = clear.shape
-    c = math.cos(th)
-    s = math.sin(th)
-    for k in range(pts.shape[0]):
-        px = x + c * pts[k, 0] - s * pts[k, 1]
-        py = y + s * pts[k, 0] + c * pts[k, 1]
-        col = math.floor((px - x0) / res)
-        row = math.floor((py - y0) / res)
-        if row < 0 or row >= rows or col < 0 or col >= cols:
-            return False
-        if _clearance_value(clear[row, col], res) < need:
-            return False
-    return True
 
 
 @numba.njit(cache=True)
@@ -455,6 +417,10 @@ def _search(
     pts_high: np.ndarray,
     reach: float,
     need: float,
+    groups: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+    groups_high: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+    windows: tuple[np.ndarray, np.ndarray, int],
+    windows_high: tuple[np.ndarray, np.ndarray, int],
     free: np.ndarray,
     dist: np.ndarray,
     heap_d: np.ndarray,
@@ -480,6 +446,10 @@ def _search(
     need_low = params[12]
     tight_radius = params[13]
     steer_cost = params[14]
+    gp, gfirst, gcentre, gradius, greach = groups
+    hp, hfirst, hcentre, hradius, hreach = groups_high
+    glow, gdone, gwin = windows
+    hlow, hdone, hwin = windows_high
     # a start closer to obstacles than ``need`` (but not touching them): within
     # ``tight_radius`` of it, moves need only keep ``need_low``, at three times the cost from a
     # pose without the full margin, so the plan gets out of the tight spot at once
@@ -577,7 +547,19 @@ def _search(
             keep = need_low if tight else need
             for j in range(1, nsub + 1):
                 nx, ny, nt = _move(x, y, th, kind, curvs[m], length, pivot, j / nsub)
-                if not _pose_free(clear, clear_high, x0, y0, res, pts, pts_high, nx, ny, nt, keep):
+                # _pose_free of the same points, grouped (the same answer, fewer looks)
+                cn = math.cos(nt)
+                sn = math.sin(nt)
+                if not (
+                    _groups_free(
+                        clear, x0, y0, res, gp, gfirst, gcentre, gradius, greach, glow, gdone,
+                        gwin, nx, ny, cn, sn, keep,
+                    )
+                    and _groups_free(
+                        clear_high, x0, y0, res, hp, hfirst, hcentre, hradius, hreach, hlow,
+                        hdone, hwin, nx, ny, cn, sn, keep,
+                    )
+                ):
                     ok = False
                     break
             if not ok:
@@ -691,6 +673,10 @@ def plan_poses(
             o.steer_cost,
         ]
     )
+    groups, groups_high = point_groups(pts), point_groups(pts_high)
+    window = max(window_cells(groups, res), window_cells(groups_high, res))
+    windows = WindowMinima(clear.shape, window)
+    windows_high = windows if high is clear else WindowMinima(high.shape, window)
     parent, move_of, pose, end, expanded = _search(
         clear,
         high,
@@ -701,6 +687,16 @@ def plan_poses(
         pts_high,
         reach,
         need,
+        (groups.points, groups.first, groups.centre, groups.radius, groups.reach),
+        (
+            groups_high.points,
+            groups_high.first,
+            groups_high.centre,
+            groups_high.radius,
+            groups_high.reach,
+        ),
+        (windows.low, windows.done, windows.window),
+        (windows_high.low, windows_high.done, windows_high.window),
         field.free,
         field.dist,
         field.heap_d,
