@@ -99,10 +99,12 @@ def outline_samples(footprint: PlanarFootprint, spacing: float = 0.05) -> np.nda
     pts = []
     for o in footprint.outlines:
         ring = o.points(48)
-        for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True):
-            n = max(1, math.ceil(float(np.hypot(*(b - a))) / spacing))
-            t = np.arange(n)[:, None] / n
-            pts.append(a + t * (b - a))
+        edge = np.roll(ring, -1, axis=0) - ring  # from each corner to the next
+        n = np.maximum(1, np.ceil(np.hypot(edge[:, 0], edge[:, 1]) / spacing)).astype(np.int64)
+        of = np.repeat(np.arange(len(ring)), n)  # the edge of each sample
+        k = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)  # its index on the edge
+        t = k / n[of]
+        pts.append(ring[of] + t[:, None] * edge[of])
     return np.concatenate(pts)
 
 

@@ -21,6 +21,7 @@ from bt_manip.navigation.lattice import (
     outline_samples,
     plan_poses,
 )
+from bt_manip.navigation.shapes import Disc
 
 
 def room(corridor: bool = False) -> OccupancyGrid:
@@ -228,3 +229,19 @@ def test_a_carry_through_a_doorway_keeps_its_heading_and_its_moves_join_up() -> 
             for r in reached
         )
         assert gap < 1e-6
+
+
+def test_outline_samples_are_even_steps_along_each_edge() -> None:
+    # each edge a -> b of each outline (discs by their 48-gon) gives n = ceil(|b - a| / spacing)
+    # samples a + (k / n) (b - a), k = 0 .. n - 1, in order, to the last bit
+    box = PlanarFootprint.rectangle(1.23, 0.47, x_offset=0.31)
+    fp = PlanarFootprint((*box.outlines, Disc(0.4, -0.1, 0.137)), "base + mast")
+    for spacing in (0.05, 0.031):
+        expected = []
+        for o in fp.outlines:
+            ring = o.points(48)
+            for a, b in zip(ring, np.roll(ring, -1, axis=0), strict=True):
+                n = max(1, math.ceil(float(np.hypot(*(b - a))) / spacing))
+                expected.append(a + (np.arange(n)[:, None] / n) * (b - a))
+        got = outline_samples(fp, spacing)
+        assert got.tobytes() == np.concatenate(expected).tobytes()
