@@ -174,11 +174,14 @@ class Navigate(RobotAction):
         world = self.world
         robot = self.robot()
         held = {a.object_body for a in world.attachments.held_by(self.robot_name())}
-        movable = {b: n for n, b in world.movable.items() if b not in held}
+        fingers = robot.finger_link_ids
+        # the contacts with each movable object asked for alone: the robot's many contacts
+        # with the floor are not read every tick
         bumped = {
-            movable[pt.body_b]
-            for pt in pbq.contacts(world.client, robot.body)
-            if pt.body_b in movable and pt.link_a not in robot.finger_link_ids
+            name
+            for name, body in world.movable.items()
+            if body not in held
+            and any(pt.link_a not in fingers for pt in pbq.contacts(world.client, robot.body, body))
         }
         return [f"ran into '{name}'" for name in sorted(bumped)]
 
