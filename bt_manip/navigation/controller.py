@@ -53,6 +53,7 @@ reason string when there is none).
 
 from __future__ import annotations
 
+import bisect
 import enum
 import math
 from collections.abc import Callable
@@ -145,6 +146,9 @@ class PathProgress:
     options: FollowerOptions
     path: np.ndarray
     _s: np.ndarray
+    _s_list: list[float]
+    _xs: np.ndarray
+    _ys: np.ndarray
     _index: int
     _phase: str
     _last_check: float | None
@@ -165,6 +169,9 @@ class PathProgress:
         self.path = path
         seg: np.ndarray = np.hypot(*np.diff(path, axis=0).T)
         self._s = np.concatenate([[0.0], np.cumsum(seg)])
+        self._s_list = self._s.tolist()  # the same lengths, searched without numpy per tick
+        self._xs = np.ascontiguousarray(path[:, 0])
+        self._ys = np.ascontiguousarray(path[:, 1])
         return seg
 
     @property
@@ -194,9 +201,10 @@ class PathProgress:
     def _advance(self, x: float, y: float) -> None:
         """Move the progress index to the closest path point within a window ahead."""
         lo = self._index
-        hi = int(np.searchsorted(self._s, self._s[lo] + 1.5, side="right"))
-        hi = min(max(hi, lo + 2), len(self.path))
-        d = np.hypot(self.path[lo:hi, 0] - x, self.path[lo:hi, 1] - y)
+        s = self._s_list
+        hi = bisect.bisect_right(s, s[lo] + 1.5)
+        hi = min(max(hi, lo + 2), len(s))
+        d = np.hypot(self._xs[lo:hi] - x, self._ys[lo:hi] - y)
         self._index = lo + int(np.argmin(d))
 
 
@@ -410,18 +418,20 @@ class PathFollower(PathProgress):
     def _lookahead_point(self, distance: float) -> tuple[float, float]:
         """The path point ``distance`` ahead of the progress point; past the end, the path's
         last stretch is extended in a straight line."""
-        target = self._s[self._index] + distance
-        k = int(np.searchsorted(self._s, target))
-        if k >= len(self.path):
-            extra = target - self._s[-1]
+        s = self._s_list
+        target = s[self._index] + distance
+        k = bisect.bisect_left(s, target)
+        if k >= len(s):
+            extra = target - s[-1]
             ex, ey = self.path_end
             return ex + extra * self._end_dir[0], ey + extra * self._end_dir[1]
         if k == 0:
             return float(self.path[0, 0]), float(self.path[0, 1])
-        s0, s1 = self._s[k - 1], self._s[k]
+        s0, s1 = s[k - 1], s[k]
         t = 0.0 if s1 <= s0 else (target - s0) / (s1 - s0)
-        p = self.path[k - 1] + t * (self.path[k] - self.path[k - 1])
-        return float(p[0]), float(p[1])
+        ax, ay = float(self._xs[k - 1]), float(self._ys[k - 1])
+        bx, by = float(self._xs[k]), float(self._ys[k])
+        return ax + t * (bx - ax), ay + t * (by - ay)
 
     def _pursue(self, x: float, y: float, yaw: float, to_end: float) -> tuple[float, float, float]:
         """Pure pursuit along the path; returns (v, w, heading error)."""
