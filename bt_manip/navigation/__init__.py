@@ -6,7 +6,8 @@ footprints, and the base controller.
 - :mod:`.costmap`: clearance, inflation by the footprint and the cost gradient.
 - :mod:`.footprint`: the robot's outline, grown by what it carries.
 - :mod:`.smoothing`, :mod:`.planner`: shortcuts, world paths and the reasons for no path.
-- :mod:`.lattice`: planning over (x, y, heading) when the footprint is long or lopsided.
+- :mod:`.lattice`: planning over (x, y, heading) when the footprint is long or lopsided;
+  :mod:`.outline_check`: whether its outline points keep clear at a pose, a group at a time.
 - :mod:`.controller`, :mod:`.segments`: following a path or a pose plan, one tick at a time.
 - :mod:`.navigator`: all of it for one robot in one world.
 """

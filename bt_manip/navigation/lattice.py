@@ -14,7 +14,9 @@ than weaving between neighbouring ones.
 
 The moves are checked every few centimetres of footprint travel: every outline point must keep
 ``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a
-cell's centre, so the point's own offset in its cell is subtracted too). A start closer than
+cell's centre, so the point's own offset in its cell is subtracted too; the points are looked
+at a group at a time where the cells around a group all keep the margin, with the same answer
+as point by point, see :mod:`bt_manip.navigation.outline_check`). A start closer than
 that but not touching (a robot that has just lifted a load out of a stand beside it) is
 accepted: within ``tight_start`` of it, moves from a pose without the margin need only keep
 the footprint off the obstacles, at three times the cost, so the plan
