@@ -115,38 +115,44 @@ class JointMove(RobotAction):
                     )
         self.stages = stages
         self.command = q_now.copy()
+        self._command = q_now.tolist()
         self.stage = -1
+        # each joint's allowed speed, and the least it may correct at, fixed for the move
+        vmax = np.asarray(arm.velocity_limits, dtype=float) * self.speed
+        self._vmax: list[float] = vmax.tolist()
+        self._floor: list[float] = (CORRECTION_SPEED * vmax).tolist()
         # contacts the arm already has may stay (it can then move away from them); only new
         # ones end the move
         self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
-        self._next_stage()
+        self._next_stage(robot, robot.arm_motion()[0])
 
-    def _next_stage(self) -> None:
+    def _next_stage(self, robot: Robot, q: list[float]) -> None:
+        """Start the next stage from the arm's joint positions ``q`` (rad)."""
         self.stage += 1
         self.stage_started = self.now()
         if self.stage >= len(self.stages):
             return
-        target, joints = self.stages[self.stage].command, self.stages[self.stage].joints
-        q = self.robot().arm_positions()
-        vmax = np.asarray(self.robot().description.arm.velocity_limits, dtype=float) * self.speed
+        stage = self.stages[self.stage]
+        target, joints = stage.command, stage.joints
         self.command = target.copy()
+        self._command = target.tolist()
         # joints moved together arrive together: scale each speed to the slowest travel time
-        travel = np.abs(target[joints] - q[joints])
-        t = float(np.max(travel / vmax[joints])) if len(joints) else 0.0
-        self._send(joints, travel, t)
+        command, vmax = self._command, self._vmax
+        travel = [abs(command[j] - q[j]) for j in joints]
+        t = max(d / vmax[j] for d, j in zip(travel, joints, strict=True)) if joints else 0.0
+        self._send(robot, joints, travel, t)
 
-    def _send(self, joints: list[int], travel: np.ndarray, t: float) -> None:
+    def _send(self, robot: Robot, joints: list[int], travel: list[float], t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
         every joint may correct at no less than :data:`CORRECTION_SPEED` of its allowed speed, so
         a joint that a load pushes away can come back."""
-        robot = self.robot()
-        vmax = np.asarray(robot.description.arm.velocity_limits, dtype=float) * self.speed
-        floor = CORRECTION_SPEED * vmax
-        speeds = floor.copy()
+        speeds = list(self._floor)
         if t > 1e-9:
-            speeds[joints] = np.maximum(travel / t, floor[joints])
+            for d, j in zip(travel, joints, strict=True):
+                speeds[j] = _larger(d / t, speeds[j])
         else:
-            speeds[joints] = vmax[joints]
+            for j in joints:
+                speeds[j] = self._vmax[j]
         robot.set_arm_targets(self.command, max_velocity=speeds)
 
     def step(self) -> Status:
@@ -160,15 +166,16 @@ class JointMove(RobotAction):
             return Status.SUCCESS
         # every joint, not only the moving ones, must be where it was told to be: a load can
         # push a holding joint away, and the move is not done until it is back
-        q = robot.arm_positions()
-        qd = robot.arm_velocities()
-        err = np.abs(q - self.command)
+        q, qd = robot.arm_motion()
+        err = [abs(a - b) for a, b in zip(q, self._command, strict=True)]
         if self.stages[self.stage].via:
-            arrived = bool(np.all(err < self.via_tol))
+            tol = self.via_tol
+            arrived = all(e < tol for e in err)
         else:
-            arrived = bool(np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED))
+            tol = self.tol
+            arrived = all(e < tol for e in err) and all(abs(v) < SETTLE_SPEED for v in qd)
         if arrived:
-            self._next_stage()
+            self._next_stage(robot, q)
             if self.stage >= len(self.stages):
                 return Status.SUCCESS
             return Status.RUNNING
@@ -456,3 +463,10 @@ def _through(path: list[np.ndarray], n: int) -> list[Stage]:
     """Stages along a waypoint path: pass through every waypoint, stop at the last."""
     joints = list(range(n))
     return [Stage(q, joints, via=i < len(path) - 1) for i, q in enumerate(path)]
+
+
+def _larger(a: float, b: float) -> float:
+    """``numpy.maximum`` of two floats (a NaN wins, as there)."""
+    if math.isnan(a):
+        return a
+    return b if b > a or math.isnan(b) else a

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.behaviours.base import ActionFailed
-from bt_manip.kinematics import KinematicsError
+from bt_manip.kinematics import IKSolver, KinematicsError
 from bt_manip.run_context import ArmIK, RobotServices
 
 STEP = 0.02
@@ -33,9 +33,15 @@ def arm_ik(services: RobotServices, tip: str) -> ArmIK:
 
 def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
     """A world pose (4x4) expressed in the arm's base link frame."""
-    base = robot.link_transform(robot.description.arm.base_link)
-    pose_base: np.ndarray = np.linalg.inv(base) @ pose_world
+    pose_base: np.ndarray = _world_to_arm_base(robot) @ pose_world
     return pose_base
+
+
+def _world_to_arm_base(robot: Any) -> np.ndarray:
+    """The transform (4x4) taking world coordinates to the arm's base link frame."""
+    base = robot.link_transform(robot.description.arm.base_link)
+    inverse: np.ndarray = np.linalg.inv(base)
+    return inverse
 
 
 def solve(
@@ -48,7 +54,15 @@ def solve(
     """Joint values putting ``tip`` at ``pose_world``; ActionFailed with IK's reason if none."""
     ik = arm_ik(services, tip)
     solver = ik.free_yaw if free_yaw else ik.full
-    result = solver.solve(to_arm_base(services.robot, pose_world), q_seed=seed)
+    return _solved(solver, _world_to_arm_base(services.robot) @ pose_world, pose_world, seed)
+
+
+def _solved(
+    solver: IKSolver, pose_base: np.ndarray, pose_world: np.ndarray, seed: np.ndarray
+) -> np.ndarray:
+    """The joints ``solver`` finds for ``pose_base`` (the arm base frame's ``pose_world``);
+    ActionFailed with IK's reason if none."""
+    result = solver.solve(pose_base, q_seed=seed)
     if not result.success:
         where = ", ".join(f"{v:.3f}" for v in pose_world[:3, 3])
         raise ActionFailed(f"no arm configuration reaches ({where}): {result.reason}")
@@ -66,18 +80,24 @@ def line(
     """Joint waypoints moving ``tip`` on a straight line from ``start_world`` to
     ``goal_world``, one every :data:`STEP` metres (orientation turning evenly from the start's
     to the goal's), each seeded by the one before so the arm does not flip between
-    solutions."""
+    solutions.
+
+    The robot does not move while the line is planned, so the arm base frame and the turn
+    between the two orientations are worked out once for all the waypoints."""
     a, b = start_world[:3, 3], goal_world[:3, 3]
-    turn = _angle(start_world[:3, :3], goal_world[:3, :3])
-    n = max(1, int(np.ceil(max(float(np.linalg.norm(b - a)) / STEP, turn / TURN_STEP))))
+    turning = _Turn(start_world[:3, :3], goal_world[:3, :3])
+    n = max(1, int(np.ceil(max(float(np.linalg.norm(b - a)) / STEP, turning.angle / TURN_STEP))))
+    ik = arm_ik(services, tip)
+    solver = ik.free_yaw if free_yaw else ik.full
+    to_base = _world_to_arm_base(services.robot)
     out = []
     q = seed
     for i in range(1, n + 1):
         s = i / n
         pose = np.eye(4)
-        pose[:3, :3] = _slerp(start_world[:3, :3], goal_world[:3, :3], s)
+        pose[:3, :3] = turning.at(s)
         pose[:3, 3] = a + (b - a) * s
-        q = solve(services, tip, pose, q, free_yaw)
+        q = _solved(solver, to_base @ pose, pose, q)
         out.append(q)
     return out
 
@@ -86,22 +106,39 @@ def _angle(ra: np.ndarray, rb: np.ndarray) -> float:
     return float(np.arccos(np.clip((np.trace(ra.T @ rb) - 1.0) / 2.0, -1.0, 1.0)))
 
 
+class _Turn:
+    """The rotations from ``ra`` to ``rb`` about one fixed axis; :meth:`at` gives the one a
+    fraction ``s`` of the way. What does not depend on ``s`` (the relative rotation, its
+    angle, the axis' cross-product matrix and its square) is worked out once."""
+
+    def __init__(self, ra: np.ndarray, rb: np.ndarray) -> None:
+        self.ra, self.rb = ra, rb
+        rel = ra.T @ rb
+        self.angle = angle = _angle(ra, rb)
+        self.still = angle < 1e-9
+        if self.still:
+            return
+        if np.pi - angle < 1e-6:  # half a turn: the axis is the eigenvector of eigenvalue 1
+            w, v = np.linalg.eigh((rel + rel.T) / 2.0)
+            axis = v[:, int(np.argmax(w))]
+        else:
+            axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+            axis /= 2.0 * np.sin(angle)
+        self.k = k = np.array(
+            [[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]
+        )
+        self.kk = k @ k
+
+    def at(self, s: float) -> np.ndarray:
+        """Rotation a fraction ``s`` of the way from ``ra`` to ``rb``."""
+        if self.still:
+            return self.rb.copy()
+        a = self.angle * s
+        step = np.eye(3) + np.sin(a) * self.k + (1.0 - np.cos(a)) * self.kk
+        turned: np.ndarray = self.ra @ step
+        return turned
+
+
 def _slerp(ra: np.ndarray, rb: np.ndarray, s: float) -> np.ndarray:
     """Rotation a fraction ``s`` of the way from ``ra`` to ``rb`` (about one fixed axis)."""
-    rel = ra.T @ rb
-    angle = _angle(ra, rb)
-    if angle < 1e-9:
-        return rb.copy()
-    if np.pi - angle < 1e-6:  # half a turn: the axis is the eigenvector of eigenvalue 1
-        w, v = np.linalg.eigh((rel + rel.T) / 2.0)
-        axis = v[:, int(np.argmax(w))]
-    else:
-        axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
-        axis /= 2.0 * np.sin(angle)
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    a = angle * s
-    step = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    turned: np.ndarray = ra @ step
-    return turned
-
-
+    return _Turn(ra, rb).at(s)

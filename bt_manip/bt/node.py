@@ -31,7 +31,7 @@ from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
 from py_trees.common import Status
-from py_trees.ports import PortInformation, PortsMixin
+from py_trees.ports import PortInformation, PortsMixin, _ports_class_is_abstract
 
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
@@ -143,6 +143,28 @@ class BtNode(PortsMixin):
         super().__init_subclass__(**kwargs)
         if "NODE_ID" not in vars(cls):
             cls.NODE_ID = cls.__name__
+
+    def __init__(self, *args: Any, behaviour_class_name: str | None = None, **kwargs: Any) -> None:
+        """``PortsMixin.__init__`` with its abstract-class check asked once per class.
+
+        py_trees checks at every construction whether the class is still abstract by scanning
+        ``dir()`` of the class, which costs more than the rest of building a node; the answer
+        is a property of the class, kept on the class itself (:func:`_class_is_abstract`).
+        The same fields are set and the same ``TypeError`` is raised as by ``PortsMixin``.
+        """
+        cls = type(self)
+        if _class_is_abstract(cls):
+            raise TypeError(
+                f"Can't instantiate abstract class {cls.__name__} without the "
+                "INPUT_PORTS and OUTPUT_PORTS class attribute declarations."
+            )
+        super(PortsMixin, self).__init__(*args, **kwargs)
+        self._blackboard_client = None
+        self._subtree_namespace = None
+        self._ports_logger = None
+        self._behaviour_class_name = (
+            behaviour_class_name if behaviour_class_name is not None else cls.__name__
+        )
 
     # ------------------------------------------------------------------ construction
 
@@ -437,6 +459,20 @@ class BtNode(PortsMixin):
         """The node's children (the list itself: read it, do not change it). The children of a
         bt-manip node are bt-manip nodes (the XML loader and ``as_bt_node`` build them)."""
         return cast("list[BtNode]", self.children)
+
+
+_ABSTRACT_FLAG = "_bt_ports_abstract"
+
+
+def _class_is_abstract(cls: type) -> bool:
+    """py_trees' ``_ports_class_is_abstract(cls)``, computed at the first construction of
+    ``cls`` and kept in the class's own namespace (so a subclass never reads its parent's
+    answer, and the cache holds one flag per class, no more)."""
+    flag = cls.__dict__.get(_ABSTRACT_FLAG)
+    if flag is None:
+        flag = _ports_class_is_abstract(cls)
+        setattr(cls, _ABSTRACT_FLAG, flag)
+    return bool(flag)
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:

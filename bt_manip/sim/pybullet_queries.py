@@ -162,6 +162,16 @@ def joint_states(client: int, body: int, joints: list[int]) -> list[JointState]:
     return [JointState(*s) for s in pb.getJointStates(body, joints, physicsClientId=client)]
 
 
+def joint_motion(client: int, body: int, joints: list[int]) -> tuple[list[float], list[float]]:
+    """Positions and velocities of ``joints`` of ``body``, in that order, from one
+    ``getJointStates`` query (the fields of :class:`JointState` a controller reads each tick,
+    without building a record per joint)."""
+    if not joints:
+        return [], []
+    states = pb.getJointStates(body, joints, physicsClientId=client)
+    return [s[0] for s in states], [s[1] for s in states]
+
+
 def root_link_name(client: int, body: int) -> str:
     """URDF name of the root link of ``body`` (``getBodyInfo``)."""
     return _text(pb.getBodyInfo(body, physicsClientId=client)[0])

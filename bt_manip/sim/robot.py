@@ -361,17 +361,20 @@ class Robot:
 
     # -- arm ----------------------------------------------------------------------------------
     def _positions(self, ids: Sequence[int]) -> np.ndarray:
-        states = pbq.joint_states(self.client, self.body, list(ids))
-        return np.array([s.position for s in states])
+        return np.array(pbq.joint_motion(self.client, self.body, list(ids))[0])
 
     def arm_positions(self) -> np.ndarray:
         """Arm joint positions (rad) in descriptor order."""
-        return self._positions(self.arm_joint_ids)
+        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[0])
 
     def arm_velocities(self) -> np.ndarray:
         """Arm joint velocities (rad/s) in descriptor order."""
-        states = pbq.joint_states(self.client, self.body, self.arm_joint_ids)
-        return np.array([s.velocity for s in states])
+        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[1])
+
+    def arm_motion(self) -> tuple[list[float], list[float]]:
+        """Arm joint positions (rad) and velocities (rad/s) in descriptor order, as plain
+        floats, from one query (what a controller checks every tick)."""
+        return pbq.joint_motion(self.client, self.body, self.arm_joint_ids)
 
     def set_arm_targets(
         self, q: Sequence[float] | np.ndarray, max_velocity: float | Sequence[float] | None = None
@@ -384,27 +387,32 @@ class Robot:
         """
         q_arr = np.asarray(q, dtype=float)
         arm = self.description.arm
-        n = len(self.arm_joint_ids)
+        ids = self.arm_joint_ids
+        n = len(ids)
         if q_arr.shape != (n,):
             raise ValueError(f"{self.name}: expected {n} arm targets, got {q_arr.shape}")
-        limits = np.asarray(self._arm_velocity, dtype=float)
+        # element-wise min and clip on plain floats: the same values numpy's minimum and clip
+        # give, without building arrays for a handful of joints
+        limits: list[float] = [float(v) for v in self._arm_velocity]
         if max_velocity is not None:
-            limits = np.minimum(limits, np.broadcast_to(np.asarray(max_velocity, float), (n,)))
-        q_arr = np.clip(q_arr, arm.lower, arm.upper)
-        for j, target, speed, effort in zip(
-            self.arm_joint_ids, q_arr, limits, self._arm_effort, strict=True
+            caps = np.broadcast_to(np.asarray(max_velocity, float), (n,)).tolist()
+            limits = [_least(v, c) for v, c in zip(limits, caps, strict=True)]
+        gain = arm.position_gain
+        client, body, control = self.client, self.body, pb.POSITION_CONTROL
+        for j, target, lo, hi, speed, effort in zip(
+            ids, q_arr.tolist(), arm.lower, arm.upper, limits, self._arm_effort, strict=True
         ):
             pb.setJointMotorControl2(
-                self.body,
+                body,
                 j,
-                pb.POSITION_CONTROL,
-                targetPosition=float(target),
+                control,
+                targetPosition=_clipped(target, lo, hi),
                 targetVelocity=0.0,
                 force=effort,
-                maxVelocity=float(speed),
-                positionGain=arm.position_gain,
+                maxVelocity=speed,
+                positionGain=gain,
                 velocityGain=1.0,
-                physicsClientId=self.client,
+                physicsClientId=client,
             )
 
     def hold_arm(self) -> None:
@@ -616,3 +624,20 @@ def _has_window(client: int) -> bool:
     """True when ``client`` is PyBullet's GUI, which draws the URDF's own visuals."""
     info = pb.getConnectionInfo(physicsClientId=client)
     return bool(info.get("connectionMethod") == pb.GUI)
+
+
+def _least(a: float, b: float) -> float:
+    """``numpy.minimum`` of two floats (a NaN wins, as there)."""
+    if math.isnan(a):
+        return a
+    return b if b < a or math.isnan(b) else a
+
+
+def _clipped(x: float, lo: float, hi: float) -> float:
+    """``numpy.clip(x, lo, hi)`` of one float: ``minimum(maximum(x, lo), hi)``."""
+    x = float(x)
+    if lo > x:
+        x = float(lo)
+    if hi < x:
+        x = float(hi)
+    return x
