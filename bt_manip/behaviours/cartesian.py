@@ -92,11 +92,12 @@ def line(
     to_base = _world_to_arm_base(services.robot)
     out = []
     q = seed
+    ab = b - a
     for i in range(1, n + 1):
         s = i / n
         pose = np.eye(4)
         pose[:3, :3] = turning.at(s)
-        pose[:3, 3] = a + (b - a) * s
+        pose[:3, 3] = a + ab * s
         q = _solved(solver, to_base @ pose, pose, q)
         out.append(q)
     return out

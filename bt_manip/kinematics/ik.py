@@ -189,7 +189,8 @@ class IKSolver:
         if problem is not None:
             usable = seed.shape == (arm.nq,) and bool(np.isfinite(seed).all())
             return self._failure(seed if usable else arm.mid, problem, start)
-        seed = np.clip(seed, arm.lower, arm.upper)
+        np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
+        np.minimum(seed, arm.upper, out=seed)
         target = np.asarray(target, dtype=float)
         distance = _norm3(target[:3, 3] - self._shoulder)
         if distance > self._reach_limit:
@@ -252,15 +253,19 @@ class IKSolver:
         t = np.asarray(target, dtype=float)
         if t.shape != (4, 4) or not np.isfinite(t).all():
             return "invalid target: expected a finite 4x4 homogeneous pose"
-        rot = t[:3, :3]
         if not self.options.position_only:
-            gram = rot.T @ rot
-            gram[0, 0] -= 1.0
-            gram[1, 1] -= 1.0
-            gram[2, 2] -= 1.0
-            (a, b, c), (d, e, f), (g, h, i) = rot.tolist()
+            # R^T R - I must vanish and det R be positive (plain floats: nine values)
+            (a, b, c), (d, e, f), (g, h, i) = t[:3, :3].tolist()
+            off = max(
+                abs(a * a + d * d + g * g - 1.0),
+                abs(b * b + e * e + h * h - 1.0),
+                abs(c * c + f * f + i * i - 1.0),
+                abs(a * b + d * e + g * h),
+                abs(a * c + d * f + g * i),
+                abs(b * c + e * f + h * i),
+            )
             det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-            if np.abs(gram).max() > 1e-6 or det < 0:
+            if off > 1e-6 or det < 0:
                 return "invalid target: the rotation part is not a rotation matrix"
         if seed.shape != (self.arm.nq,) or not np.isfinite(seed).all():
             return f"invalid seed: expected {self.arm.nq} finite joint values"

@@ -236,6 +236,13 @@ def contacts(client: int, body: int, other: int | None = None) -> list[ContactIn
     return [ContactInfo(*p[:14]) for p in points]
 
 
+def contact_links(client: int, body: int) -> list[tuple[int, int]]:
+    """(``link_a``, ``body_b``) of each contact point of ``body`` (as body A) with any body,
+    from the same query as :func:`contacts`, without the rest of each point: what a check
+    that runs every tick needs to tell which of its links touch which bodies."""
+    return [(p[3], p[2]) for p in pb.getContactPoints(bodyA=body, physicsClientId=client)]
+
+
 def closest_points(
     client: int, body: int, other: int, max_distance: float, link: int | None = None
 ) -> list[ContactInfo]:

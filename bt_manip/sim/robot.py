@@ -395,7 +395,10 @@ class Robot:
         # give, without building arrays for a handful of joints
         limits: list[float] = [float(v) for v in self._arm_velocity]
         if max_velocity is not None:
-            caps = np.broadcast_to(np.asarray(max_velocity, float), (n,)).tolist()
+            if isinstance(max_velocity, list) and len(max_velocity) == n:
+                caps = [float(v) for v in max_velocity]
+            else:
+                caps = np.broadcast_to(np.asarray(max_velocity, float), (n,)).tolist()
             limits = [_least(v, c) for v, c in zip(limits, caps, strict=True)]
         gain = arm.position_gain
         client, body, control = self.client, self.body, pb.POSITION_CONTROL
