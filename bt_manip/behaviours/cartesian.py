@@ -128,18 +128,29 @@ class _Turn:
         self.k = k = np.array(
             [[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]
         )
-        self.kk = k @ k
+        kk = k @ k
+        self._k = k.ravel().tolist()
+        self._kk = kk.ravel().tolist()
 
     def at(self, s: float) -> np.ndarray:
-        """Rotation a fraction ``s`` of the way from ``ra`` to ``rb``."""
+        """Rotation a fraction ``s`` of the way from ``ra`` to ``rb``: ``ra`` times
+        ``I + sin(a) K + (1 - cos(a)) K^2`` for the angle ``a`` of that fraction."""
         if self.still:
             return self.rb.copy()
         a = self.angle * s
-        step = np.eye(3) + np.sin(a) * self.k + (1.0 - np.cos(a)) * self.kk
+        sin_a = float(np.sin(a))
+        vers_a = 1.0 - float(np.cos(a))
+        # element by element, in numpy's order, zeros of I included (so that the signs of
+        # zero results are the same too): (I + sin_a K) + vers_a K^2
+        k, kk = self._k, self._kk
+        step = np.array([
+            [1.0 + sin_a * k[0] + vers_a * kk[0], 0.0 + sin_a * k[1] + vers_a * kk[1],
+             0.0 + sin_a * k[2] + vers_a * kk[2]],
+            [0.0 + sin_a * k[3] + vers_a * kk[3], 1.0 + sin_a * k[4] + vers_a * kk[4],
+             0.0 + sin_a * k[5] + vers_a * kk[5]],
+            [0.0 + sin_a * k[6] + vers_a * kk[6], 0.0 + sin_a * k[7] + vers_a * kk[7],
+             1.0 + sin_a * k[8] + vers_a * kk[8]],
+        ])
         turned: np.ndarray = self.ra @ step
         return turned
 
-
-def _slerp(ra: np.ndarray, rb: np.ndarray, s: float) -> np.ndarray:
-    """Rotation a fraction ``s`` of the way from ``ra`` to ``rb`` (about one fixed axis)."""
-    return _Turn(ra, rb).at(s)

@@ -184,10 +184,10 @@ class IKSolver:
         start = time.perf_counter()
         o = self.options
         arm = self.arm
-        seed = arm.mid.copy() if q_seed is None else np.asarray(q_seed, dtype=float).copy()
+        seed = arm.mid.copy() if q_seed is None else np.array(q_seed, dtype=float)
         problem = self._check_target(target, seed)
         if problem is not None:
-            usable = seed.shape == (arm.nq,) and bool(np.isfinite(seed).all())
+            usable = seed.shape == (arm.nq,) and _finite(seed)
             return self._failure(seed if usable else arm.mid, problem, start)
         np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
         np.minimum(seed, arm.upper, out=seed)
@@ -208,7 +208,7 @@ class IKSolver:
         out_q, out_err, out_status = r.outputs
         rng: np.random.Generator | None = None
         iterations = 0
-        best_q, best_err, best_score = seed.copy(), np.full(6, np.inf), math.inf
+        best_q, best_err, best_score = seed.copy(), None, math.inf
         deadline = None if o.time_budget is None else start + o.time_budget
         budget_hit = False
         attempt = 0
@@ -227,6 +227,8 @@ class IKSolver:
                 rng = np.random.default_rng(o.seed)
             q0[:] = rng.uniform(arm.lower, arm.upper)
 
+        if best_err is None:  # no attempt gave a comparable error (NaN)
+            best_err = np.full(6, np.inf)
         reason = None
         if o.diagnose:
             reason = self._diagnose_limits(best_q, rng or np.random.default_rng(o.seed))
@@ -251,7 +253,7 @@ class IKSolver:
 
     def _check_target(self, target: np.ndarray, seed: np.ndarray) -> str | None:
         t = np.asarray(target, dtype=float)
-        if t.shape != (4, 4) or not np.isfinite(t).all():
+        if t.shape != (4, 4) or not _finite(t):
             return "invalid target: expected a finite 4x4 homogeneous pose"
         if not self.options.position_only:
             # R^T R - I must vanish and det R be positive (plain floats: nine values)
@@ -267,7 +269,7 @@ class IKSolver:
             det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
             if off > 1e-6 or det < 0:
                 return "invalid target: the rotation part is not a rotation matrix"
-        if seed.shape != (self.arm.nq,) or not np.isfinite(seed).all():
+        if seed.shape != (self.arm.nq,) or not _finite(seed):
             return f"invalid seed: expected {self.arm.nq} finite joint values"
         return None
 
@@ -352,3 +354,9 @@ def _norm3(v: np.ndarray) -> float:
     """Euclidean norm of a 3-vector (cheaper than numpy.linalg.norm for tiny arrays)."""
     x, y, z = float(v[0]), float(v[1]), float(v[2])
     return math.sqrt(x * x + y * y + z * z)
+
+
+def _finite(a: np.ndarray) -> bool:
+    """Whether every value of ``a`` is finite (``numpy.isfinite(a).all()`` for a few values,
+    on plain floats)."""
+    return all(map(math.isfinite, a.ravel().tolist()))

@@ -405,17 +405,11 @@ class Robot:
         for j, target, lo, hi, speed, effort in zip(
             ids, q_arr.tolist(), arm.lower, arm.upper, limits, self._arm_effort, strict=True
         ):
+            # positional arguments (PyBullet parses them several times faster than keywords),
+            # in its order: targetPosition, targetVelocity, force, positionGain, velocityGain,
+            # maxVelocity, physicsClientId
             pb.setJointMotorControl2(
-                body,
-                j,
-                control,
-                targetPosition=_clipped(target, lo, hi),
-                targetVelocity=0.0,
-                force=effort,
-                maxVelocity=speed,
-                positionGain=gain,
-                velocityGain=1.0,
-                physicsClientId=client,
+                body, j, control, _clipped(target, lo, hi), 0.0, effort, gain, 1.0, speed, client
             )
 
     def hold_arm(self) -> None:
