@@ -102,10 +102,10 @@ class JointMove(RobotAction):
         arm = robot.description.arm
         q_now = robot.arm_positions()
         stages = [st for st in self.plan(q_now) if st.joints]
-        lower = np.asarray(arm.lower, dtype=float)
-        upper = np.asarray(arm.upper, dtype=float)
+        lower = [float(v) for v in arm.lower]
+        upper = [float(v) for v in arm.upper]
         for st in stages:
-            command = st.command
+            command = st.command.tolist()
             for j in st.joints:
                 if not lower[j] - 1e-9 <= command[j] <= upper[j] + 1e-9:
                     raise ActionFailed(
@@ -139,7 +139,7 @@ class JointMove(RobotAction):
         # joints moved together arrive together: scale each speed to the slowest travel time
         command, vmax = self._command, self._vmax
         travel = [abs(command[j] - q[j]) for j in joints]
-        t = max(d / vmax[j] for d, j in zip(travel, joints, strict=True)) if joints else 0.0
+        t = _largest([d / vmax[j] for d, j in zip(travel, joints, strict=True)]) if joints else 0.0
         self._send(robot, joints, travel, t)
 
     def _send(self, robot: Robot, joints: list[int], travel: list[float], t: float) -> None:
@@ -149,7 +149,9 @@ class JointMove(RobotAction):
         speeds = list(self._floor)
         if t > 1e-9:
             for d, j in zip(travel, joints, strict=True):
-                speeds[j] = _larger(d / t, speeds[j])
+                # numpy.maximum(d / t, floor) on plain floats (a NaN wins, as there)
+                v, f = d / t, speeds[j]
+                speeds[j] = f if f > v or f != f else v
         else:
             for j in joints:
                 speeds[j] = self._vmax[j]
@@ -465,8 +467,12 @@ def _through(path: list[np.ndarray], n: int) -> list[Stage]:
     return [Stage(q, joints, via=i < len(path) - 1) for i, q in enumerate(path)]
 
 
-def _larger(a: float, b: float) -> float:
-    """``numpy.maximum`` of two floats (a NaN wins, as there)."""
-    if math.isnan(a):
-        return a
-    return b if b > a or math.isnan(b) else a
+def _largest(values: list[float]) -> float:
+    """``numpy.max`` of a non-empty list of floats (NaN when one is NaN, as there)."""
+    top = values[0]
+    for v in values:
+        if v > top or v != v:
+            top = v
+            if v != v:
+                break
+    return top

@@ -13,7 +13,8 @@ from bt_manip.sim import pybullet_queries as pbq
 
 def arm_link_ids(robot: Any) -> frozenset[int]:
     """PyBullet link indices of the arm and gripper of ``robot``."""
-    return frozenset(robot.arm_link_ids())
+    links: frozenset[int] = robot.arm_link_set()
+    return links
 
 
 def _static_ids(world: Any) -> dict[int, str]:

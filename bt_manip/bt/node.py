@@ -60,6 +60,10 @@ _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 # Enum members hash in Python code: the hot path maps statuses through identity lookups.
 _PY_BY_ID = {id(s): p for s, p in PY_TREES_OF.items()}
+_IDLE = NodeStatus.IDLE
+_SUCCESS = NodeStatus.SUCCESS
+_FAILURE = NodeStatus.FAILURE
+_SKIPPED = NodeStatus.SKIPPED
 _LEAF_RESULT = {id(s): b for s, b in RESULT_OF_PY_TREES.items()}
 
 
@@ -366,26 +370,27 @@ class BtNode(PortsMixin):
 
     def execute_tick(self) -> NodeStatus:
         """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
-        if self.bt_status is NodeStatus.IDLE:
+        if self.bt_status is _IDLE:
             self.started_order = next(_ORDER)
         new = self._check_preconditions() if self._pre else None
         if new is None and self.pre_tick is not None and not self.bt_status.completed:
             forced = self.pre_tick(self)
-            if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
+            if forced is _SUCCESS or forced is _FAILURE:
                 new = forced
         if new is None:
             new = self.tick_node()
-        if self._post and (new is NodeStatus.SUCCESS or new is NodeStatus.FAILURE):
-            if new is NodeStatus.SUCCESS and "_onSuccess" in self._post:
-                self._run_script("_onSuccess", self._post["_onSuccess"])
-            elif new is NodeStatus.FAILURE and "_onFailure" in self._post:
-                self._run_script("_onFailure", self._post["_onFailure"])
-            if "_post" in self._post:
-                self._run_script("_post", self._post["_post"])
+        post = self._post
+        if post and (new is _SUCCESS or new is _FAILURE):
+            if new is _SUCCESS and "_onSuccess" in post:
+                self._run_script("_onSuccess", post["_onSuccess"])
+            elif new is _FAILURE and "_onFailure" in post:
+                self._run_script("_onFailure", post["_onFailure"])
+            if "_post" in post:
+                self._run_script("_post", post["_post"])
         self.last_status = new
-        if new is NodeStatus.FAILURE:
+        if new is _FAILURE:
             self.failure_order = next(_ORDER)
-        if new is not NodeStatus.SKIPPED:
+        if new is not _SKIPPED:
             self.bt_status = new
             self.status = _PY_BY_ID[id(new)]
         visited = self.context.visited

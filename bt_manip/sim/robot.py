@@ -110,6 +110,7 @@ class Robot:
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
         self._arm_links: list[int] | None = None
+        self._arm_link_set: frozenset[int] | None = None
         self.wheel_ids_left = [self.joint_index(n) for n in description.base.left_wheels]
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
         self.base_joint_ids = [self.joint_index(n) for n in description.base.joints]
@@ -267,6 +268,13 @@ class Robot:
             self._arm_links = sorted(links)
         return list(self._arm_links)
 
+    def arm_link_set(self) -> frozenset[int]:
+        """:meth:`arm_link_ids` as a set, kept (a robot's links do not change): what a contact
+        check that runs every tick tests links against."""
+        if self._arm_link_set is None:
+            self._arm_link_set = frozenset(self.arm_link_ids())
+        return self._arm_link_set
+
     def link_index(self, name: str) -> int:
         """PyBullet link index of the URDF link ``name`` (-1 for the root link); for a link merged
         into another, the index of the link that carries it."""
@@ -393,23 +401,29 @@ class Robot:
             raise ValueError(f"{self.name}: expected {n} arm targets, got {q_arr.shape}")
         # element-wise min and clip on plain floats: the same values numpy's minimum and clip
         # give, without building arrays for a handful of joints
-        limits: list[float] = [float(v) for v in self._arm_velocity]
+        limits: list[float] = self._arm_velocity
         if max_velocity is not None:
             if isinstance(max_velocity, list) and len(max_velocity) == n:
                 caps = [float(v) for v in max_velocity]
             else:
                 caps = np.broadcast_to(np.asarray(max_velocity, float), (n,)).tolist()
-            limits = [_least(v, c) for v, c in zip(limits, caps, strict=True)]
+            # numpy.minimum(limits, caps) on plain floats (a NaN wins, as there)
+            limits = [c if c < v or c != c else v for v, c in zip(limits, caps, strict=True)]
         gain = arm.position_gain
         client, body, control = self.client, self.body, pb.POSITION_CONTROL
         for j, target, lo, hi, speed, effort in zip(
             ids, q_arr.tolist(), arm.lower, arm.upper, limits, self._arm_effort, strict=True
         ):
+            # numpy.clip(target, lo, hi): minimum(maximum(target, lo), hi)
+            if lo > target:
+                target = float(lo)
+            if hi < target:
+                target = float(hi)
             # positional arguments (PyBullet parses them several times faster than keywords),
             # in its order: targetPosition, targetVelocity, force, positionGain, velocityGain,
             # maxVelocity, physicsClientId
             pb.setJointMotorControl2(
-                body, j, control, _clipped(target, lo, hi), 0.0, effort, gain, 1.0, speed, client
+                body, j, control, target, 0.0, effort, gain, 1.0, speed, client
             )
 
     def hold_arm(self) -> None:
@@ -622,19 +636,3 @@ def _has_window(client: int) -> bool:
     info = pb.getConnectionInfo(physicsClientId=client)
     return bool(info.get("connectionMethod") == pb.GUI)
 
-
-def _least(a: float, b: float) -> float:
-    """``numpy.minimum`` of two floats (a NaN wins, as there)."""
-    if math.isnan(a):
-        return a
-    return b if b < a or math.isnan(b) else a
-
-
-def _clipped(x: float, lo: float, hi: float) -> float:
-    """``numpy.clip(x, lo, hi)`` of one float: ``minimum(maximum(x, lo), hi)``."""
-    x = float(x)
-    if lo > x:
-        x = float(lo)
-    if hi < x:
-        x = float(hi)
-    return x
