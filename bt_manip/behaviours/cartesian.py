@@ -92,12 +92,17 @@ def line(
     to_base = _world_to_arm_base(services.robot)
     out = []
     q = seed
-    ab = b - a
+    (ax, ay, az), (dx, dy, dz) = a.tolist(), (b - a).tolist()
     for i in range(1, n + 1):
         s = i / n
-        pose = np.eye(4)
-        pose[:3, :3] = turning.at(s)
-        pose[:3, 3] = a + ab * s
+        # the waypoint's pose, its position a + (b - a) s worked out on plain floats
+        (r00, r01, r02), (r10, r11, r12), (r20, r21, r22) = turning.at(s).tolist()
+        pose = np.array([
+            [r00, r01, r02, ax + dx * s],
+            [r10, r11, r12, ay + dy * s],
+            [r20, r21, r22, az + dz * s],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
         q = _solved(solver, to_base @ pose, pose, q)
         out.append(q)
     return out

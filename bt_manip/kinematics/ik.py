@@ -165,6 +165,8 @@ class IKSolver:
         self._free_lower = np.full(arm.nq, -np.inf)
         self._free_upper = np.full(arm.nq, np.inf)
         self._shoulder = arm.shoulder()
+        sx, sy, sz = self._shoulder.tolist()
+        self._shoulder_xyz = (float(sx), float(sy), float(sz))
         # A small margin over the numerically maximised reach (see ArmModel.reach).
         self._reach = arm.reach()
         self._reach_limit = self._reach * (1.0 + 1e-3) + o.position_tolerance
@@ -185,21 +187,24 @@ class IKSolver:
         o = self.options
         arm = self.arm
         seed = arm.mid.copy() if q_seed is None else np.array(q_seed, dtype=float)
-        problem = self._check_target(target, seed)
-        if problem is not None:
+        t = np.asarray(target, dtype=float)
+        rows = t.tolist() if t.shape == (4, 4) else None
+        problem = self._check_target(rows, seed)
+        if problem is not None or rows is None:
             usable = seed.shape == (arm.nq,) and _finite(seed)
-            return self._failure(seed if usable else arm.mid, problem, start)
+            return self._failure(seed if usable else arm.mid, problem or "", start)
         np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
         np.minimum(seed, arm.upper, out=seed)
-        target = np.asarray(target, dtype=float)
-        distance = _norm3(target[:3, 3] - self._shoulder)
+        # the target's values as plain floats: the same numbers numpy would hand on
+        (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z) = rows[:3]
+        sx, sy, sz = self._shoulder_xyz
+        distance = _norm3((x - sx, y - sy, z - sz))
         if distance > self._reach_limit:
             return self._failure(seed, beyond_reach(distance, self._reach), start)
 
         r = self._runner
         q0, tgt, q_ref, lower, upper, params = r.inputs
-        tgt[:9] = target[:3, :3].ravel(order="F")
-        tgt[9:] = target[:3, 3]
+        tgt[:] = (r00, r10, r20, r01, r11, r21, r02, r12, r22, x, y, z)  # rotation column-major
         q_ref[:] = seed
         lower[:] = self._lower
         upper[:] = self._upper
@@ -251,13 +256,14 @@ class IKSolver:
             + np.max(np.abs(err[3:])) / o.rotation_tolerance
         )
 
-    def _check_target(self, target: np.ndarray, seed: np.ndarray) -> str | None:
-        t = np.asarray(target, dtype=float)
-        if t.shape != (4, 4) or not _finite(t):
+    def _check_target(self, rows: list[list[float]] | None, seed: np.ndarray) -> str | None:
+        """Why a target (``rows``: its 4x4 values, None when it is not 4x4) or a seed cannot be
+        solved for, or None."""
+        if rows is None or not all(math.isfinite(v) for row in rows for v in row):
             return "invalid target: expected a finite 4x4 homogeneous pose"
         if not self.options.position_only:
             # R^T R - I must vanish and det R be positive (plain floats: nine values)
-            (a, b, c), (d, e, f), (g, h, i) = t[:3, :3].tolist()
+            (a, b, c, _), (d, e, f, _), (g, h, i, _) = rows[:3]
             off = max(
                 abs(a * a + d * d + g * g - 1.0),
                 abs(b * b + e * e + h * h - 1.0),
@@ -350,7 +356,7 @@ def _attempt_function(arm: ArmModel, key: tuple[bytes, str, int, str]) -> ca.Fun
     return function
 
 
-def _norm3(v: np.ndarray) -> float:
+def _norm3(v: np.ndarray | tuple[float, float, float]) -> float:
     """Euclidean norm of a 3-vector (cheaper than numpy.linalg.norm for tiny arrays)."""
     x, y, z = float(v[0]), float(v[1]), float(v[2])
     return math.sqrt(x * x + y * y + z * z)
