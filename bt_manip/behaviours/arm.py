@@ -9,6 +9,7 @@ end the move with FAILURE and a reason; the arm then holds where it is.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -169,13 +170,14 @@ class JointMove(RobotAction):
         # every joint, not only the moving ones, must be where it was told to be: a load can
         # push a holding joint away, and the move is not done until it is back
         q, qd = robot.arm_motion()
-        err = [abs(a - b) for a, b in zip(q, self._command, strict=True)]
+        err = list(map(abs, map(operator.sub, q, self._command)))
+        # "every e < tol" as tol > e on each (False for a NaN, as numpy's comparison)
         if self.stages[self.stage].via:
-            tol = self.via_tol
-            arrived = all(e < tol for e in err)
+            arrived = all(map(float(self.via_tol).__gt__, err))
         else:
-            tol = self.tol
-            arrived = all(e < tol for e in err) and all(abs(v) < SETTLE_SPEED for v in qd)
+            arrived = all(map(float(self.tol).__gt__, err)) and all(
+                map(SETTLE_SPEED.__gt__, map(abs, qd))
+            )
         if arrived:
             self._next_stage(robot, q)
             if self.stage >= len(self.stages):

@@ -31,6 +31,7 @@ solve deterministic.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -259,7 +260,7 @@ class IKSolver:
     def _check_target(self, rows: list[list[float]] | None, seed: np.ndarray) -> str | None:
         """Why a target (``rows``: its 4x4 values, None when it is not 4x4) or a seed cannot be
         solved for, or None."""
-        if rows is None or not all(math.isfinite(v) for row in rows for v in row):
+        if rows is None or not all(map(math.isfinite, itertools.chain.from_iterable(rows))):
             return "invalid target: expected a finite 4x4 homogeneous pose"
         if not self.options.position_only:
             # R^T R - I must vanish and det R be positive (plain floats: nine values)
