@@ -62,6 +62,9 @@ def _solved(
 ) -> np.ndarray:
     """The joints ``solver`` finds for ``pose_base`` (the arm base frame's ``pose_world``);
     ActionFailed with IK's reason if none."""
+    q = solver.solve_q(pose_base, seed)  # the usual case: the attempt from the seed succeeds
+    if q is not None:
+        return q
     result = solver.solve(pose_base, q_seed=seed)
     if not result.success:
         where = ", ".join(f"{v:.3f}" for v in pose_world[:3, 3])

@@ -187,30 +187,11 @@ class IKSolver:
         start = time.perf_counter()
         o = self.options
         arm = self.arm
-        seed = arm.mid.copy() if q_seed is None else np.array(q_seed, dtype=float)
-        t = np.asarray(target, dtype=float)
-        rows = t.tolist() if t.shape == (4, 4) else None
-        problem = self._check_target(rows, seed)
-        if problem is not None or rows is None:
-            usable = seed.shape == (arm.nq,) and _finite(seed)
-            return self._failure(seed if usable else arm.mid, problem or "", start)
-        np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
-        np.minimum(seed, arm.upper, out=seed)
-        # the target's values as plain floats: the same numbers numpy would hand on
-        (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z) = rows[:3]
-        sx, sy, sz = self._shoulder_xyz
-        distance = _norm3((x - sx, y - sy, z - sz))
-        if distance > self._reach_limit:
-            return self._failure(seed, beyond_reach(distance, self._reach), start)
-
+        seed, problem = self._load(target, q_seed)
+        if problem is not None:
+            return self._failure(seed, problem, start)
         r = self._runner
-        q0, tgt, q_ref, lower, upper, params = r.inputs
-        tgt[:] = (r00, r10, r20, r01, r11, r21, r02, r12, r22, x, y, z)  # rotation column-major
-        q_ref[:] = seed
-        lower[:] = self._lower
-        upper[:] = self._upper
-        params[:] = self._params
-        q0[:] = seed
+        q0 = r.inputs[0]
         out_q, out_err, out_status = r.outputs
         rng: np.random.Generator | None = None
         iterations = 0
@@ -249,7 +230,49 @@ class IKSolver:
             )
         return self._result(False, best_q, best_err, iterations, attempt, start, reason)
 
+    def solve_q(self, target: np.ndarray, q_seed: np.ndarray) -> np.ndarray | None:
+        """The joint values ``solve(target, q_seed)`` returns when its first attempt (the one
+        from the seed) succeeds, else None: the same numbers without a result record, for
+        callers that solve many targets in a row and call :meth:`solve` for the reason only
+        when this gives None."""
+        _, problem = self._load(target, q_seed)
+        if problem is not None:
+            return None
+        r = self._runner
+        r.run()
+        out_q, _, out_status = r.outputs
+        return out_q.copy() if out_status[1] > 0.5 else None
+
     # ------------------------------------------------------------------ helpers
+    def _load(self, target: np.ndarray, q_seed: np.ndarray | None) -> tuple[np.ndarray, str | None]:
+        """Check ``target`` and ``q_seed`` and load the solver's inputs for the attempt from
+        the seed: (the seed, clipped to the limits, and None), or (the configuration to report,
+        why there is nothing to solve)."""
+        arm = self.arm
+        seed = arm.mid.copy() if q_seed is None else np.array(q_seed, dtype=float)
+        t = np.asarray(target, dtype=float)
+        rows = t.tolist() if t.shape == (4, 4) else None
+        problem = self._check_target(rows, seed)
+        if problem is not None or rows is None:
+            usable = seed.shape == (arm.nq,) and _finite(seed)
+            return (seed if usable else arm.mid), problem or ""
+        np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
+        np.minimum(seed, arm.upper, out=seed)
+        # the target's values as plain floats: the same numbers numpy would hand on
+        (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z) = rows[:3]
+        sx, sy, sz = self._shoulder_xyz
+        distance = _norm3((x - sx, y - sy, z - sz))
+        if distance > self._reach_limit:
+            return seed, beyond_reach(distance, self._reach)
+        q0, tgt, q_ref, lower, upper, params = self._runner.inputs
+        tgt[:] = (r00, r10, r20, r01, r11, r21, r02, r12, r22, x, y, z)  # rotation column-major
+        q_ref[:] = seed
+        lower[:] = self._lower
+        upper[:] = self._upper
+        params[:] = self._params
+        q0[:] = seed
+        return seed, None
+
     def _score(self, err: np.ndarray) -> float:
         o = self.options
         return float(
