@@ -163,6 +163,10 @@ class IKSolver:
         )
         self._lower = arm.lower.copy()
         self._upper = arm.upper.copy()
+        _, _, _, lower, upper, params = self._runner.inputs
+        lower[:] = self._lower
+        upper[:] = self._upper
+        params[:] = self._params
         self._free_lower = np.full(arm.nq, -np.inf)
         self._free_upper = np.full(arm.nq, np.inf)
         self._shoulder = arm.shoulder()
@@ -264,12 +268,11 @@ class IKSolver:
         distance = _norm3((x - sx, y - sy, z - sz))
         if distance > self._reach_limit:
             return seed, beyond_reach(distance, self._reach)
-        q0, tgt, q_ref, lower, upper, params = self._runner.inputs
+        # (the limits and parameters stay loaded from the constructor: only the diagnosis
+        # changes the limits, and it puts them back)
+        q0, tgt, q_ref = self._runner.inputs[:3]
         tgt[:] = (r00, r10, r20, r01, r11, r21, r02, r12, r22, x, y, z)  # rotation column-major
         q_ref[:] = seed
-        lower[:] = self._lower
-        upper[:] = self._upper
-        params[:] = self._params
         q0[:] = seed
         return seed, None
 
