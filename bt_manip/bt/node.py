@@ -85,6 +85,20 @@ class AttributeCheck:
     post: dict[str, Script] = field(default_factory=dict)
     errors: list[tuple[str, int | None]] = field(default_factory=list)  # (message, column)
 
+    def copy(self) -> AttributeCheck:
+        """A check with its own dicts and lists (the bindings and scripts themselves shared)."""
+        return AttributeCheck(
+            dict(self.bindings), dict(self.texts), list(self.pre), dict(self.post),
+            list(self.errors),
+        )
+
+    def shareable(self) -> bool:
+        """Whether nodes may share what this check holds: no scripts, no errors, and every
+        literal an immutable value (a number, a flag, a text)."""
+        return not (self.pre or self.post or self.errors) and all(
+            isinstance(b, Ref) or type(b.value) in _IMMUTABLE for b in self.bindings.values()
+        )
+
 
 def closest(word: str, choices: list[str] | set[str], n: int = 3) -> str:
     """' (did you mean 'a', 'b'?)' or '' when nothing is close."""
@@ -178,7 +192,34 @@ class BtNode(PortsMixin):
 
     @classmethod
     def check_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
-        """Check and convert ``attributes`` (XML text or Python values) for this class."""
+        """Check and convert ``attributes`` (XML text or Python values) for this class.
+
+        A tree repeats the same node with the same text attributes (a subtree used once per
+        object): the check of text attributes that holds no script and only immutable
+        literals is kept per class (:data:`_CHECKS_PER_CLASS` at most) and handed out as a
+        copy, so each node still has its own bindings."""
+        key = tuple(attributes.items())
+        if not all(type(v) is str for _, v in key):
+            return cls._checked_attributes(attributes)
+        memo: dict[tuple[tuple[str, Any], ...], AttributeCheck] | None = cls.__dict__.get(
+            _CHECKS_FLAG
+        )
+        if memo is None:
+            memo = {}
+            setattr(cls, _CHECKS_FLAG, memo)
+        known = memo.get(key)
+        if known is not None:
+            return known.copy()
+        check = cls._checked_attributes(attributes)
+        if check.shareable():
+            if len(memo) >= _CHECKS_PER_CLASS:
+                memo.pop(next(iter(memo)))
+            memo[key] = check.copy()
+        return check
+
+    @classmethod
+    def _checked_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
+        """:meth:`check_attributes` worked out."""
         check = AttributeCheck()
         where = f"{cls.NODE_ID}"
         parse_condition_scripts(attributes, check, where)
@@ -467,6 +508,9 @@ class BtNode(PortsMixin):
 
 
 _ABSTRACT_FLAG = "_bt_ports_abstract"
+_CHECKS_FLAG = "_bt_attribute_checks"
+_CHECKS_PER_CLASS = 256
+"""The most attribute checks kept per node class (the oldest goes first)."""
 
 
 def _class_is_abstract(cls: type) -> bool:

@@ -94,3 +94,44 @@ def test_an_abstract_node_class_cannot_be_built(monkeypatch: pytest.MonkeyPatch)
     monkeypatch.setattr(Undeclared, _ABSTRACT_FLAG, True, raising=False)
     with pytest.raises(TypeError, match="without the INPUT_PORTS and OUTPUT_PORTS"):
         Undeclared("u")
+
+
+class Listed(ActionNode):
+    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+        "n": PortInformation(int, False, "a number", 3),
+        "values": PortInformation(list[float], False, "numbers", []),
+        "key": PortInformation(str, False, "an entry", ""),
+    }
+
+    def update(self) -> Status:
+        return Status.SUCCESS
+
+
+def test_repeated_text_attributes_are_checked_once_and_never_shared() -> None:
+    from bt_manip.bt.node import _CHECKS_FLAG, _CHECKS_PER_CLASS
+
+    text = {"n": "5", "key": "{entry}"}
+    first = Listed.check_attributes(text)
+    again = Listed.check_attributes(text)
+    assert again == first and again.bindings is not first.bindings
+    assert tuple(text.items()) in vars(Listed)[_CHECKS_FLAG]
+    a, b = Listed("a", **text), Listed("b", **text)
+    assert a.bindings == b.bindings and a.bindings is not b.bindings
+    assert a.attribute_texts is not b.attribute_texts
+    del a.bindings["n"]                          # one node's bindings are its own
+    assert b.get_input("n") == 5 and Listed("c", **text).get_input("n") == 5
+    assert a.get_input("n") == 3
+    # a list literal is converted for each node: nodes never hold the same list
+    with_list = {"values": "1;2;3"}
+    c, d = Listed("c", **with_list), Listed("d", **with_list)
+    assert c.get_input("values") == d.get_input("values") == [1.0, 2.0, 3.0]
+    assert c.get_input("values") is not d.get_input("values")
+    assert tuple(with_list.items()) not in vars(Listed)[_CHECKS_FLAG]
+    # errors are reported every time, and not kept
+    with pytest.raises(ValueError, match="'m' is not a port of Listed"):
+        Listed("e", m="1")
+    with pytest.raises(ValueError, match="'m' is not a port of Listed"):
+        Listed("e", m="1")
+    for i in range(_CHECKS_PER_CLASS + 10):
+        Listed.check_attributes({"n": str(i)})
+    assert len(vars(Listed)[_CHECKS_FLAG]) <= _CHECKS_PER_CLASS
