@@ -213,7 +213,7 @@ class BtNode(PortsMixin):
         check = cls._checked_attributes(attributes)
         if check.shareable():
             if len(memo) >= _CHECKS_PER_CLASS:
-                memo.pop(next(iter(memo)))
+                memo.pop(next(iter(memo)), None)
             memo[key] = check.copy()
         return check
 

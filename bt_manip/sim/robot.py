@@ -635,4 +635,3 @@ def _has_window(client: int) -> bool:
     """True when ``client`` is PyBullet's GUI, which draws the URDF's own visuals."""
     info = pb.getConnectionInfo(physicsClientId=client)
     return bool(info.get("connectionMethod") == pb.GUI)
-
