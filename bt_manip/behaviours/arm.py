@@ -9,6 +9,7 @@ end the move with FAILURE and a reason; the arm then holds where it is.
 from __future__ import annotations
 
 import math
+import operator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar
 
@@ -102,10 +103,10 @@ class JointMove(RobotAction):
         arm = robot.description.arm
         q_now = robot.arm_positions()
         stages = [st for st in self.plan(q_now) if st.joints]
-        lower = np.asarray(arm.lower, dtype=float)
-        upper = np.asarray(arm.upper, dtype=float)
+        lower = [float(v) for v in arm.lower]
+        upper = [float(v) for v in arm.upper]
         for st in stages:
-            command = st.command
+            command = st.command.tolist()
             for j in st.joints:
                 if not lower[j] - 1e-9 <= command[j] <= upper[j] + 1e-9:
                     raise ActionFailed(
@@ -115,38 +116,46 @@ class JointMove(RobotAction):
                     )
         self.stages = stages
         self.command = q_now.copy()
+        self._command = q_now.tolist()
         self.stage = -1
+        # each joint's allowed speed, and the least it may correct at, fixed for the move
+        vmax = np.asarray(arm.velocity_limits, dtype=float) * self.speed
+        self._vmax: list[float] = vmax.tolist()
+        self._floor: list[float] = (CORRECTION_SPEED * vmax).tolist()
         # contacts the arm already has may stay (it can then move away from them); only new
         # ones end the move
         self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
-        self._next_stage()
+        self._next_stage(robot, robot.arm_motion()[0])
 
-    def _next_stage(self) -> None:
+    def _next_stage(self, robot: Robot, q: list[float]) -> None:
+        """Start the next stage from the arm's joint positions ``q`` (rad)."""
         self.stage += 1
         self.stage_started = self.now()
         if self.stage >= len(self.stages):
             return
-        target, joints = self.stages[self.stage].command, self.stages[self.stage].joints
-        q = self.robot().arm_positions()
-        vmax = np.asarray(self.robot().description.arm.velocity_limits, dtype=float) * self.speed
+        stage = self.stages[self.stage]
+        target, joints = stage.command, stage.joints
         self.command = target.copy()
+        self._command = target.tolist()
         # joints moved together arrive together: scale each speed to the slowest travel time
-        travel = np.abs(target[joints] - q[joints])
-        t = float(np.max(travel / vmax[joints])) if len(joints) else 0.0
-        self._send(joints, travel, t)
+        command, vmax = self._command, self._vmax
+        travel = [abs(command[j] - q[j]) for j in joints]
+        t = _largest([d / vmax[j] for d, j in zip(travel, joints, strict=True)]) if joints else 0.0
+        self._send(robot, joints, travel, t)
 
-    def _send(self, joints: list[int], travel: np.ndarray, t: float) -> None:
+    def _send(self, robot: Robot, joints: list[int], travel: list[float], t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
         every joint may correct at no less than :data:`CORRECTION_SPEED` of its allowed speed, so
         a joint that a load pushes away can come back."""
-        robot = self.robot()
-        vmax = np.asarray(robot.description.arm.velocity_limits, dtype=float) * self.speed
-        floor = CORRECTION_SPEED * vmax
-        speeds = floor.copy()
+        speeds = list(self._floor)
         if t > 1e-9:
-            speeds[joints] = np.maximum(travel / t, floor[joints])
+            for d, j in zip(travel, joints, strict=True):
+                # numpy.maximum(d / t, floor) on plain floats (a NaN wins, as there)
+                v, f = d / t, speeds[j]
+                speeds[j] = f if f > v or f != f else v
         else:
-            speeds[joints] = vmax[joints]
+            for j in joints:
+                speeds[j] = self._vmax[j]
         robot.set_arm_targets(self.command, max_velocity=speeds)
 
     def step(self) -> Status:
@@ -160,15 +169,17 @@ class JointMove(RobotAction):
             return Status.SUCCESS
         # every joint, not only the moving ones, must be where it was told to be: a load can
         # push a holding joint away, and the move is not done until it is back
-        q = robot.arm_positions()
-        qd = robot.arm_velocities()
-        err = np.abs(q - self.command)
+        q, qd = robot.arm_motion()
+        err = list(map(abs, map(operator.sub, q, self._command)))
+        # "every e < tol" as tol > e on each (False for a NaN, as numpy's comparison)
         if self.stages[self.stage].via:
-            arrived = bool(np.all(err < self.via_tol))
+            arrived = all(map(float(self.via_tol).__gt__, err))
         else:
-            arrived = bool(np.all(err < self.tol) and np.all(np.abs(qd) < SETTLE_SPEED))
+            arrived = all(map(float(self.tol).__gt__, err)) and all(
+                map(SETTLE_SPEED.__gt__, map(abs, qd))
+            )
         if arrived:
-            self._next_stage()
+            self._next_stage(robot, q)
             if self.stage >= len(self.stages):
                 return Status.SUCCESS
             return Status.RUNNING
@@ -456,3 +467,14 @@ def _through(path: list[np.ndarray], n: int) -> list[Stage]:
     """Stages along a waypoint path: pass through every waypoint, stop at the last."""
     joints = list(range(n))
     return [Stage(q, joints, via=i < len(path) - 1) for i, q in enumerate(path)]
+
+
+def _largest(values: list[float]) -> float:
+    """``numpy.max`` of a non-empty list of floats (NaN when one is NaN, as there)."""
+    top = values[0]
+    for v in values:
+        if v > top or v != v:
+            top = v
+            if v != v:
+                break
+    return top

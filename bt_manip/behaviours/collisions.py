@@ -13,7 +13,8 @@ from bt_manip.sim import pybullet_queries as pbq
 
 def arm_link_ids(robot: Any) -> frozenset[int]:
     """PyBullet link indices of the arm and gripper of ``robot``."""
-    return frozenset(robot.arm_link_ids())
+    links: frozenset[int] = robot.arm_link_set()
+    return links
 
 
 def _static_ids(world: Any) -> dict[int, str]:
@@ -26,13 +27,15 @@ def _static_ids(world: Any) -> dict[int, str]:
 
 def arm_collisions(world: Any, robot: Any) -> list[str]:
     """Descriptions of contacts between the arm (or what it holds) and the static world."""
-    static = _static_ids(world)
     links = arm_link_ids(robot)
+    static: dict[int, str] | None = None
     found: list[str] = []
-    for pt in pbq.contacts(world.client, robot.body):
-        link, other = pt.link_a, pt.body_b
-        if link in links and other in static:
-            found.append(f"{robot.link_name(link)} touched '{static[other]}'")
+    for link, other in pbq.contact_links(world.client, robot.body):
+        if link in links:
+            if static is None:
+                static = _static_ids(world)
+            if other in static:
+                found.append(f"{robot.link_name(link)} touched '{static[other]}'")
     found += carried_collisions(world, robot)
     return sorted(set(found))
 

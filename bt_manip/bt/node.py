@@ -31,7 +31,7 @@ from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
 from py_trees.common import Status
-from py_trees.ports import PortInformation, PortsMixin
+from py_trees.ports import PortInformation, PortsMixin, _ports_class_is_abstract
 
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
@@ -60,6 +60,10 @@ _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 # Enum members hash in Python code: the hot path maps statuses through identity lookups.
 _PY_BY_ID = {id(s): p for s, p in PY_TREES_OF.items()}
+_IDLE = NodeStatus.IDLE
+_SUCCESS = NodeStatus.SUCCESS
+_FAILURE = NodeStatus.FAILURE
+_SKIPPED = NodeStatus.SKIPPED
 _LEAF_RESULT = {id(s): b for s, b in RESULT_OF_PY_TREES.items()}
 
 
@@ -80,6 +84,20 @@ class AttributeCheck:
     pre: list[tuple[str, Script]] = field(default_factory=list)
     post: dict[str, Script] = field(default_factory=dict)
     errors: list[tuple[str, int | None]] = field(default_factory=list)  # (message, column)
+
+    def copy(self) -> AttributeCheck:
+        """A check with its own dicts and lists (the bindings and scripts themselves shared)."""
+        return AttributeCheck(
+            dict(self.bindings), dict(self.texts), list(self.pre), dict(self.post),
+            list(self.errors),
+        )
+
+    def shareable(self) -> bool:
+        """Whether nodes may share what this check holds: no scripts, no errors, and every
+        literal an immutable value (a number, a flag, a text)."""
+        return not (self.pre or self.post or self.errors) and all(
+            isinstance(b, Ref) or type(b.value) in _IMMUTABLE for b in self.bindings.values()
+        )
 
 
 def closest(word: str, choices: list[str] | set[str], n: int = 3) -> str:
@@ -144,6 +162,28 @@ class BtNode(PortsMixin):
         if "NODE_ID" not in vars(cls):
             cls.NODE_ID = cls.__name__
 
+    def __init__(self, *args: Any, behaviour_class_name: str | None = None, **kwargs: Any) -> None:
+        """``PortsMixin.__init__`` with its abstract-class check asked once per class.
+
+        py_trees checks at every construction whether the class is still abstract by scanning
+        ``dir()`` of the class, which costs more than the rest of building a node; the answer
+        is a property of the class, kept on the class itself (:func:`_class_is_abstract`).
+        The same fields are set and the same ``TypeError`` is raised as by ``PortsMixin``.
+        """
+        cls = type(self)
+        if _class_is_abstract(cls):
+            raise TypeError(
+                f"Can't instantiate abstract class {cls.__name__} without the "
+                "INPUT_PORTS and OUTPUT_PORTS class attribute declarations."
+            )
+        super(PortsMixin, self).__init__(*args, **kwargs)
+        self._blackboard_client = None
+        self._subtree_namespace = None
+        self._ports_logger = None
+        self._behaviour_class_name = (
+            behaviour_class_name if behaviour_class_name is not None else cls.__name__
+        )
+
     # ------------------------------------------------------------------ construction
 
     @classmethod
@@ -152,7 +192,34 @@ class BtNode(PortsMixin):
 
     @classmethod
     def check_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
-        """Check and convert ``attributes`` (XML text or Python values) for this class."""
+        """Check and convert ``attributes`` (XML text or Python values) for this class.
+
+        A tree repeats the same node with the same text attributes (a subtree used once per
+        object): the check of text attributes that holds no script and only immutable
+        literals is kept per class (:data:`_CHECKS_PER_CLASS` at most) and handed out as a
+        copy, so each node still has its own bindings."""
+        key = tuple(attributes.items())
+        if not all(type(v) is str for _, v in key):
+            return cls._checked_attributes(attributes)
+        memo: dict[tuple[tuple[str, Any], ...], AttributeCheck] | None = cls.__dict__.get(
+            _CHECKS_FLAG
+        )
+        if memo is None:
+            memo = {}
+            setattr(cls, _CHECKS_FLAG, memo)
+        known = memo.get(key)
+        if known is not None:
+            return known.copy()
+        check = cls._checked_attributes(attributes)
+        if check.shareable():
+            if len(memo) >= _CHECKS_PER_CLASS:
+                memo.pop(next(iter(memo)), None)
+            memo[key] = check.copy()
+        return check
+
+    @classmethod
+    def _checked_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
+        """:meth:`check_attributes` worked out."""
         check = AttributeCheck()
         where = f"{cls.NODE_ID}"
         parse_condition_scripts(attributes, check, where)
@@ -344,26 +411,27 @@ class BtNode(PortsMixin):
 
     def execute_tick(self) -> NodeStatus:
         """Tick this node once, BT.CPP style; returns the status it reports to its parent."""
-        if self.bt_status is NodeStatus.IDLE:
+        if self.bt_status is _IDLE:
             self.started_order = next(_ORDER)
         new = self._check_preconditions() if self._pre else None
         if new is None and self.pre_tick is not None and not self.bt_status.completed:
             forced = self.pre_tick(self)
-            if forced is NodeStatus.SUCCESS or forced is NodeStatus.FAILURE:
+            if forced is _SUCCESS or forced is _FAILURE:
                 new = forced
         if new is None:
             new = self.tick_node()
-        if self._post and (new is NodeStatus.SUCCESS or new is NodeStatus.FAILURE):
-            if new is NodeStatus.SUCCESS and "_onSuccess" in self._post:
-                self._run_script("_onSuccess", self._post["_onSuccess"])
-            elif new is NodeStatus.FAILURE and "_onFailure" in self._post:
-                self._run_script("_onFailure", self._post["_onFailure"])
-            if "_post" in self._post:
-                self._run_script("_post", self._post["_post"])
+        post = self._post
+        if post and (new is _SUCCESS or new is _FAILURE):
+            if new is _SUCCESS and "_onSuccess" in post:
+                self._run_script("_onSuccess", post["_onSuccess"])
+            elif new is _FAILURE and "_onFailure" in post:
+                self._run_script("_onFailure", post["_onFailure"])
+            if "_post" in post:
+                self._run_script("_post", post["_post"])
         self.last_status = new
-        if new is NodeStatus.FAILURE:
+        if new is _FAILURE:
             self.failure_order = next(_ORDER)
-        if new is not NodeStatus.SKIPPED:
+        if new is not _SKIPPED:
             self.bt_status = new
             self.status = _PY_BY_ID[id(new)]
         visited = self.context.visited
@@ -437,6 +505,23 @@ class BtNode(PortsMixin):
         """The node's children (the list itself: read it, do not change it). The children of a
         bt-manip node are bt-manip nodes (the XML loader and ``as_bt_node`` build them)."""
         return cast("list[BtNode]", self.children)
+
+
+_ABSTRACT_FLAG = "_bt_ports_abstract"
+_CHECKS_FLAG = "_bt_attribute_checks"
+_CHECKS_PER_CLASS = 256
+"""The most attribute checks kept per node class (the oldest goes first)."""
+
+
+def _class_is_abstract(cls: type) -> bool:
+    """py_trees' ``_ports_class_is_abstract(cls)``, computed at the first construction of
+    ``cls`` and kept in the class's own namespace (so a subclass never reads its parent's
+    answer, and the cache holds one flag per class, no more)."""
+    flag = cls.__dict__.get(_ABSTRACT_FLAG)
+    if flag is None:
+        flag = _ports_class_is_abstract(cls)
+        setattr(cls, _ABSTRACT_FLAG, flag)
+    return bool(flag)
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:

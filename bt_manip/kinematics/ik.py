@@ -31,6 +31,7 @@ solve deterministic.
 
 from __future__ import annotations
 
+import itertools
 import math
 import time
 from dataclasses import dataclass, field
@@ -162,9 +163,15 @@ class IKSolver:
         )
         self._lower = arm.lower.copy()
         self._upper = arm.upper.copy()
+        _, _, _, lower, upper, params = self._runner.inputs
+        lower[:] = self._lower
+        upper[:] = self._upper
+        params[:] = self._params
         self._free_lower = np.full(arm.nq, -np.inf)
         self._free_upper = np.full(arm.nq, np.inf)
         self._shoulder = arm.shoulder()
+        sx, sy, sz = self._shoulder.tolist()
+        self._shoulder_xyz = (float(sx), float(sy), float(sz))
         # A small margin over the numerically maximised reach (see ArmModel.reach).
         self._reach = arm.reach()
         self._reach_limit = self._reach * (1.0 + 1e-3) + o.position_tolerance
@@ -184,30 +191,15 @@ class IKSolver:
         start = time.perf_counter()
         o = self.options
         arm = self.arm
-        seed = arm.mid.copy() if q_seed is None else np.asarray(q_seed, dtype=float).copy()
-        problem = self._check_target(target, seed)
+        seed, problem = self._load(target, q_seed)
         if problem is not None:
-            usable = seed.shape == (arm.nq,) and bool(np.isfinite(seed).all())
-            return self._failure(seed if usable else arm.mid, problem, start)
-        seed = np.clip(seed, arm.lower, arm.upper)
-        target = np.asarray(target, dtype=float)
-        distance = _norm3(target[:3, 3] - self._shoulder)
-        if distance > self._reach_limit:
-            return self._failure(seed, beyond_reach(distance, self._reach), start)
-
+            return self._failure(seed, problem, start)
         r = self._runner
-        q0, tgt, q_ref, lower, upper, params = r.inputs
-        tgt[:9] = target[:3, :3].ravel(order="F")
-        tgt[9:] = target[:3, 3]
-        q_ref[:] = seed
-        lower[:] = self._lower
-        upper[:] = self._upper
-        params[:] = self._params
-        q0[:] = seed
+        q0 = r.inputs[0]
         out_q, out_err, out_status = r.outputs
         rng: np.random.Generator | None = None
         iterations = 0
-        best_q, best_err, best_score = seed.copy(), np.full(6, np.inf), math.inf
+        best_q, best_err, best_score = seed.copy(), None, math.inf
         deadline = None if o.time_budget is None else start + o.time_budget
         budget_hit = False
         attempt = 0
@@ -226,6 +218,8 @@ class IKSolver:
                 rng = np.random.default_rng(o.seed)
             q0[:] = rng.uniform(arm.lower, arm.upper)
 
+        if best_err is None:  # no attempt gave a comparable error (NaN)
+            best_err = np.full(6, np.inf)
         reason = None
         if o.diagnose:
             reason = self._diagnose_limits(best_q, rng or np.random.default_rng(o.seed))
@@ -240,7 +234,48 @@ class IKSolver:
             )
         return self._result(False, best_q, best_err, iterations, attempt, start, reason)
 
+    def solve_q(self, target: np.ndarray, q_seed: np.ndarray) -> np.ndarray | None:
+        """The joint values ``solve(target, q_seed)`` returns when its first attempt (the one
+        from the seed) succeeds, else None: the same numbers without a result record, for
+        callers that solve many targets in a row and call :meth:`solve` for the reason only
+        when this gives None."""
+        _, problem = self._load(target, q_seed)
+        if problem is not None:
+            return None
+        r = self._runner
+        r.run()
+        out_q, _, out_status = r.outputs
+        return out_q.copy() if out_status[1] > 0.5 else None
+
     # ------------------------------------------------------------------ helpers
+    def _load(self, target: np.ndarray, q_seed: np.ndarray | None) -> tuple[np.ndarray, str | None]:
+        """Check ``target`` and ``q_seed`` and load the solver's inputs for the attempt from
+        the seed: (the seed, clipped to the limits, and None), or (the configuration to report,
+        why there is nothing to solve)."""
+        arm = self.arm
+        seed = arm.mid.copy() if q_seed is None else np.array(q_seed, dtype=float)
+        t = np.asarray(target, dtype=float)
+        rows = t.tolist() if t.shape == (4, 4) else None
+        problem = self._check_target(rows, seed)
+        if problem is not None or rows is None:
+            usable = seed.shape == (arm.nq,) and _finite(seed)
+            return (seed if usable else arm.mid), problem or ""
+        np.maximum(seed, arm.lower, out=seed)  # numpy.clip(seed, lower, upper), in place
+        np.minimum(seed, arm.upper, out=seed)
+        # the target's values as plain floats: the same numbers numpy would hand on
+        (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z) = rows[:3]
+        sx, sy, sz = self._shoulder_xyz
+        distance = _norm3((x - sx, y - sy, z - sz))
+        if distance > self._reach_limit:
+            return seed, beyond_reach(distance, self._reach)
+        # (the limits and parameters stay loaded from the constructor: only the diagnosis
+        # changes the limits, and it puts them back)
+        q0, tgt, q_ref = self._runner.inputs[:3]
+        tgt[:] = (r00, r10, r20, r01, r11, r21, r02, r12, r22, x, y, z)  # rotation column-major
+        q_ref[:] = seed
+        q0[:] = seed
+        return seed, None
+
     def _score(self, err: np.ndarray) -> float:
         o = self.options
         return float(
@@ -248,21 +283,26 @@ class IKSolver:
             + np.max(np.abs(err[3:])) / o.rotation_tolerance
         )
 
-    def _check_target(self, target: np.ndarray, seed: np.ndarray) -> str | None:
-        t = np.asarray(target, dtype=float)
-        if t.shape != (4, 4) or not np.isfinite(t).all():
+    def _check_target(self, rows: list[list[float]] | None, seed: np.ndarray) -> str | None:
+        """Why a target (``rows``: its 4x4 values, None when it is not 4x4) or a seed cannot be
+        solved for, or None."""
+        if rows is None or not all(map(math.isfinite, itertools.chain.from_iterable(rows))):
             return "invalid target: expected a finite 4x4 homogeneous pose"
-        rot = t[:3, :3]
         if not self.options.position_only:
-            gram = rot.T @ rot
-            gram[0, 0] -= 1.0
-            gram[1, 1] -= 1.0
-            gram[2, 2] -= 1.0
-            (a, b, c), (d, e, f), (g, h, i) = rot.tolist()
+            # R^T R - I must vanish and det R be positive (plain floats: nine values)
+            (a, b, c, _), (d, e, f, _), (g, h, i, _) = rows[:3]
+            off = max(
+                abs(a * a + d * d + g * g - 1.0),
+                abs(b * b + e * e + h * h - 1.0),
+                abs(c * c + f * f + i * i - 1.0),
+                abs(a * b + d * e + g * h),
+                abs(a * c + d * f + g * i),
+                abs(b * c + e * f + h * i),
+            )
             det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
-            if np.abs(gram).max() > 1e-6 or det < 0:
+            if off > 1e-6 or det < 0:
                 return "invalid target: the rotation part is not a rotation matrix"
-        if seed.shape != (self.arm.nq,) or not np.isfinite(seed).all():
+        if seed.shape != (self.arm.nq,) or not _finite(seed):
             return f"invalid seed: expected {self.arm.nq} finite joint values"
         return None
 
@@ -343,7 +383,13 @@ def _attempt_function(arm: ArmModel, key: tuple[bytes, str, int, str]) -> ca.Fun
     return function
 
 
-def _norm3(v: np.ndarray) -> float:
+def _norm3(v: np.ndarray | tuple[float, float, float]) -> float:
     """Euclidean norm of a 3-vector (cheaper than numpy.linalg.norm for tiny arrays)."""
     x, y, z = float(v[0]), float(v[1]), float(v[2])
     return math.sqrt(x * x + y * y + z * z)
+
+
+def _finite(a: np.ndarray) -> bool:
+    """Whether every value of ``a`` is finite (``numpy.isfinite(a).all()`` for a few values,
+    on plain floats)."""
+    return all(map(math.isfinite, a.ravel().tolist()))

@@ -162,6 +162,16 @@ def joint_states(client: int, body: int, joints: list[int]) -> list[JointState]:
     return [JointState(*s) for s in pb.getJointStates(body, joints, physicsClientId=client)]
 
 
+def joint_motion(client: int, body: int, joints: list[int]) -> tuple[list[float], list[float]]:
+    """Positions and velocities of ``joints`` of ``body``, in that order, from one
+    ``getJointStates`` query (the fields of :class:`JointState` a controller reads each tick,
+    without building a record per joint)."""
+    if not joints:
+        return [], []
+    states = pb.getJointStates(body, joints, physicsClientId=client)
+    return [s[0] for s in states], [s[1] for s in states]
+
+
 def root_link_name(client: int, body: int) -> str:
     """URDF name of the root link of ``body`` (``getBodyInfo``)."""
     return _text(pb.getBodyInfo(body, physicsClientId=client)[0])
@@ -224,6 +234,13 @@ def contacts(client: int, body: int, other: int | None = None) -> list[ContactIn
     else:
         points = pb.getContactPoints(bodyA=body, bodyB=other, physicsClientId=client)
     return [ContactInfo(*p[:14]) for p in points]
+
+
+def contact_links(client: int, body: int) -> list[tuple[int, int]]:
+    """(``link_a``, ``body_b``) of each contact point of ``body`` (as body A) with any body,
+    from the same query as :func:`contacts`, without the rest of each point: what a check
+    that runs every tick needs to tell which of its links touch which bodies."""
+    return [(p[3], p[2]) for p in pb.getContactPoints(bodyA=body, physicsClientId=client)]
 
 
 def closest_points(

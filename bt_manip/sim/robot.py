@@ -110,6 +110,7 @@ class Robot:
         self.gripper_joint_ids = [self.joint_index(n) for n in description.gripper.joints]
         self.finger_link_ids = [self.link_index(n) for n in description.gripper.finger_links]
         self._arm_links: list[int] | None = None
+        self._arm_link_set: frozenset[int] | None = None
         self.wheel_ids_left = [self.joint_index(n) for n in description.base.left_wheels]
         self.wheel_ids_right = [self.joint_index(n) for n in description.base.right_wheels]
         self.base_joint_ids = [self.joint_index(n) for n in description.base.joints]
@@ -267,6 +268,13 @@ class Robot:
             self._arm_links = sorted(links)
         return list(self._arm_links)
 
+    def arm_link_set(self) -> frozenset[int]:
+        """:meth:`arm_link_ids` as a set, kept (a robot's links do not change): what a contact
+        check that runs every tick tests links against."""
+        if self._arm_link_set is None:
+            self._arm_link_set = frozenset(self.arm_link_ids())
+        return self._arm_link_set
+
     def link_index(self, name: str) -> int:
         """PyBullet link index of the URDF link ``name`` (-1 for the root link); for a link merged
         into another, the index of the link that carries it."""
@@ -361,17 +369,20 @@ class Robot:
 
     # -- arm ----------------------------------------------------------------------------------
     def _positions(self, ids: Sequence[int]) -> np.ndarray:
-        states = pbq.joint_states(self.client, self.body, list(ids))
-        return np.array([s.position for s in states])
+        return np.array(pbq.joint_motion(self.client, self.body, list(ids))[0])
 
     def arm_positions(self) -> np.ndarray:
         """Arm joint positions (rad) in descriptor order."""
-        return self._positions(self.arm_joint_ids)
+        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[0])
 
     def arm_velocities(self) -> np.ndarray:
         """Arm joint velocities (rad/s) in descriptor order."""
-        states = pbq.joint_states(self.client, self.body, self.arm_joint_ids)
-        return np.array([s.velocity for s in states])
+        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[1])
+
+    def arm_motion(self) -> tuple[list[float], list[float]]:
+        """Arm joint positions (rad) and velocities (rad/s) in descriptor order, as plain
+        floats, from one query (what a controller checks every tick)."""
+        return pbq.joint_motion(self.client, self.body, self.arm_joint_ids)
 
     def set_arm_targets(
         self, q: Sequence[float] | np.ndarray, max_velocity: float | Sequence[float] | None = None
@@ -384,27 +395,35 @@ class Robot:
         """
         q_arr = np.asarray(q, dtype=float)
         arm = self.description.arm
-        n = len(self.arm_joint_ids)
+        ids = self.arm_joint_ids
+        n = len(ids)
         if q_arr.shape != (n,):
             raise ValueError(f"{self.name}: expected {n} arm targets, got {q_arr.shape}")
-        limits = np.asarray(self._arm_velocity, dtype=float)
+        # element-wise min and clip on plain floats: the same values numpy's minimum and clip
+        # give, without building arrays for a handful of joints
+        limits: list[float] = self._arm_velocity
         if max_velocity is not None:
-            limits = np.minimum(limits, np.broadcast_to(np.asarray(max_velocity, float), (n,)))
-        q_arr = np.clip(q_arr, arm.lower, arm.upper)
-        for j, target, speed, effort in zip(
-            self.arm_joint_ids, q_arr, limits, self._arm_effort, strict=True
+            if isinstance(max_velocity, list) and len(max_velocity) == n:
+                caps = [float(v) for v in max_velocity]
+            else:
+                caps = np.broadcast_to(np.asarray(max_velocity, float), (n,)).tolist()
+            # numpy.minimum(limits, caps) on plain floats (a NaN wins, as there)
+            limits = [c if c < v or c != c else v for v, c in zip(limits, caps, strict=True)]
+        gain = arm.position_gain
+        client, body, control = self.client, self.body, pb.POSITION_CONTROL
+        for j, target, lo, hi, speed, effort in zip(
+            ids, q_arr.tolist(), arm.lower, arm.upper, limits, self._arm_effort, strict=True
         ):
+            # numpy.clip(target, lo, hi): minimum(maximum(target, lo), hi)
+            if lo > target:
+                target = float(lo)
+            if hi < target:
+                target = float(hi)
+            # positional arguments (PyBullet parses them several times faster than keywords),
+            # in its order: targetPosition, targetVelocity, force, positionGain, velocityGain,
+            # maxVelocity, physicsClientId
             pb.setJointMotorControl2(
-                self.body,
-                j,
-                pb.POSITION_CONTROL,
-                targetPosition=float(target),
-                targetVelocity=0.0,
-                force=effort,
-                maxVelocity=float(speed),
-                positionGain=arm.position_gain,
-                velocityGain=1.0,
-                physicsClientId=self.client,
+                body, j, control, target, 0.0, effort, gain, 1.0, speed, client
             )
 
     def hold_arm(self) -> None:

@@ -159,6 +159,20 @@ def test_joint_limits_reason_names_the_joint(ur3: ArmModel, ur3_tight_wrist: Arm
     assert res.restarts == 30
 
 
+def test_a_diagnosis_leaves_the_limits_loaded(ur3: ArmModel, ur3_tight_wrist: ArmModel) -> None:
+    options = IKOptions(time_budget=None, max_restarts=30)
+    used, fresh = IKSolver(ur3_tight_wrist, options), IKSolver(ur3_tight_wrist, options)
+    beyond = ur3.fk(np.array([0.3, -1.2, 0.4, -0.5, 1.2, 2.0]))  # wrist beyond its limits
+    first_reason = used.solve(beyond).reason
+    again = used.solve(beyond)                 # the limits are back: fails the same way
+    assert not again.success and again.reason == first_reason
+    assert used.solve_q(beyond, ur3_tight_wrist.mid) is None
+    reachable = ur3.fk(np.array([0.3, -1.2, 0.4, -0.5, 1.2, 0.25]))
+    after, first = used.solve(reachable), fresh.solve(reachable)
+    assert after.success and np.array_equal(after.q, first.q)
+    assert ur3_tight_wrist.within_limits(after.q)
+
+
 def test_not_converged_reason_gives_the_best_error(ur3: ArmModel) -> None:
     options = IKOptions(time_budget=None, max_restarts=2, iterations_per_attempt=2)
     _, target = random_targets(ur3, 1, seed=26)[0]
