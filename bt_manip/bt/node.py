@@ -31,7 +31,19 @@ from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
 from py_trees.common import Status
-from py_trees.ports import PortInformation, PortsMixin, _ports_class_is_abstract
+from py_trees.ports import PortInformation, PortsMixin
+
+try:  # py_trees' own answer when it has one by that name
+    from py_trees.ports import _ports_class_is_abstract
+except ImportError:  # pragma: no cover - another py_trees release
+
+    def _ports_class_is_abstract(cls: type) -> bool:
+        """Whether ``cls`` lacks its port declarations or still has abstract methods."""
+        if not (hasattr(cls, "INPUT_PORTS") and hasattr(cls, "OUTPUT_PORTS")):
+            return True
+        return any(
+            getattr(getattr(cls, name, None), "__isabstractmethod__", False) for name in dir(cls)
+        )
 
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
