@@ -219,5 +219,9 @@ class Attachments:
         """What a robot holds through attach joints."""
         return [a for a in self._by_object.values() if a.robot_name == robot_name]
 
+    def any(self) -> bool:
+        """Whether anything is attached."""
+        return bool(self._by_object)
+
     def all(self) -> list[Attachment]:
         return list(self._by_object.values())

@@ -363,6 +363,14 @@ class World:
     def step(self, n: int = 1) -> None:
         """Advance physics by ``n`` periods of ``dt`` and the sim clock with it."""
         step, client, clock, dt = pb.stepSimulation, self.client, self.clock, self.dt
+        if not self.attachments.any():
+            # nothing attaches while physics steps: with nothing held there are no contacts
+            # to record, and nothing reads the clock between these steps
+            for _ in range(n):
+                step(physicsClientId=client)
+            self.step_count += n
+            clock.t = self.step_count * dt
+            return
         record_contacts = self.attachments.record_contacts
         for _ in range(n):
             step(physicsClientId=client)
