@@ -1,9 +1,22 @@
-"""Where bt-manip keeps files it builds once and reuses (composed URDFs, compiled IK code)."""
+"""What bt-manip keeps to reuse: files it builds once (composed URDFs, compiled IK code) in a
+cache folder, and results a process computes again and again (:class:`Memo`).
+
+A :class:`Memo` maps keys that hold every input of a computation (bytes of the numbers, or a
+file's path, size and modification time) to its result, so a result taken from it is the one
+the computation would give. It is bounded and drops the least recently used entry first.
+What it holds must not be changed by those who read it: frozen dataclasses, tuples, read-only
+arrays.
+"""
 
 from __future__ import annotations
 
 import os
+import threading
+from collections.abc import Hashable
 from pathlib import Path
+from typing import Generic, TypeVar
+
+V = TypeVar("V")
 
 
 def cache_dir(kind: str, override: str) -> Path:
@@ -15,3 +28,38 @@ def cache_dir(kind: str, override: str) -> Path:
     xdg = os.environ.get("XDG_CACHE_HOME")
     root = Path(xdg) if xdg else Path.home() / ".cache"
     return root / "bt-manip" / kind
+
+
+class Memo(Generic[V]):
+    """Results by key, at most ``max_entries`` of them, the least recently used dropped
+    first; safe to use from several threads. ``get`` answers ``None`` for a key not held, so
+    a result that may be ``None`` is stored wrapped (in a tuple, say)."""
+
+    def __init__(self, max_entries: int) -> None:
+        self.max_entries = max_entries
+        self._items: dict[Hashable, V] = {}
+        self._lock = threading.Lock()
+
+    def get(self, key: Hashable) -> V | None:
+        """The result stored under ``key`` (now the most recently used), or None."""
+        with self._lock:
+            value = self._items.pop(key, None)
+            if value is not None:
+                self._items[key] = value
+            return value
+
+    def put(self, key: Hashable, value: V) -> None:
+        """Store ``value`` under ``key``, dropping the oldest entries beyond the bound."""
+        with self._lock:
+            self._items.pop(key, None)
+            while self._items and len(self._items) >= self.max_entries:
+                del self._items[next(iter(self._items))]
+            if self.max_entries > 0:
+                self._items[key] = value
+
+    def clear(self) -> None:
+        with self._lock:
+            self._items.clear()
+
+    def __len__(self) -> int:
+        return len(self._items)

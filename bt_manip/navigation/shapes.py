@@ -21,12 +21,15 @@ link's centre-of-mass frame (``getBasePositionAndOrientation`` / ``getLinkState`
 from __future__ import annotations
 
 import math
+import struct
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 import pybullet as pb
 
+from bt_manip.cache import Memo
 from bt_manip.geometry import Frame, compose, frame_of, inverse
 from bt_manip.sim import pybullet_queries as pbq
 
@@ -72,11 +75,30 @@ Outline = Disc | Polygon
 
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
-    pts = _sorted_unique_rows(np.round(np.asarray(points, dtype=float), 12))
-    if len(pts) <= 2:
-        return pts
-    return _monotone_chain(pts)
+    """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped.
+
+    Hulls of up to :data:`MEMO_HULL_POINTS` points are remembered for the process under the
+    bytes of the points (:data:`HULL_MEMO`); the caller gets its own copy."""
+    given = np.asarray(points, dtype=float)
+    key = None
+    if given.size <= 2 * MEMO_HULL_POINTS:
+        key = struct.pack("<2q", *given.shape) + given.tobytes() if given.ndim == 2 else None
+        if key is not None:
+            known = HULL_MEMO.get(key)
+            if known is not None:
+                return known.copy()
+    pts = _sorted_unique_rows(np.round(given, 12))
+    hull = pts if len(pts) <= 2 else _monotone_chain(pts)
+    if key is not None:
+        HULL_MEMO.put(key, hull.copy())
+    return hull
+
+
+MEMO_HULL_POINTS = 20_000
+"""Hulls of more points than this are computed every time (not remembered)."""
+
+HULL_MEMO: Memo[np.ndarray] = Memo(8192)
+"""The hulls computed in this process, keyed by the bytes of their points."""
 
 
 def _sorted_unique_rows(pts: np.ndarray) -> np.ndarray:
@@ -234,8 +256,15 @@ def body_outlines(
     ``reference`` is the frame (position, rotation) the outlines are expressed in; the world
     frame if ``None``. ``band`` is measured along the reference frame's z axis. ``links``
     restricts the links looked at (all, base included, by default).
+
+    The outline of a shape is a function of its numbers alone (type, size, frame, the link's
+    pose, the reference frame, the band; a mesh's vertices), so outlines are remembered for
+    the process under the bytes of those numbers (:data:`OUTLINE_MEMO`): walls and furniture,
+    and objects at rest, are outlined again in every episode and every height band with the
+    very same numbers. A remembered polygon's vertices are read-only.
     """
     ref_inv = inverse(reference) if reference is not None else (np.zeros(3), np.eye(3))
+    frame_key = ref_inv[0].tobytes() + ref_inv[1].tobytes() + _BAND.pack(*band)
     if links is None:
         links = list(range(-1, pbq.joint_count(client, body)))
     out: list[Outline] = []
@@ -243,31 +272,86 @@ def body_outlines(
         shapes = pbq.collision_shapes(client, body, link)
         if not shapes:
             continue
-        com = compose(ref_inv, link_frame(client, body, link))
+        com_pose = pbq.com_pose(client, body, link)
+        com: Frame | None = None  # computed when an outline is not remembered
         for index, shape in enumerate(shapes):
-            geom, dims = shape.geometry_type, shape.dimensions
-            local = frame_of(shape.local_position, shape.local_orientation)
-            frame = compose(com, local)
-            outline: Outline | None
-            if geom == pb.GEOM_BOX:
-                outline = _points_outline(_box_slice(frame, np.asarray(dims) / 2.0, band))
-            elif geom == pb.GEOM_SPHERE:
-                outline = _sphere_slice(frame[0], float(dims[0]), band)
-            elif geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
-                outline = _round_solid(
-                    frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE, band
-                )
-            elif geom == pb.GEOM_PLANE:
+            geom = shape.geometry_type
+            if geom == pb.GEOM_PLANE:
                 continue
+            verts: np.ndarray | None = None
+            key: bytes | None = None
+            if geom in _PRIMITIVES:
+                key = _shape_key(shape, com_pose) + frame_key
             elif geom == pb.GEOM_MESH:
-                outline = _mesh_outline(client, body, link, index, com, band)
-                if outline is None and not _has_mesh_vertices(client, body, link, index):
-                    outline = _aabb_outline(client, body, link, ref_inv, band)
-            else:
-                outline = _aabb_outline(client, body, link, ref_inv, band)
+                verts = _mesh_vertices(client, body, link, index)
+                if 0 < len(verts) <= MEMO_MESH_VERTICES:
+                    key = _shape_key(shape, com_pose) + frame_key + verts.tobytes()
+            if key is not None:
+                known = OUTLINE_MEMO.get(key)
+                if known is not None:
+                    if known[0] is not None:
+                        out.append(known[0])
+                    continue
+            if com is None:
+                com = compose(ref_inv, frame_of(*com_pose))
+            outline = _shape_outline(client, body, link, index, shape, com, ref_inv, band, verts)
+            if key is not None:
+                if isinstance(outline, Polygon):
+                    outline.vertices.flags.writeable = False
+                OUTLINE_MEMO.put(key, (outline,))
             if outline is not None:
                 out.append(outline)
     return out
+
+
+MEMO_MESH_VERTICES = 20_000
+"""Meshes with more collision vertices than this are outlined every time (not remembered)."""
+
+OUTLINE_MEMO: Memo[tuple[Outline | None]] = Memo(8192)
+"""Outlines of the shapes outlined in this process (``None``: the shape misses the band),
+keyed by the bytes of every number the outline is computed from."""
+
+_PRIMITIVES = (pb.GEOM_BOX, pb.GEOM_SPHERE, pb.GEOM_CYLINDER, pb.GEOM_CAPSULE)
+_BAND = struct.Struct("<2d")
+_SHAPE = struct.Struct("<i17d")
+
+
+def _shape_key(shape: pbq.ShapeData, com_pose: tuple[Sequence[float], Sequence[float]]) -> bytes:
+    """The bytes of a shape's type, size and frame, and of its link's centre-of-mass pose."""
+    return _SHAPE.pack(
+        shape.geometry_type, *shape.dimensions, *shape.local_position, *shape.local_orientation,
+        *com_pose[0], *com_pose[1],
+    )
+
+
+def _shape_outline(
+    client: int,
+    body: int,
+    link: int,
+    index: int,
+    shape: pbq.ShapeData,
+    com: Frame,
+    ref_inv: Frame,
+    band: ZBand,
+    verts: np.ndarray | None,
+) -> Outline | None:
+    """The outline of the ``index``-th collision shape of a link (``com``: the link's
+    centre-of-mass frame in the reference frame; ``verts``: a mesh's vertices, if read)."""
+    geom, dims = shape.geometry_type, shape.dimensions
+    frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
+    if geom == pb.GEOM_BOX:
+        return _points_outline(_box_slice(frame, np.asarray(dims) / 2.0, band))
+    if geom == pb.GEOM_SPHERE:
+        return _sphere_slice(frame[0], float(dims[0]), band)
+    if geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
+        return _round_solid(frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE, band)
+    if geom == pb.GEOM_MESH:
+        if verts is None:
+            verts = _mesh_vertices(client, body, link, index)
+        if len(verts) == 0:  # PyBullet gives no vertices: the link's bounding box
+            return _aabb_outline(client, body, link, ref_inv, band)
+        return _mesh_outline(verts, com, band)
+    return _aabb_outline(client, body, link, ref_inv, band)
 
 
 def _mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
@@ -278,17 +362,8 @@ def _mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
     return np.asarray(verts, dtype=float).reshape(-1, 3) if n else np.zeros((0, 3))
 
 
-def _has_mesh_vertices(client: int, body: int, link: int, index: int) -> bool:
-    return len(_mesh_vertices(client, body, link, index)) > 0
-
-
-def _mesh_outline(
-    client: int, body: int, link: int, index: int, com: Frame, band: ZBand
-) -> Outline | None:
+def _mesh_outline(verts: np.ndarray, com: Frame, band: ZBand) -> Outline | None:
     """Mesh vertices come in the link's centre-of-mass frame, the shape's offset applied."""
-    verts = _mesh_vertices(client, body, link, index)
-    if len(verts) == 0:
-        return None
     pts = com[0] + verts @ com[1].T
     z = pts[:, 2]
     if z.max() < band[0] or z.min() > band[1]:

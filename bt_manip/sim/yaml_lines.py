@@ -9,6 +9,7 @@ that knows the line of each item).
 
 from __future__ import annotations
 
+import copy
 import math
 from collections.abc import Iterator
 from pathlib import Path
@@ -16,6 +17,7 @@ from typing import Any
 
 import yaml
 
+from bt_manip.cache import Memo
 from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import read_bounded
 
@@ -127,10 +129,67 @@ _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _constru
 _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
 
 
+YAML_MEMO_ENTRIES = 32
+YAML_MEMO_BYTES = 4 * 1024 * 1024
+"""Files whose values are remembered for the process (:func:`load_yaml`): at most this many,
+of at most this many bytes each."""
+
+_YAML_MEMO: Memo[tuple[Any]] = Memo(YAML_MEMO_ENTRIES)
+
+
 def load_yaml(path: str | Path) -> Any:
-    """Read a YAML file; syntax errors become an InputError with the file and line."""
+    """Read a YAML file; syntax errors become an InputError with the file and line.
+
+    The file is read every time; the values of a file whose bytes were read before in this
+    process are a copy of those read then (the same bytes give the same values), so a world
+    loaded episode after episode is parsed once. A caller may change what it gets."""
     path = Path(path)
     data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
+    known = _YAML_MEMO.get(data)
+    if known is not None:
+        return copy_values(known[0])
+    values = _parse(path, data)
+    if len(data) <= YAML_MEMO_BYTES // YAML_MEMO_ENTRIES:
+        _YAML_MEMO.put(data, (copy_values(values),))
+    return values
+
+
+def copy_values(value: Any, memo: dict[int, Any] | None = None) -> Any:
+    """A deep copy of values read from YAML: mappings and sequences copied with their lines,
+    a value reached twice (through an alias) copied once and shared as in the original."""
+    if memo is None:
+        memo = {}
+    kind = type(value)
+    if kind in _IMMUTABLE:
+        return value
+    known = memo.get(id(value))
+    if known is not None:
+        return known
+    if kind is LineDict:
+        out = LineDict()
+        memo[id(value)] = out
+        out.line = value.line
+        out.key_lines = dict(value.key_lines)
+        for k, v in value.items():
+            out[k] = copy_values(v, memo)
+        return out
+    if kind is LineList:
+        seq = LineList()
+        memo[id(value)] = seq
+        seq.line = value.line
+        seq.item_lines = list(value.item_lines)
+        seq.extend(copy_values(v, memo) for v in value)
+        return seq
+    other = copy.deepcopy(value)  # other YAML types: sets, dates, byte strings
+    memo[id(value)] = other
+    return other
+
+
+_IMMUTABLE = (str, int, float, bool, type(None))
+
+
+def _parse(path: Path, data: bytes) -> Any:
+    """The values of a YAML document (``data``, read from ``path``)."""
     text = data.decode("utf-8", errors="replace")
     loader = None
     try:
