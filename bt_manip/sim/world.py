@@ -121,6 +121,7 @@ class World:
         self.dt = 1.0 / self.rate_hz
         self.clock = ManualClock()
         self.step_count = 0
+        self.gui = gui
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         self.infos: dict[str, BodyInfo] = {}
         self.robots: dict[str, Any] = {}
@@ -154,9 +155,22 @@ class World:
                 solverResidualThreshold=ph.solver_tolerance**2, physicsClientId=c
             )
         plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
-        ground = pb.createMultiBody(0, plane, -1, [0, 0, 0], physicsClientId=c)
+        ground = pb.createMultiBody(0, plane, self._ground_visual(), [0, 0, 0], physicsClientId=c)
         pb.changeDynamics(ground, -1, lateralFriction=ph.ground_friction, physicsClientId=c)
         self.infos["ground"] = BodyInfo("ground", ground, "ground", None, 0)
+
+    def _ground_visual(self) -> int:
+        """The ground's visual shape: PyBullet's own (a large checkered plane) in its window;
+        headless, a transparent 1 mm box at the origin. Nothing in bt-manip draws the ground
+        from PyBullet's visuals (the viewer and the replay page draw their own floor), and
+        PyBullet takes some 5 ms to make its plane visual for every world built. The ground's
+        collision shape, and so the physics, are the same either way."""
+        if self.gui:
+            return -1  # PyBullet makes its plane visual from the collision shape
+        return int(pb.createVisualShape(
+            pb.GEOM_BOX, halfExtents=[0.0005] * 3, rgbaColor=[0.0, 0.0, 0.0, 0.0],
+            physicsClientId=self.client,
+        ))
 
     def _build(self) -> None:
         problems: list[Problem] = []
