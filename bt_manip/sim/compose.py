@@ -34,6 +34,7 @@ from typing import TYPE_CHECKING, cast
 
 import defusedxml.ElementTree as SafeET
 
+from bt_manip.cache import Memo
 from bt_manip.cache import cache_dir as shared_cache_dir
 from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import line_of_text, read_bounded
@@ -141,15 +142,26 @@ def _compose_recipe(recipe: Recipe) -> Path:
     return target
 
 
+_HAS_MESHES: Memo[tuple[bool]] = Memo(16)
+"""Whether a plain URDF names meshes, by its path and bytes, for the URDFs read in this
+process."""
+
+
 def _resolve_single(path: Path) -> Path:
     path = path.resolve()
-    root = _read_urdf(path)
-    if root.find(".//mesh") is None:
+    data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
+    known = _HAS_MESHES.get((str(path), data))
+    root = None
+    if known is None:  # bytes not read before: parse and check them
+        root = _read_urdf(path)
+        known = (root.find(".//mesh") is not None,)
+        _HAS_MESHES.put((str(path), data), known)
+    if not known[0]:
         return path
     key = _hash_inputs({"version": COMPOSER_VERSION, "file": str(path)}, [path])
     target = cache_dir() / f"{path.stem}-{key}.urdf"
     if not target.is_file():
-        _write_atomic(target, _to_text(root))
+        _write_atomic(target, _to_text(root if root is not None else _read_urdf(path)))
     return target
 
 

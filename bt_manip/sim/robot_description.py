@@ -11,14 +11,18 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from types import MappingProxyType
 
 import defusedxml.ElementTree as SafeET
 
+from bt_manip.cache import Memo
 from bt_manip.errors import InputError
+from bt_manip.input_files import read_bounded
 from bt_manip.sim.assets import data_root
-from bt_manip.sim.compose import Recipe, composed_urdf, parse_recipe
+from bt_manip.sim.compose import MAX_URDF_BYTES, Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
 
 __all__ = [
@@ -471,13 +475,46 @@ def _parse_urdf_source(f: _Fields, data: LineDict, path: Path) -> Path | Recipe:
     return path
 
 
+@dataclass(frozen=True)
+class _UrdfNames:
+    """The link names of a URDF, and per joint name the attributes of its ``<limit>`` (None
+    when it has none)."""
+
+    links: frozenset[str | None]
+    joints: Mapping[str | None, Mapping[str, str] | None]
+
+
+_URDF_NAMES: Memo[_UrdfNames] = Memo(16)
+"""The names read from URDFs in this process, keyed by the URDF's bytes."""
+
+
+def _urdf_names(
+    urdf: Path,
+) -> tuple[frozenset[str | None], Mapping[str | None, Mapping[str, str] | None]]:
+    """The link names of ``urdf`` and its joints' limits (read once per content and process:
+    the file is read every time, parsed again only when its bytes are new)."""
+    data = read_bounded(urdf, MAX_URDF_BYTES, "URDF file")
+    names = _URDF_NAMES.get(data)
+    if names is None:
+        root = SafeET.fromstring(data)
+        joints: dict[str | None, Mapping[str, str] | None] = {}
+        for el in root.findall("joint"):
+            limit = el.find("limit")
+            joints[el.get("name")] = (
+                MappingProxyType(dict(limit.attrib)) if limit is not None else None
+            )
+        names = _UrdfNames(
+            frozenset(el.get("name") for el in root.findall("link")), MappingProxyType(joints)
+        )
+        _URDF_NAMES.put(data, names)
+    return names.links, names.joints
+
+
 def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> RobotDescription:
     """Check every joint and link name of ``desc`` in its URDF; fill the arm's joint limits."""
-    root = SafeET.parse(str(composed_urdf(desc))).getroot()
-    links = {el.get("name") for el in root.findall("link")}
-    joints = {el.get("name"): el for el in root.findall("joint")}
+    links, joints = _urdf_names(composed_urdf(desc))
 
-    def need(names: tuple[str, ...], kind: set | dict, section: str, key: str) -> None:
+    def need(names: tuple[str, ...], kind: Collection[str | None], section: str, key: str) -> None:
         sec = data.get(section) if section else data
         line = sec.line_of(key) if isinstance(sec, LineDict) else None
         for n in names:
@@ -499,7 +536,7 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
         raise InputError(f.problems)
     lower, upper = [], []
     for n in desc.arm.joints:
-        limit = joints[n].find("limit")
+        limit = joints[n]
         lo = float(limit.get("lower", -math.inf)) if limit is not None else -math.inf
         hi = float(limit.get("upper", math.inf)) if limit is not None else math.inf
         lower.append(lo)
