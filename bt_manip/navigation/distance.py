@@ -19,6 +19,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from bt_manip.cache import Memo
+
 
 def squared_distances_dtype(shape: tuple[int, int]) -> type[np.integer]:
     """The integer type :func:`squared_distances` uses for a grid of ``shape``."""
@@ -86,14 +88,34 @@ def _rows(out: np.ndarray) -> None:
 
 def squared_distances(occupied: np.ndarray) -> np.ndarray | None:
     """Squared distance (cells^2) from each cell to the nearest occupied cell, or ``None`` if no
-    cell is occupied. 0 in occupied cells."""
+    cell is occupied. 0 in occupied cells.
+
+    The distances of grids of up to :data:`MEMO_GRID_CELLS` cells are remembered for the
+    process under the grid's shape and occupied cells (the walls and furniture of a world give
+    the same grid in every episode); the caller gets its own copy."""
     occ = np.ascontiguousarray(occupied, dtype=bool)
     if occ.ndim != 2:
         raise ValueError("occupied must be a 2-D array")
     if not occ.any():
         return None
+    key = None
+    if occ.size <= MEMO_GRID_CELLS:
+        key = np.array(occ.shape, np.int64).tobytes() + np.packbits(occ).tobytes()
+        known = _DISTANCE_MEMO.get(key)
+        if known is not None:
+            return known.copy()
     rows, cols = occ.shape
     out = np.empty(occ.shape, squared_distances_dtype(occ.shape))
     _columns(occ, out, rows + cols)
     _rows(out)
+    if key is not None:
+        _DISTANCE_MEMO.put(key, out.copy())
     return out
+
+
+MEMO_GRID_CELLS = 1 << 20
+"""Grids of more cells than this are not remembered."""
+
+_DISTANCE_MEMO: Memo[np.ndarray] = Memo(16)
+"""Squared distances of the grids seen in this process (at most 16 grids of at most
+:data:`MEMO_GRID_CELLS` cells: about 70 MB at most, 5 MB for a house)."""

@@ -156,6 +156,8 @@ _BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz i
 """The eight corners of a box as signs of its half extents; corner ``i`` and ``i ^ bit``
 (bit 1, 2 or 4) share an edge."""
 _BOX_EDGES = [(i, i ^ bit) for i in range(8) for bit in (1, 2, 4) if (i ^ bit) > i]
+_EDGE_A = np.array([i for i, _ in _BOX_EDGES])
+_EDGE_B = np.array([j for _, j in _BOX_EDGES])
 
 
 def _box_slice(frame: Frame, half: np.ndarray, band: ZBand) -> np.ndarray | None:
@@ -192,16 +194,26 @@ def _sphere_slice(centre: np.ndarray, radius: float, band: ZBand) -> Disc | None
     return Disc(float(centre[0]), float(centre[1]), r)
 
 
+def _round_solid_misses(
+    frame: Frame, length: float, radius: float, capsule: bool, band: ZBand
+) -> bool:
+    """Whether a cylinder (or capsule) along the frame's z axis lies wholly below or above
+    the band."""
+    centre = frame[0]
+    az = abs(float(frame[1][2, 2]))
+    half_z = 0.5 * length * az + radius * (1.0 if capsule else math.sqrt(max(1.0 - az * az, 0.0)))
+    return bool(centre[2] + half_z < band[0] or centre[2] - half_z > band[1])
+
+
 def _round_solid(
     frame: Frame, length: float, radius: float, capsule: bool, band: ZBand
 ) -> Outline | None:
     """Cylinder (or capsule) along the frame's z axis."""
+    if _round_solid_misses(frame, length, radius, capsule, band):
+        return None
     axis = frame[1][:, 2]
     centre = frame[0]
     az = abs(float(axis[2]))
-    half_z = 0.5 * length * az + radius * (1.0 if capsule else math.sqrt(max(1.0 - az * az, 0.0)))
-    if centre[2] + half_z < band[0] or centre[2] - half_z > band[1]:
-        return None
     if az > 1.0 - 1e-9:
         return Disc(float(centre[0]), float(centre[1]), radius)
     ends = [centre + axis * (0.5 * length), centre - axis * (0.5 * length)]
@@ -294,14 +306,61 @@ def body_outlines(
                     continue
             if com is None:
                 com = compose(ref_inv, frame_of(*com_pose))
-            outline = _shape_outline(client, body, link, index, shape, com, ref_inv, band, verts)
-            if key is not None:
-                if isinstance(outline, Polygon):
-                    outline.vertices.flags.writeable = False
-                OUTLINE_MEMO.put(key, (outline,))
+            frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
+            wide = _band_free_key(geom, shape.dimensions, frame, band)
+            if wide is not None:
+                known = OUTLINE_MEMO.get(wide)
+                if known is not None:
+                    if key is not None:
+                        OUTLINE_MEMO.put(key, known)
+                    if known[0] is not None:
+                        out.append(known[0])
+                    continue
+            outline = _shape_outline(
+                client, body, link, index, shape, com, frame, ref_inv, band, verts
+            )
+            if isinstance(outline, Polygon) and (key is not None or wide is not None):
+                outline.vertices.flags.writeable = False
+            for k in (key, wide):
+                if k is not None:
+                    OUTLINE_MEMO.put(k, (outline,))
             if outline is not None:
                 out.append(outline)
     return out
+
+
+def _band_free_key(geom: int, dims: Sequence[float], frame: Frame, band: ZBand) -> bytes | None:
+    """A key of a shape's outline that holds the band only as far as the outline depends on
+    it, or None. Bands that differ in the last bits (the height of a robot on another start
+    pose) give the same outlines of walls and furniture, and these keys find them.
+
+    - Box: its corners, which corners lie in the band and which edges cross its planes. When
+      every edge that crosses a plane is upright (its two ends have the same x and the same y,
+      bit for bit), a crossing point is that x and y whatever the plane's height, so these
+      facts give the slice's points exactly; otherwise None.
+    - Cylinder or capsule: its frame and size, and whether it misses the band (the outline
+      does not depend on the band otherwise).
+    """
+    lo, hi = band
+    if geom == pb.GEOM_BOX:
+        corners = frame[0] + (_BOX_SIGNS * (np.asarray(dims) / 2.0)) @ frame[1].T
+        z = corners[:, 2]
+        if z.max() < lo or z.min() > hi:
+            return b"B" + corners.tobytes() + b"miss"
+        za, zb = z[_EDGE_A], z[_EDGE_B]
+        crossing = np.concatenate([(za - lo) * (zb - lo) < 0.0, (za - hi) * (zb - hi) < 0.0])
+        ends = np.concatenate([_EDGE_A, _EDGE_A]), np.concatenate([_EDGE_B, _EDGE_B])
+        a, b = corners[ends[0][crossing], :2], corners[ends[1][crossing], :2]
+        if not np.array_equal(a, b):
+            return None
+        inside = (z >= lo) & (z <= hi)
+        return b"B" + corners.tobytes() + inside.tobytes() + crossing.tobytes()
+    if geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
+        capsule = geom == pb.GEOM_CAPSULE
+        miss = _round_solid_misses(frame, float(dims[0]), float(dims[1]), capsule, band)
+        return (b"K" if capsule else b"C") + frame[0].tobytes() + frame[1].tobytes() + (
+            _BAND.pack(float(dims[0]), float(dims[1])) + (b"miss" if miss else b"in"))
+    return None
 
 
 MEMO_MESH_VERTICES = 20_000
@@ -331,14 +390,15 @@ def _shape_outline(
     index: int,
     shape: pbq.ShapeData,
     com: Frame,
+    frame: Frame,
     ref_inv: Frame,
     band: ZBand,
     verts: np.ndarray | None,
 ) -> Outline | None:
     """The outline of the ``index``-th collision shape of a link (``com``: the link's
-    centre-of-mass frame in the reference frame; ``verts``: a mesh's vertices, if read)."""
+    centre-of-mass frame in the reference frame, ``frame`` the shape's; ``verts``: a mesh's
+    vertices, if read)."""
     geom, dims = shape.geometry_type, shape.dimensions
-    frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
     if geom == pb.GEOM_BOX:
         return _points_outline(_box_slice(frame, np.asarray(dims) / 2.0, band))
     if geom == pb.GEOM_SPHERE:
