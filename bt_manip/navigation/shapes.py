@@ -20,10 +20,11 @@ link's centre-of-mass frame (``getBasePositionAndOrientation`` / ``getLinkState`
 
 from __future__ import annotations
 
+import bisect
 import math
 import struct
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numba
 import numpy as np
@@ -194,15 +195,23 @@ def _sphere_slice(centre: np.ndarray, radius: float, band: ZBand) -> Disc | None
     return Disc(float(centre[0]), float(centre[1]), r)
 
 
+def _round_solid_heights(
+    frame: Frame, length: float, radius: float, capsule: bool
+) -> tuple[float, float]:
+    """The lowest and highest heights of a cylinder (or capsule) along the frame's z axis."""
+    centre = frame[0]
+    az = abs(float(frame[1][2, 2]))
+    half_z = 0.5 * length * az + radius * (1.0 if capsule else math.sqrt(max(1.0 - az * az, 0.0)))
+    return float(centre[2] - half_z), float(centre[2] + half_z)
+
+
 def _round_solid_misses(
     frame: Frame, length: float, radius: float, capsule: bool, band: ZBand
 ) -> bool:
     """Whether a cylinder (or capsule) along the frame's z axis lies wholly below or above
     the band."""
-    centre = frame[0]
-    az = abs(float(frame[1][2, 2]))
-    half_z = 0.5 * length * az + radius * (1.0 if capsule else math.sqrt(max(1.0 - az * az, 0.0)))
-    return bool(centre[2] + half_z < band[0] or centre[2] - half_z > band[1])
+    low, high = _round_solid_heights(frame, length, radius, capsule)
+    return high < band[0] or low > band[1]
 
 
 def _round_solid(
@@ -269,98 +278,171 @@ def body_outlines(
     frame if ``None``. ``band`` is measured along the reference frame's z axis. ``links``
     restricts the links looked at (all, base included, by default).
 
-    The outline of a shape is a function of its numbers alone (type, size, frame, the link's
-    pose, the reference frame, the band; a mesh's vertices), so outlines are remembered for
-    the process under the bytes of those numbers (:data:`OUTLINE_MEMO`): walls and furniture,
-    and objects at rest, are outlined again in every episode and every height band with the
-    very same numbers. A remembered polygon's vertices are read-only.
+    Outlines are functions of numbers alone, so they are remembered for the process (walls,
+    furniture and objects at rest are outlined again in every episode and height band):
+
+    - per shape (:data:`OUTLINE_MEMO`), under the bytes of every number its outline is
+      computed from (type, size, frame, the link's pose, the reference frame, the band; a
+      mesh's vertices);
+    - per body made of boxes, cylinders and capsules (:data:`BODY_MEMO`), under the bytes of
+      its shapes' numbers and the reference frame, and then per *band class*: where the band's
+      two ends fall among the heights at which the outlines can change (see
+      :class:`_BandLevels`). Bands that differ in the last bits (a robot's height on another
+      start pose) fall in the same class and get the very same outlines.
+
+    A remembered polygon's vertices are read-only.
     """
     ref_inv = inverse(reference) if reference is not None else (np.zeros(3), np.eye(3))
-    frame_key = ref_inv[0].tobytes() + ref_inv[1].tobytes() + _BAND.pack(*band)
+    ref_key = ref_inv[0].tobytes() + ref_inv[1].tobytes()
     if links is None:
         links = list(range(-1, pbq.joint_count(client, body)))
-    out: list[Outline] = []
+    items: list[_Item] = []
     for link in links:
         shapes = pbq.collision_shapes(client, body, link)
-        if not shapes:
-            continue
-        com_pose = pbq.com_pose(client, body, link)
-        com: Frame | None = None  # computed when an outline is not remembered
-        for index, shape in enumerate(shapes):
-            geom = shape.geometry_type
-            if geom == pb.GEOM_PLANE:
-                continue
-            verts: np.ndarray | None = None
-            key: bytes | None = None
-            if geom in _PRIMITIVES:
-                key = _shape_key(shape, com_pose) + frame_key
-            elif geom == pb.GEOM_MESH:
-                verts = _mesh_vertices(client, body, link, index)
-                if 0 < len(verts) <= MEMO_MESH_VERTICES:
-                    key = _shape_key(shape, com_pose) + frame_key + verts.tobytes()
-            if key is not None:
-                known = OUTLINE_MEMO.get(key)
-                if known is not None:
-                    if known[0] is not None:
-                        out.append(known[0])
-                    continue
-            if com is None:
-                com = compose(ref_inv, frame_of(*com_pose))
-            frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
-            wide = _band_free_key(geom, shape.dimensions, frame, band)
-            if wide is not None:
-                known = OUTLINE_MEMO.get(wide)
-                if known is not None:
-                    if key is not None:
-                        OUTLINE_MEMO.put(key, known)
-                    if known[0] is not None:
-                        out.append(known[0])
-                    continue
-            outline = _shape_outline(
-                client, body, link, index, shape, com, frame, ref_inv, band, verts
-            )
-            if isinstance(outline, Polygon) and (key is not None or wide is not None):
+        if shapes:
+            com_pose = pbq.com_pose(client, body, link)
+            items += [(link, index, shape, com_pose) for index, shape in enumerate(shapes)]
+    if not all(shape.geometry_type in _BANDED for _, _, shape, _ in items):
+        return _outlines(client, body, items, ref_inv, ref_key, band)
+    key = ref_key + b"".join(_shape_key(shape, com_pose) for _, _, shape, com_pose in items)
+    levels = BODY_MEMO.get(key)
+    if levels is None:
+        levels = _BandLevels.of(items, ref_inv)
+        BODY_MEMO.put(key, levels)
+    cls = levels.band_class(band)
+    if cls is None:
+        return _outlines(client, body, items, ref_inv, ref_key, band)
+    known = levels.outlines.get(cls)
+    if known is None:
+        known = tuple(_outlines(client, body, items, ref_inv, ref_key, band))
+        for outline in known:
+            if isinstance(outline, Polygon):
                 outline.vertices.flags.writeable = False
-            for k in (key, wide):
-                if k is not None:
-                    OUTLINE_MEMO.put(k, (outline,))
-            if outline is not None:
-                out.append(outline)
+        if len(levels.outlines) < _BandLevels.MAX_CLASSES:
+            levels.outlines[cls] = known
+    return list(known)
+
+
+_Item = tuple[int, int, pbq.ShapeData, tuple[Sequence[float], Sequence[float]]]
+"""A collision shape to outline: its link, its index in the link, its data, the link's
+centre-of-mass pose."""
+
+
+def _outlines(
+    client: int, body: int, items: list[_Item], ref_inv: Frame, ref_key: bytes, band: ZBand
+) -> list[Outline]:
+    """The outlines of ``items`` (the collision shapes of ``body``), shape by shape, those
+    outlined before with the same numbers taken from :data:`OUTLINE_MEMO`."""
+    frame_key = ref_key + _BAND.pack(*band)
+    out: list[Outline] = []
+    coms: dict[int, Frame] = {}  # per link, computed when an outline is not remembered
+    for link, index, shape, com_pose in items:
+        geom = shape.geometry_type
+        if geom == pb.GEOM_PLANE:
+            continue
+        verts: np.ndarray | None = None
+        key: bytes | None = None
+        if geom in _PRIMITIVES:
+            key = _shape_key(shape, com_pose) + frame_key
+        elif geom == pb.GEOM_MESH:
+            verts = _mesh_vertices(client, body, link, index)
+            if 0 < len(verts) <= MEMO_MESH_VERTICES:
+                key = _shape_key(shape, com_pose) + frame_key + verts.tobytes()
+        if key is not None:
+            known = OUTLINE_MEMO.get(key)
+            if known is not None:
+                if known[0] is not None:
+                    out.append(known[0])
+                continue
+        com = coms.get(link)
+        if com is None:
+            com = coms[link] = compose(ref_inv, frame_of(*com_pose))
+        frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
+        outline = _shape_outline(client, body, link, index, shape, com, frame, ref_inv, band, verts)
+        if key is not None:
+            if isinstance(outline, Polygon):
+                outline.vertices.flags.writeable = False
+            OUTLINE_MEMO.put(key, (outline,))
+        if outline is not None:
+            out.append(outline)
     return out
 
 
-def _band_free_key(geom: int, dims: Sequence[float], frame: Frame, band: ZBand) -> bytes | None:
-    """A key of a shape's outline that holds the band only as far as the outline depends on
-    it, or None. Bands that differ in the last bits (the height of a robot on another start
-    pose) give the same outlines of walls and furniture, and these keys find them.
+@dataclass
+class _BandLevels:
+    """The heights (in the reference frame) at which the outlines of a body of boxes,
+    cylinders and capsules can change with the band, and the outlines per band class.
 
-    - Box: its corners, which corners lie in the band and which edges cross its planes. When
-      every edge that crosses a plane is upright (its two ends have the same x and the same y,
-      bit for bit), a crossing point is that x and y whatever the plane's height, so these
-      facts give the slice's points exactly; otherwise None.
-    - Cylinder or capsule: its frame and size, and whether it misses the band (the outline
-      does not depend on the band otherwise).
+    - A box is sliced by comparing each corner's height with the band's ends (corners in the
+      band) and each edge's ends with the band's planes (edges crossing a plane). When every
+      edge that is not level is upright (its ends have the same x and y, bit for bit), the
+      point where it crosses a plane is that x and y whatever the plane's height: the slice
+      then depends on the band only through those comparisons, with the corners' heights.
+    - A cylinder or capsule is outlined whole unless it lies wholly below or above the band:
+      two comparisons, with its lowest and highest heights.
+
+    The class of a band is where each of its ends falls among these heights (below, on,
+    above each), so two bands of one class give the same outlines. ``levels`` is empty for a
+    body that does not qualify (a tilted box): then there are no classes.
     """
-    lo, hi = band
-    if geom == pb.GEOM_BOX:
-        corners = frame[0] + (_BOX_SIGNS * (np.asarray(dims) / 2.0)) @ frame[1].T
-        z = corners[:, 2]
-        if z.max() < lo or z.min() > hi:
-            return b"B" + corners.tobytes() + b"miss"
-        za, zb = z[_EDGE_A], z[_EDGE_B]
-        crossing = np.concatenate([(za - lo) * (zb - lo) < 0.0, (za - hi) * (zb - hi) < 0.0])
-        ends = np.concatenate([_EDGE_A, _EDGE_A]), np.concatenate([_EDGE_B, _EDGE_B])
-        a, b = corners[ends[0][crossing], :2], corners[ends[1][crossing], :2]
-        if not np.array_equal(a, b):
+
+    levels: list[float]
+    outlines: dict[tuple[int, int, int, int], tuple[Outline, ...]] = field(default_factory=dict)
+
+    MAX_CLASSES = 64
+    """Band classes remembered per body at most."""
+
+    @classmethod
+    def of(cls, items: list[_Item], ref_inv: Frame) -> _BandLevels:
+        levels: list[float] = []
+        for _, _, shape, com_pose in items:
+            geom, dims = shape.geometry_type, shape.dimensions
+            if geom == pb.GEOM_PLANE:
+                continue
+            com = compose(ref_inv, frame_of(*com_pose))
+            frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
+            if geom == pb.GEOM_BOX:
+                corners = frame[0] + (_BOX_SIGNS * (np.asarray(dims) / 2.0)) @ frame[1].T
+                a, b = corners[_EDGE_A], corners[_EDGE_B]
+                sloped = a[:, 2] != b[:, 2]
+                if not np.array_equal(a[sloped, :2], b[sloped, :2]):
+                    return cls([])  # a tilted box: its slice moves with the band
+                levels += corners[:, 2].tolist()
+            else:  # cylinder or capsule
+                low, high = _round_solid_heights(
+                    frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE
+                )
+                levels += [low, high]
+        if not all(math.isfinite(v) for v in levels):
+            return cls([])
+        return cls(sorted(set(levels)) or [0.0])
+
+    def band_class(self, band: ZBand) -> tuple[int, int, int, int] | None:
+        """Where the band's ends fall among the levels; None when the body has no classes, or
+        when an end is so close to a level (below 1e-150 m) that a product of two differences
+        could round to zero."""
+        if not self.levels:
             return None
-        inside = (z >= lo) & (z <= hi)
-        return b"B" + corners.tobytes() + inside.tobytes() + crossing.tobytes()
-    if geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
-        capsule = geom == pb.GEOM_CAPSULE
-        miss = _round_solid_misses(frame, float(dims[0]), float(dims[1]), capsule, band)
-        return (b"K" if capsule else b"C") + frame[0].tobytes() + frame[1].tobytes() + (
-            _BAND.pack(float(dims[0]), float(dims[1])) + (b"miss" if miss else b"in"))
-    return None
+        lo, hi = float(band[0]), float(band[1])
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            return None
+        levels = self.levels
+        ends = []
+        for end in (lo, hi):
+            first, last = bisect.bisect_left(levels, end), bisect.bisect_right(levels, end)
+            for i in (first - 1, last):
+                if 0 <= i < len(levels) and 0.0 < abs(levels[i] - end) < 1e-150:
+                    return None
+            ends += [first, last]
+        return ends[0], ends[1], ends[2], ends[3]
+
+
+BODY_MEMO: Memo[_BandLevels] = Memo(4096)
+"""Per body (the bytes of its shapes' numbers and of the reference frame), the heights at
+which its outlines change and its outlines per band class."""
+
+_BANDED = (pb.GEOM_BOX, pb.GEOM_CYLINDER, pb.GEOM_CAPSULE, pb.GEOM_PLANE)
+"""The shapes whose outlines :class:`_BandLevels` follows."""
 
 
 MEMO_MESH_VERTICES = 20_000

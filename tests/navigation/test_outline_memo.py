@@ -27,6 +27,7 @@ def _numbers(outlines: list[Outline]) -> list[bytes]:
 def _fresh(*args: object, **kwargs: object) -> list[bytes]:
     shapes.OUTLINE_MEMO.clear()
     shapes.HULL_MEMO.clear()
+    shapes.BODY_MEMO.clear()
     return _numbers(body_outlines(*args, **kwargs))  # type: ignore[arg-type]
 
 
@@ -35,6 +36,7 @@ def memos(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Memories of this test only (the process's own are left as they are)."""
     monkeypatch.setattr(shapes, "OUTLINE_MEMO", Memo(8192))
     monkeypatch.setattr(shapes, "HULL_MEMO", Memo(8192))
+    monkeypatch.setattr(shapes, "BODY_MEMO", Memo(4096))
     yield
 
 
@@ -61,6 +63,43 @@ def test_remembered_outlines_equal_fresh_ones_across_worlds_bands_and_frames(mem
             assert first_arm == _fresh(c, robot.body, bands[0], links=arm)
             outlined += sum(len(o) for o in fresh)
     assert outlined > 100  # walls, furniture, panel and robot all outlined
+
+
+def test_bands_ending_on_at_and_around_the_heights_of_shapes_give_fresh_outlines(
+    memos: None,
+) -> None:
+    """Upright and tilted boxes, upright and tilted cylinders and capsules, a compound of
+    them: bands whose ends lie on the shapes' corner and end heights, a hair's breadth below
+    or above them, or between them, outlined in one process equal each outline made fresh."""
+    c = pb.connect(pb.DIRECT)
+    try:
+        bodies = []
+        for yaw, tilt in ((0.0, 0.0), (0.7, 0.0), (np.pi / 2, 0.0), (0.3, 0.4)):
+            quat = pb.getQuaternionFromEuler((tilt, 0.0, yaw))
+            col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.4, 0.1, 0.35),
+                                          physicsClientId=c)
+            bodies.append(pb.createMultiBody(0, col, -1, (1.0, 0.5, 0.35), quat,
+                                             physicsClientId=c))
+            for geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
+                col = pb.createCollisionShape(geom, radius=0.2, height=0.6, physicsClientId=c)
+                bodies.append(pb.createMultiBody(0, col, -1, (-1.0, 0.3, 0.5), quat,
+                                                 physicsClientId=c))
+        col = pb.createCollisionShapeArray(
+            [pb.GEOM_BOX, pb.GEOM_CYLINDER], halfExtents=[[0.5, 0.5, 0.02], [0, 0, 0]],
+            radii=[0, 0.04], lengths=[0, 0.7],
+            collisionFramePositions=[[0, 0, 0.72], [0, 0, 0.35]], physicsClientId=c)
+        bodies.append(pb.createMultiBody(0, col, -1, (3.0, 0.0, 0.0), physicsClientId=c))
+        heights = [0.0, 0.02, 0.2, 0.35, 0.5, 0.7, 0.74, 0.8]
+        ends = sorted({h + d for h in heights
+                       for d in (0.0, 1e-12, -1e-12, 1e-17, -1e-17, 0.013)})
+        ends.append(float(np.nextafter(0.7, 1.0)))
+        bands = [(lo, hi) for lo in ends[::3] for hi in ends if hi > lo]
+        got = [_numbers(body_outlines(c, b, band)) for band in bands for b in bodies]
+        want = [_fresh(c, b, band) for band in bands for b in bodies]
+        assert got == want
+        assert len(shapes.BODY_MEMO) > 0
+    finally:
+        pb.disconnect(c)
 
 
 def test_remembered_polygons_are_read_only_and_hulls_are_copies(memos: None) -> None:
