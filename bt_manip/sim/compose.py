@@ -142,21 +142,32 @@ def _compose_recipe(recipe: Recipe) -> Path:
     return target
 
 
-_HAS_MESHES: Memo[tuple[bool]] = Memo(16)
-"""Whether a plain URDF names meshes, by its path and bytes, for the URDFs read in this
-process."""
+_MESHES_SEEN: Memo[tuple[tuple[str, tuple[int, int, int] | None], ...]] = Memo(16)
+"""For the plain URDFs read in this process, by path and bytes: the meshes they name (resolved)
+with the size, modification time and inode each had when checked."""
+
+
+def _file_stamp(path: str) -> tuple[int, int, int] | None:
+    """A file's size, modification time (ns) and inode; None if it cannot be read."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_size, st.st_mtime_ns, st.st_ino
 
 
 def _resolve_single(path: Path) -> Path:
     path = path.resolve()
     data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
-    known = _HAS_MESHES.get((str(path), data))
+    seen = _MESHES_SEEN.get((str(path), data))
     root = None
-    if known is None:  # bytes not read before: parse and check them
+    if seen is None or any(_file_stamp(mesh) != stamp for mesh, stamp in seen):
+        # bytes not read before, or a mesh changed since: parse them and check the meshes
         root = _read_urdf(path)
-        known = (root.find(".//mesh") is not None,)
-        _HAS_MESHES.put((str(path), data), known)
-    if not known[0]:
+        meshes = dict.fromkeys(el.get("filename", "") for el in root.iter("mesh"))
+        seen = tuple((mesh, _file_stamp(mesh)) for mesh in meshes)
+        _MESHES_SEEN.put((str(path), data), seen)
+    if not seen:
         return path
     key = _hash_inputs({"version": COMPOSER_VERSION, "file": str(path)}, [path])
     target = cache_dir() / f"{path.stem}-{key}.urdf"
