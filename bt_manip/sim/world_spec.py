@@ -22,16 +22,19 @@ Every problem found is collected with its file and line; :func:`parse_world` rai
 
 from __future__ import annotations
 
+import copy
 import itertools
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
+from bt_manip.cache import Memo
 from bt_manip.errors import InputError
 from bt_manip.geometry import quat_from_euler, quat_from_yaw
+from bt_manip.input_files import read_bounded
 from bt_manip.sim.robot_description import find_descriptor, known_robots
-from bt_manip.sim.yaml_lines import FieldReader, LineDict, LineList, load_yaml
+from bt_manip.sim.yaml_lines import MAX_YAML_BYTES, FieldReader, LineDict, LineList, yaml_values
 
 COLOURS: dict[str, tuple[float, float, float, float]] = {
     "white": (0.95, 0.95, 0.95, 1.0),
@@ -66,6 +69,9 @@ class Pose3D:
     xyz: tuple[float, float, float]
     quat: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
 
+    def __deepcopy__(self, memo: dict[int, Any]) -> Pose3D:
+        return self  # frozen, of numbers and text only: a copy would be the same value
+
 
 @dataclass(frozen=True)
 class Range2D:
@@ -78,6 +84,9 @@ class Range2D:
     def is_zero(self) -> bool:
         return self.x == (0.0, 0.0) and self.y == (0.0, 0.0) and self.yaw == (0.0, 0.0)
 
+    def __deepcopy__(self, memo: dict[int, Any]) -> Range2D:
+        return self  # frozen, of numbers and text only: a copy would be the same value
+
 
 @dataclass(frozen=True)
 class Part:
@@ -88,6 +97,9 @@ class Part:
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
     colour: tuple[float, float, float, float] | None = None
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> Part:
+        return self  # frozen, of numbers and text only: a copy would be the same value
 
     def bottom(self) -> float:
         """Lowest z of the part in its body frame (rotation about z only is exact)."""
@@ -144,6 +156,9 @@ class BatterySpec:
     percentage: float = 1.0
     voltage: float = 12.0
     drain: float = 0.0
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> BatterySpec:
+        return self  # frozen, of numbers and text only: a copy would be the same value
 
     def percentage_at(self, t: float) -> float:
         """The charge left after ``t`` seconds of sim time (never below 0)."""
@@ -581,10 +596,44 @@ SOLVER_TOLERANCE = (0.0, 1.0)
 """Solver iterations per physics step accepted."""
 
 
+@dataclass(frozen=True)
+class _KnownWorld:
+    """A world file's spec as parsed, and where its robots' descriptors were found."""
+
+    spec: WorldSpec
+    descriptors: tuple[tuple[str, Path], ...]
+
+
+_WORLD_MEMO: Memo[_KnownWorld] = Memo(16)
+
+
 def parse_world(path: str | Path) -> WorldSpec:
-    """Read and check a world file; raise InputError listing every problem found."""
+    """Read and check a world file; raise InputError listing every problem found.
+
+    The file is read every time. A world file read before in this process, with the same
+    bytes, named by the same path, whose robots' descriptors are found at the same files and
+    that names no URDF (whose files and meshes would need checking again), is not parsed
+    again: the caller gets a copy of the spec parsed then, which is what parsing would give.
+    """
     path = Path(path)
-    data = load_yaml(path)
+    data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
+    base = path.resolve().parent
+    key = (str(path), str(base), data)
+    known = _WORLD_MEMO.get(key)
+    if known is not None and all(
+        find_descriptor(name, base) == found for name, found in known.descriptors
+    ):
+        return copy.deepcopy(known.spec)
+    spec = _parse_world(path, data)
+    if all(b.urdf is None for b in spec.furniture + spec.objects + spec.models):
+        found = tuple((r.description, r.description_path) for r in spec.robots)
+        _WORLD_MEMO.put(key, _KnownWorld(copy.deepcopy(spec), found))
+    return spec
+
+
+def _parse_world(path: Path, raw: bytes) -> WorldSpec:
+    """The checked spec of the world file ``path`` whose bytes are ``raw``."""
+    data = yaml_values(path, raw)
     rd = _Reader(path)
     if not isinstance(data, LineDict):
         raise InputError.single(

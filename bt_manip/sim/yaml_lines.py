@@ -144,7 +144,11 @@ def load_yaml(path: str | Path) -> Any:
     process are a copy of those read then (the same bytes give the same values), so a world
     loaded episode after episode is parsed once. A caller may change what it gets."""
     path = Path(path)
-    data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
+    return yaml_values(path, read_bounded(path, MAX_YAML_BYTES, "YAML file"))
+
+
+def yaml_values(path: Path, data: bytes) -> Any:
+    """The values of ``data``, the bytes of the YAML file ``path`` (as :func:`load_yaml`)."""
     known = _YAML_MEMO.get(data)
     if known is not None:
         return copy_values(known[0])
