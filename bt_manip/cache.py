@@ -1,15 +1,17 @@
 """What bt-manip keeps to reuse: files it builds once (composed URDFs, compiled IK code) in a
 cache folder, and results a process computes again and again (:class:`Memo`).
 
-A :class:`Memo` maps keys that hold every input of a computation (bytes of the numbers, or a
-file's path, size and modification time) to its result, so a result taken from it is the one
-the computation would give. It is bounded and drops the least recently used entry first.
+A :class:`Memo` maps keys that hold every input of a computation (the bytes of its numbers or
+of a file, long ones as their digest, see :func:`bytes_key`; a file's size, modification time
+and inode where the file itself is not read) to its result, so a result taken from it is the
+one the computation would give. It is bounded and drops the least recently used entry first.
 What it holds must not be changed by those who read it: frozen dataclasses, tuples, read-only
-arrays.
+arrays, or copies handed out.
 """
 
 from __future__ import annotations
 
+import hashlib
 import os
 import threading
 from collections.abc import Hashable
@@ -28,6 +30,19 @@ def cache_dir(kind: str, override: str) -> Path:
     xdg = os.environ.get("XDG_CACHE_HOME")
     root = Path(xdg) if xdg else Path.home() / ".cache"
     return root / "bt-manip" / kind
+
+
+SHORT_KEY_BYTES = 256
+"""Keys up to this long are kept as they are; longer ones as their digest."""
+
+
+def bytes_key(data: bytes) -> bytes:
+    """A memo key for ``data``: ``data`` itself when short, else its 256-bit BLAKE2b digest
+    (so that a key stays small however large what it stands for; two different inputs with
+    one digest are not expected ever to be met). The two kinds never equal each other."""
+    if len(data) <= SHORT_KEY_BYTES:
+        return b"=" + data
+    return b"#" + hashlib.blake2b(data, digest_size=32).digest()
 
 
 class Memo(Generic[V]):

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 
 
 def squared_distances_dtype(shape: tuple[int, int]) -> type[np.integer]:
@@ -100,7 +100,7 @@ def squared_distances(occupied: np.ndarray) -> np.ndarray | None:
         return None
     key = None
     if occ.size <= MEMO_GRID_CELLS:
-        key = np.array(occ.shape, np.int64).tobytes() + np.packbits(occ).tobytes()
+        key = bytes_key(np.array(occ.shape, np.int64).tobytes() + np.packbits(occ).tobytes())
         known = _DISTANCE_MEMO.get(key)
         if known is not None:
             return known.copy()

@@ -21,6 +21,7 @@ link's centre-of-mass frame (``getBasePositionAndOrientation`` / ``getLinkState`
 from __future__ import annotations
 
 import bisect
+import itertools
 import math
 import struct
 from collections.abc import Sequence
@@ -30,7 +31,7 @@ import numba
 import numpy as np
 import pybullet as pb
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.geometry import Frame, compose, frame_of, inverse
 from bt_manip.sim import pybullet_queries as pbq
 
@@ -82,12 +83,11 @@ def convex_hull(points: np.ndarray) -> np.ndarray:
     bytes of the points (:data:`HULL_MEMO`); the caller gets its own copy."""
     given = np.asarray(points, dtype=float)
     key = None
-    if given.size <= 2 * MEMO_HULL_POINTS:
-        key = struct.pack("<2q", *given.shape) + given.tobytes() if given.ndim == 2 else None
-        if key is not None:
-            known = HULL_MEMO.get(key)
-            if known is not None:
-                return known.copy()
+    if given.ndim == 2 and given.size <= 2 * MEMO_HULL_POINTS:
+        key = bytes_key(struct.pack("<2q", *given.shape) + given.tobytes())
+        known = HULL_MEMO.get(key)
+        if known is not None:
+            return known.copy()
     pts = _sorted_unique_rows(np.round(given, 12))
     hull = pts if len(pts) <= 2 else _monotone_chain(pts)
     if key is not None:
@@ -99,7 +99,8 @@ MEMO_HULL_POINTS = 20_000
 """Hulls of more points than this are computed every time (not remembered)."""
 
 HULL_MEMO: Memo[np.ndarray] = Memo(8192)
-"""The hulls computed in this process, keyed by the bytes of their points."""
+"""The hulls computed in this process, keyed by the bytes of their points (see
+:func:`~bt_manip.cache.bytes_key`)."""
 
 
 def _sorted_unique_rows(pts: np.ndarray) -> np.ndarray:
@@ -347,7 +348,7 @@ def _outlines(
         elif geom == pb.GEOM_MESH:
             verts = _mesh_vertices(client, body, link, index)
             if 0 < len(verts) <= MEMO_MESH_VERTICES:
-                key = _shape_key(shape, com_pose) + frame_key + verts.tobytes()
+                key = _shape_key(shape, com_pose) + frame_key + bytes_key(verts.tobytes())
         if key is not None:
             known = OUTLINE_MEMO.get(key)
             if known is not None:
@@ -501,7 +502,12 @@ def _mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
         n, verts = pb.getMeshData(body, link, collisionShapeIndex=index, physicsClientId=client)
     except pb.error:
         return np.zeros((0, 3))
-    return np.asarray(verts, dtype=float).reshape(-1, 3) if n else np.zeros((0, 3))
+    if not n:
+        return np.zeros((0, 3))
+    # the (x, y, z) tuples' floats read in order: numpy's conversion of the nested tuples,
+    # without looking at each tuple as a sequence first
+    flat = np.fromiter(itertools.chain.from_iterable(verts), dtype=float, count=3 * len(verts))
+    return flat.reshape(-1, 3)
 
 
 def _mesh_outline(verts: np.ndarray, com: Frame, band: ZBand) -> Outline | None:

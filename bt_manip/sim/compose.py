@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, cast
 
 import defusedxml.ElementTree as SafeET
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.cache import cache_dir as shared_cache_dir
 from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import line_of_text, read_bounded
@@ -159,14 +159,15 @@ def _file_stamp(path: str) -> tuple[int, int, int] | None:
 def _resolve_single(path: Path) -> Path:
     path = path.resolve()
     data = read_bounded(path, MAX_URDF_BYTES, "URDF file")
-    seen = _MESHES_SEEN.get((str(path), data))
+    seen_key = (str(path), bytes_key(data))
+    seen = _MESHES_SEEN.get(seen_key)
     root = None
     if seen is None or any(_file_stamp(mesh) != stamp for mesh, stamp in seen):
         # bytes not read before, or a mesh changed since: parse them and check the meshes
         root = _read_urdf(path)
         meshes = dict.fromkeys(el.get("filename", "") for el in root.iter("mesh"))
         seen = tuple((mesh, _file_stamp(mesh)) for mesh in meshes)
-        _MESHES_SEEN.put((str(path), data), seen)
+        _MESHES_SEEN.put(seen_key, seen)
     if not seen:
         return path
     key = _hash_inputs({"version": COMPOSER_VERSION, "file": str(path)}, [path])

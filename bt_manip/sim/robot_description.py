@@ -18,7 +18,7 @@ from types import MappingProxyType
 
 import defusedxml.ElementTree as SafeET
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError
 from bt_manip.input_files import read_bounded
 from bt_manip.sim.assets import data_root
@@ -494,7 +494,8 @@ def _urdf_names(
     """The link names of ``urdf`` and its joints' limits (read once per content and process:
     the file is read every time, parsed again only when its bytes are new)."""
     data = read_bounded(urdf, MAX_URDF_BYTES, "URDF file")
-    names = _URDF_NAMES.get(data)
+    key = bytes_key(data)
+    names = _URDF_NAMES.get(key)
     if names is None:
         root = SafeET.fromstring(data)
         joints: dict[str | None, Mapping[str, str] | None] = {}
@@ -506,7 +507,7 @@ def _urdf_names(
         names = _UrdfNames(
             frozenset(el.get("name") for el in root.findall("link")), MappingProxyType(joints)
         )
-        _URDF_NAMES.put(data, names)
+        _URDF_NAMES.put(key, names)
     return names.links, names.joints
 
 

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError
 from bt_manip.geometry import quat_from_euler, quat_from_yaw
 from bt_manip.input_files import read_bounded
@@ -618,7 +618,7 @@ def parse_world(path: str | Path) -> WorldSpec:
     path = Path(path)
     data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
     base = path.resolve().parent
-    key = (str(path), str(base), data)
+    key = (str(path), str(base), bytes_key(data))
     known = _WORLD_MEMO.get(key)
     if known is not None and all(
         find_descriptor(name, base) == found for name, found in known.descriptors

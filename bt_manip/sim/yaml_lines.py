@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import read_bounded
 
@@ -149,12 +149,13 @@ def load_yaml(path: str | Path) -> Any:
 
 def yaml_values(path: Path, data: bytes) -> Any:
     """The values of ``data``, the bytes of the YAML file ``path`` (as :func:`load_yaml`)."""
-    known = _YAML_MEMO.get(data)
+    key = bytes_key(data)
+    known = _YAML_MEMO.get(key)
     if known is not None:
         return copy_values(known[0])
     values = _parse(path, data)
     if len(data) <= YAML_MEMO_BYTES // YAML_MEMO_ENTRIES:
-        _YAML_MEMO.put(data, (copy_values(values),))
+        _YAML_MEMO.put(key, (copy_values(values),))
     return values
 
 

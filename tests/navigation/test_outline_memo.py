@@ -11,7 +11,7 @@ import numpy as np
 import pybullet as pb
 import pytest
 
-from bt_manip.cache import Memo
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.navigation import shapes
 from bt_manip.navigation.shapes import Disc, Outline, Polygon, body_outlines, convex_hull
 from bt_manip.sim.world import World
@@ -130,3 +130,12 @@ def test_memories_are_bounded() -> None:
     memo.get(15)  # used last: kept when the next is added
     memo.put(20, 20)
     assert memo.get(15) == 15 and memo.get(16) is None
+
+
+def test_long_keys_are_digests_and_short_ones_stay_apart_from_them() -> None:
+    long_a, long_b = b"x" * 1000, b"x" * 999 + b"y"
+    assert bytes_key(long_a) == bytes_key(b"x" * 1000) != bytes_key(long_b)
+    assert len(bytes_key(long_a)) == 33
+    digest = bytes_key(long_a)
+    assert bytes_key(digest[1:]) != digest and bytes_key(digest) != digest  # kinds never meet
+    assert bytes_key(b"") != bytes_key(b"\x00")
