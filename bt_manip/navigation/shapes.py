@@ -31,7 +31,7 @@ import numba
 import numpy as np
 import pybullet as pb
 
-from bt_manip.cache import Memo, bytes_key
+from bt_manip.cache import Memo
 from bt_manip.geometry import Frame, compose, frame_of, inverse
 from bt_manip.sim import pybullet_queries as pbq
 
@@ -77,30 +77,11 @@ Outline = Disc | Polygon
 
 
 def convex_hull(points: np.ndarray) -> np.ndarray:
-    """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped.
-
-    Hulls of up to :data:`MEMO_HULL_POINTS` points are remembered for the process under the
-    bytes of the points (:data:`HULL_MEMO`); the caller gets its own copy."""
-    given = np.asarray(points, dtype=float)
-    key = None
-    if given.ndim == 2 and given.size <= 2 * MEMO_HULL_POINTS:
-        key = bytes_key(struct.pack("<2q", *given.shape) + given.tobytes())
-        known = HULL_MEMO.get(key)
-        if known is not None:
-            return known.copy()
-    pts = _sorted_unique_rows(np.round(given, 12))
-    hull = pts if len(pts) <= 2 else _monotone_chain(pts)
-    if key is not None:
-        HULL_MEMO.put(key, hull.copy())
-    return hull
-
-
-MEMO_HULL_POINTS = 20_000
-"""Hulls of more points than this are computed every time (not remembered)."""
-
-HULL_MEMO: Memo[np.ndarray] = Memo(8192)
-"""The hulls computed in this process, keyed by the bytes of their points (see
-:func:`~bt_manip.cache.bytes_key`)."""
+    """Counter-clockwise convex hull of 2-D points (monotone chain); collinear points dropped."""
+    pts = _sorted_unique_rows(np.round(np.asarray(points, dtype=float), 12))
+    if len(pts) <= 2:
+        return pts
+    return _monotone_chain(pts)
 
 
 def _sorted_unique_rows(pts: np.ndarray) -> np.ndarray:
@@ -282,9 +263,9 @@ def body_outlines(
     Outlines are functions of numbers alone, so they are remembered for the process (walls,
     furniture and objects at rest are outlined again in every episode and height band):
 
-    - per shape (:data:`OUTLINE_MEMO`), under the bytes of every number its outline is
-      computed from (type, size, frame, the link's pose, the reference frame, the band; a
-      mesh's vertices);
+    - per primitive shape (:data:`OUTLINE_MEMO`), under the bytes of every number its outline
+      is computed from (type, size, frame, the link's pose, the reference frame, the band);
+      meshes, mostly the links of a moving robot, are outlined every time;
     - per body made of boxes, cylinders and capsules (:data:`BODY_MEMO`), under the bytes of
       its shapes' numbers and the reference frame, and then per *band class*: where the band's
       two ends fall among the heights at which the outlines can change (see
@@ -341,14 +322,9 @@ def _outlines(
         geom = shape.geometry_type
         if geom == pb.GEOM_PLANE:
             continue
-        verts: np.ndarray | None = None
         key: bytes | None = None
-        if geom in _PRIMITIVES:
+        if geom in _PRIMITIVES:  # meshes: mostly a robot's links, never twice in one place
             key = _shape_key(shape, com_pose) + frame_key
-        elif geom == pb.GEOM_MESH:
-            verts = _mesh_vertices(client, body, link, index)
-            if 0 < len(verts) <= MEMO_MESH_VERTICES:
-                key = _shape_key(shape, com_pose) + frame_key + bytes_key(verts.tobytes())
         if key is not None:
             known = OUTLINE_MEMO.get(key)
             if known is not None:
@@ -359,7 +335,7 @@ def _outlines(
         if com is None:
             com = coms[link] = compose(ref_inv, frame_of(*com_pose))
         frame = compose(com, frame_of(shape.local_position, shape.local_orientation))
-        outline = _shape_outline(client, body, link, index, shape, com, frame, ref_inv, band, verts)
+        outline = _shape_outline(client, body, link, index, shape, com, frame, ref_inv, band)
         if key is not None:
             if isinstance(outline, Polygon):
                 outline.vertices.flags.writeable = False
@@ -446,9 +422,6 @@ _BANDED = (pb.GEOM_BOX, pb.GEOM_CYLINDER, pb.GEOM_CAPSULE, pb.GEOM_PLANE)
 """The shapes whose outlines :class:`_BandLevels` follows."""
 
 
-MEMO_MESH_VERTICES = 20_000
-"""Meshes with more collision vertices than this are outlined every time (not remembered)."""
-
 OUTLINE_MEMO: Memo[tuple[Outline | None]] = Memo(8192)
 """Outlines of the shapes outlined in this process (``None``: the shape misses the band),
 keyed by the bytes of every number the outline is computed from."""
@@ -476,11 +449,9 @@ def _shape_outline(
     frame: Frame,
     ref_inv: Frame,
     band: ZBand,
-    verts: np.ndarray | None,
 ) -> Outline | None:
     """The outline of the ``index``-th collision shape of a link (``com``: the link's
-    centre-of-mass frame in the reference frame, ``frame`` the shape's; ``verts``: a mesh's
-    vertices, if read)."""
+    centre-of-mass frame in the reference frame, ``frame`` the shape's)."""
     geom, dims = shape.geometry_type, shape.dimensions
     if geom == pb.GEOM_BOX:
         return _points_outline(_box_slice(frame, np.asarray(dims) / 2.0, band))
@@ -489,8 +460,7 @@ def _shape_outline(
     if geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
         return _round_solid(frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE, band)
     if geom == pb.GEOM_MESH:
-        if verts is None:
-            verts = _mesh_vertices(client, body, link, index)
+        verts = _mesh_vertices(client, body, link, index)
         if len(verts) == 0:  # PyBullet gives no vertices: the link's bounding box
             return _aabb_outline(client, body, link, ref_inv, band)
         return _mesh_outline(verts, com, band)

@@ -13,7 +13,7 @@ import pytest
 
 from bt_manip.cache import Memo, bytes_key
 from bt_manip.navigation import shapes
-from bt_manip.navigation.shapes import Disc, Outline, Polygon, body_outlines, convex_hull
+from bt_manip.navigation.shapes import Disc, Outline, Polygon, body_outlines
 from bt_manip.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -26,7 +26,6 @@ def _numbers(outlines: list[Outline]) -> list[bytes]:
 
 def _fresh(*args: object, **kwargs: object) -> list[bytes]:
     shapes.OUTLINE_MEMO.clear()
-    shapes.HULL_MEMO.clear()
     shapes.BODY_MEMO.clear()
     return _numbers(body_outlines(*args, **kwargs))  # type: ignore[arg-type]
 
@@ -35,7 +34,6 @@ def _fresh(*args: object, **kwargs: object) -> list[bytes]:
 def memos(monkeypatch: pytest.MonkeyPatch) -> Iterator[None]:
     """Memories of this test only (the process's own are left as they are)."""
     monkeypatch.setattr(shapes, "OUTLINE_MEMO", Memo(8192))
-    monkeypatch.setattr(shapes, "HULL_MEMO", Memo(8192))
     monkeypatch.setattr(shapes, "BODY_MEMO", Memo(4096))
     yield
 
@@ -102,7 +100,7 @@ def test_bands_ending_on_at_and_around_the_heights_of_shapes_give_fresh_outlines
         pb.disconnect(c)
 
 
-def test_remembered_polygons_are_read_only_and_hulls_are_copies(memos: None) -> None:
+def test_remembered_polygons_are_read_only(memos: None) -> None:
     c = pb.connect(pb.DIRECT)
     try:
         col = pb.createCollisionShape(pb.GEOM_BOX, halfExtents=(0.5, 0.2, 0.4), physicsClientId=c)
@@ -115,10 +113,6 @@ def test_remembered_polygons_are_read_only_and_hulls_are_copies(memos: None) -> 
         assert first.extent() == pytest.approx((0.5, 1.8, 1.5, 2.2))
     finally:
         pb.disconnect(c)
-    pts = np.array([[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.5, 1.5], [1.0, 0.5]])
-    hull = convex_hull(pts)
-    hull[0, 0] = 42.0  # the caller's own copy
-    assert convex_hull(pts).tolist() == [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.5, 1.5]]
 
 
 def test_memories_are_bounded() -> None:
