@@ -44,7 +44,7 @@ from bt_manip.sim.compose import MAX_URDF_BYTES, cache_dir, write_atomic_bytes
 from bt_manip.sim.fixed_links import MergedFrame, merge_fixed_links
 from bt_manip.sim.mesh_check import MAX_MESH_BYTES
 
-PHYSICS_VERSION = 2
+PHYSICS_VERSION = 3
 """Bumped whenever the output for the same inputs changes."""
 
 
@@ -158,7 +158,8 @@ def read_stl_vertices(path: Path) -> np.ndarray:
 
 def hull_triangles(vertices: np.ndarray) -> np.ndarray | None:
     """Triangles (m, 3, 3) whose vertices are the inputs on or near the convex hull of
-    ``vertices``; None when the points span no volume.
+    ``vertices``, each point once (the last triangle repeats a point to fill it); None when
+    the points span no volume.
 
     Qhull merges facets that are nearly coplanar and drops their vertices (by micrometres),
     where PyBullet's own hull may keep them; so every input point closer to the hull's surface
@@ -179,9 +180,11 @@ def hull_triangles(vertices: np.ndarray) -> np.ndarray | None:
               + hull.equations[:, 3:4]).max(axis=0)
     keep = depth <= NEAR_SURFACE * extent
     keep[hull.vertices] = True
-    # the kept points in the order (and with the repeats) of the original vertex stream
-    _, index = np.unique(vertices, axis=0, return_inverse=True)
-    stream = vertices[keep[index.ravel()]]
+    # the kept points, each once, in the order they first come in the original vertex stream
+    # (PyBullet's hull of a point set does not depend on repeats; each repeat costs it time)
+    _, first, index = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
+    order = np.sort(first)
+    stream = vertices[order[keep[index.ravel()][order]]]
     pad = (-len(stream)) % 3
     stream = np.concatenate([stream, np.repeat(stream[-1:], pad, axis=0)])
     return np.asarray(stream.reshape(-1, 3, 3), dtype=np.float32)

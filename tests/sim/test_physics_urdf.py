@@ -185,6 +185,19 @@ def test_hull_keeps_only_points_on_the_surface(tmp_path: Path) -> None:
     assert {tuple(p) for p in read_stl_vertices(stl)} == kept
 
 
+def test_hull_lists_each_point_once_in_the_order_of_the_mesh() -> None:
+    corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], np.float32)
+    # a mesh's vertex stream repeats each corner (every triangle names its three)
+    stream = np.concatenate([corners[[3, 1, 3, 0]], corners, corners[::-1], [[0.0, 0.0, 0.0]]])
+    triangles = hull_triangles(stream.astype(np.float32))
+    assert triangles is not None
+    points = triangles.reshape(-1, 3)
+    order = [3, 1, 0, 2, 4, 5, 6, 7]  # first seen: 3, 1, 0, then the rest in turn
+    assert points[: len(order)].tolist() == corners[order].tolist()
+    assert all((p == points[len(order) - 1]).all() for p in points[len(order):])  # the fill
+    assert len(points) == len(order) + (-len(order)) % 3
+
+
 def test_flat_or_tiny_point_sets_have_no_hull(tmp_path: Path) -> None:
     flat = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [0.5, 0.5, 0]], np.float32)
     assert hull_triangles(flat) is None
