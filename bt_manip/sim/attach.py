@@ -178,6 +178,11 @@ class Attachments:
     def _static_contacts(self, object_name: str, held: Attachment) -> list[str]:
         """:meth:`static_contacts` of an attached object."""
         supports = self._supports.get(object_name, set())
+        if not supports:  # the common case once lifted: touching the hand alone is nothing
+            points = pb.getContactPoints(bodyA=held.object_body, physicsClientId=self.client)
+            robot = held.robot_body
+            if all(p[2] == robot for p in points):
+                return []
         touching = self._touching(held.object_body)
         for support in list(supports):  # a support left once is a support no more
             if support not in touching and not pbq.closest_points(

@@ -520,7 +520,7 @@ class Robot:
             raise RuntimeError(f"{self.name} has a fixed base")
         limit = base.max_wheel_speed
         for ids, speed in ((self.wheel_ids_left, left), (self.wheel_ids_right, right)):
-            speed = float(np.clip(speed, -limit, limit))
+            speed = min(max(float(speed), -limit), limit)  # np.clip's value, without numpy
             for j in ids:
                 pb.setJointMotorControl2(
                     self.body,
