@@ -13,7 +13,6 @@ from typing import Any
 
 import pybullet as pb
 
-from bt_manip.geometry import compose_poses, invert_pose
 from bt_manip.sim import pybullet_queries as pbq
 
 STRUCTURE_KINDS = ("wall", "furniture", "ground")
@@ -48,31 +47,38 @@ def structures_near(world: Any, body: int, max_gap: float) -> list[Structure]:
 
 
 def fasten(world: Any, body: int, structure: Structure) -> int:
-    """Fix ``body`` to ``structure`` where both are now; the constraint id."""
+    """Fix ``body`` where it is now, fastened to ``structure``; the constraint id.
+
+    The joint holds the object to the world frame: walls, furniture and the floor are static
+    rigid bodies (:mod:`bt_manip.sim.static_bodies`), fixed in the world, so this is the same
+    joint as one to the structure (PyBullet makes no joint from an articulated body to a static
+    rigid one). Which structure it is fastened to is kept in ``world.fastened_to``
+    (:func:`fastenings`)."""
     client = world.client
-    parent = pbq.com_pose(client, structure.body, -1)
-    child = pbq.com_pose(client, body, -1)
-    rel_pos, rel_quat = compose_poses(invert_pose(parent), child)
+    pos, quat = pbq.com_pose(client, body, -1)
     cid = pb.createConstraint(
-        structure.body, -1, body, -1, pb.JOINT_FIXED, [0, 0, 0],
-        parentFramePosition=rel_pos, childFramePosition=[0, 0, 0],
-        parentFrameOrientation=rel_quat, childFrameOrientation=[0, 0, 0, 1],
+        body, -1, -1, -1, pb.JOINT_FIXED, [0, 0, 0],
+        parentFramePosition=[0, 0, 0], childFramePosition=list(pos),
+        parentFrameOrientation=[0, 0, 0, 1], childFrameOrientation=list(quat),
         physicsClientId=client,
     )
     pb.changeConstraint(cid, maxForce=HOLD_FORCE, physicsClientId=client)
+    world.fastened_to[int(cid)] = structure.name
     return int(cid)
 
 
 def fastenings(world: Any) -> dict[str, str]:
     """Each fastened movable object's name with the structure it is fastened to."""
-    static = {i.body_id: i.name for i in world.infos.values() if i.kind in STRUCTURE_KINDS}
     movable = {b: n for n, b in world.movable.items()}
+    to = world.fastened_to
     out: dict[str, str] = {}
     client = world.client
     for k in range(pb.getNumConstraints(physicsClientId=client)):
         cid = pb.getConstraintUniqueId(k, physicsClientId=client)
+        if cid not in to:
+            continue
         info = pb.getConstraintInfo(cid, physicsClientId=client)
         parent, child, kind = info[0], info[2], info[4]
-        if kind == pb.JOINT_FIXED and parent in static and child in movable:
-            out[movable[child]] = static[parent]
+        if kind == pb.JOINT_FIXED and child == -1 and parent in movable:
+            out[movable[parent]] = to[cid]
     return out

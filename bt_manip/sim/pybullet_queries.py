@@ -218,8 +218,32 @@ def visual_shapes(client: int, body: int) -> list[ShapeData]:
     ]
 
 
+_REGISTERED_SHAPES: dict[tuple[int, int], list[ShapeData]] = {}
+"""Collision geometries of bodies PyBullet gives none for (static rigid bodies, see
+:mod:`bt_manip.sim.static_bodies`), by client and body."""
+
+
+def register_collision_shapes(client: int, body: int, shapes: list[ShapeData]) -> None:
+    """Have :func:`collision_shapes` answer ``shapes`` for the base of ``body`` (a body
+    without links)."""
+    _REGISTERED_SHAPES[(client, body)] = list(shapes)
+
+
+def forget_collision_shapes(client: int, body: int | None = None) -> None:
+    """Drop what :func:`register_collision_shapes` said of ``body`` (of every body of
+    ``client`` when ``None``: before the client is disconnected or reset)."""
+    if body is not None:
+        _REGISTERED_SHAPES.pop((client, body), None)
+        return
+    for key in [k for k in _REGISTERED_SHAPES if k[0] == client]:
+        del _REGISTERED_SHAPES[key]
+
+
 def collision_shapes(client: int, body: int, link: int) -> list[ShapeData]:
     """Collision geometries of one link of ``body`` (frames relative to its centre of mass)."""
+    known = _REGISTERED_SHAPES.get((client, body))
+    if known is not None:
+        return list(known) if link == -1 else []
     return [
         ShapeData(s[0], s[1], s[2], tuple(s[3]), _text(s[4]), tuple(s[5]), tuple(s[6]))
         for s in pb.getCollisionShapeData(body, link, physicsClientId=client)

@@ -33,6 +33,7 @@ from bt_manip.geometry import euler_from_quat, quat_from_euler, quat_from_yaw, r
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.attach import Attachments
 from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
+from bt_manip.sim.static_bodies import make_static
 from bt_manip.sim.world_spec import (
     BodySpec,
     Part,
@@ -123,6 +124,7 @@ class World:
         self.step_count = 0
         self.gui = gui
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
+        pbq.forget_collision_shapes(self.client)  # of an earlier client with this id
         self.infos: dict[str, BodyInfo] = {}
         self.robots: dict[str, Any] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
@@ -130,6 +132,9 @@ class World:
         self.events = WorldEvents()
         """Bodies added and removed, attach and detach, announced while the world runs."""
         self.attachments = Attachments(self)
+        self.fastened_to: dict[int, str] = {}
+        """The structure each fastening joint holds an object to, by constraint id
+        (:mod:`bt_manip.sim.fasteners`)."""
         try:
             self._setup_physics()
             self._build()
@@ -154,8 +159,8 @@ class World:
             pb.setPhysicsEngineParameter(
                 solverResidualThreshold=ph.solver_tolerance**2, physicsClientId=c
             )
-        plane = pb.createCollisionShape(pb.GEOM_PLANE, physicsClientId=c)
-        ground = pb.createMultiBody(0, plane, self._ground_visual(), [0, 0, 0], physicsClientId=c)
+        plane = {"shapeType": pb.GEOM_PLANE}
+        ground = make_static(c, False, plane, self._ground_visual(), [0.0, 0.0, 0.0])
         pb.changeDynamics(ground, -1, lateralFriction=ph.ground_friction, physicsClientId=c)
         self.infos["ground"] = BodyInfo("ground", ground, "ground", None, 0)
 
@@ -222,13 +227,15 @@ class World:
         # frames are relative to the wall's start point, along the wall's axis
         frames = [[(a + b) / 2, 0.0, wall.height / 2] for a, b in stretches]
         n = len(stretches)
-        col = pb.createCollisionShapeArray(
-            [pb.GEOM_BOX] * n, halfExtents=halves, collisionFramePositions=frames, physicsClientId=c
-        )
+        shape = {
+            "shapeTypes": [pb.GEOM_BOX] * n,
+            "halfExtents": halves,
+            "collisionFramePositions": frames,
+        }
         vis = pb.createVisualShapeArray(
             [pb.GEOM_BOX] * n, halfExtents=halves, visualFramePositions=frames, physicsClientId=c
         )
-        body = pb.createMultiBody(0, col, vis, [x0, y0, 0.0], quat, physicsClientId=c)
+        body = make_static(c, True, shape, vis, [x0, y0, 0.0], quat)
         pb.changeVisualShape(body, -1, rgbaColor=wall.colour, physicsClientId=c)
         return int(body)
 
@@ -292,8 +299,12 @@ class World:
             if spec.movable
             else np.zeros(3)
         )
-        if len(parts) == 1 and parts[0].rpy == (0.0, 0.0, 0.0) and parts[0].xyz == (0.0, 0.0, 0.0):
-            col = pb.createCollisionShape(**_shape_args(parts[0]), physicsClientId=c)
+        array = not (
+            len(parts) == 1 and parts[0].rpy == (0.0, 0.0, 0.0) and parts[0].xyz == (0.0, 0.0, 0.0)
+        )
+        shape: dict[str, Any]
+        if not array:
+            shape = _shape_args(parts[0])
             vis = pb.createVisualShape(
                 **_shape_args(parts[0], visual=True),
                 rgbaColor=parts[0].colour or spec.colour,
@@ -301,27 +312,30 @@ class World:
             )
         else:
             types = [_shape_args(p)["shapeType"] for p in parts]
-            radii = [p.size[0] for p in parts]
-            halves = [_half(p) for p in parts]
-            lengths = [p.size[2] for p in parts]
+            sizes = {
+                "radii": [p.size[0] for p in parts],
+                "halfExtents": [_half(p) for p in parts],
+                "lengths": [p.size[2] for p in parts],
+            }
             frames = [list(np.subtract(p.xyz, com)) for p in parts]
             orns = [list(quat_from_euler(p.rpy)) for p in parts]
-            shapes = {
-                "radii": radii,
-                "halfExtents": halves,
-                "lengths": lengths,
-                "physicsClientId": c,
+            shape = {
+                "shapeTypes": types, "collisionFramePositions": frames,
+                "collisionFrameOrientations": orns, **sizes,
             }
-            col = pb.createCollisionShapeArray(
-                types, collisionFramePositions=frames, collisionFrameOrientations=orns, **shapes
-            )
             vis = pb.createVisualShapeArray(
-                types, visualFramePositions=frames, visualFrameOrientations=orns, **shapes
+                types, visualFramePositions=frames, visualFrameOrientations=orns, **sizes,
+                physicsClientId=c,
             )
         # the body frame sits at the centre of mass; shift the spawn point to match
         rot = rotation_matrix(quat)
         base = np.asarray(pos) + rot @ com
-        body = pb.createMultiBody(spec.mass, col, vis, list(base), quat, physicsClientId=c)
+        if spec.movable:
+            make = pb.createCollisionShapeArray if array else pb.createCollisionShape
+            col = make(**shape, physicsClientId=c)
+            body = pb.createMultiBody(spec.mass, col, vis, list(base), quat, physicsClientId=c)
+        else:
+            body = make_static(c, array, shape, vis, list(base), quat)
         pb.changeVisualShape(body, -1, rgbaColor=spec.colour, physicsClientId=c)
         return int(body)
 
@@ -427,6 +441,7 @@ class World:
             depth = self._penetration(body, info.body_id)
             if depth < -OVERLAP_TOLERANCE:
                 pb.removeBody(body, physicsClientId=self.client)
+                pbq.forget_collision_shapes(self.client, body)
                 raise ValueError(
                     f"'{spec.name}' would start {-depth * 1000:.0f} mm inside '{info.name}'"
                 )
@@ -444,6 +459,7 @@ class World:
         if self.attachments.is_attached(name):
             self.attachments.detach(name)
         pb.removeBody(info.body_id, physicsClientId=self.client)
+        pbq.forget_collision_shapes(self.client, info.body_id)
         del self.infos[name]
         self._wake_movables()  # whatever rested on the body removed must fall
         self.events.announce(BodyRemoved(self.time, name, info.body_id, info.kind))
@@ -538,6 +554,7 @@ class World:
     def close(self) -> None:
         """Disconnect the PyBullet client (idempotent)."""
         if getattr(self, "client", None) is not None and self.client >= 0:
+            pbq.forget_collision_shapes(self.client)
             with contextlib.suppress(pb.error):
                 pb.disconnect(physicsClientId=self.client)
             self.client = -1
