@@ -269,6 +269,12 @@ class Runner:
                 self._advance(wall0)
         except KeyboardInterrupt:
             status, reason = "INTERRUPTED", "interrupted by the user"
+        except SystemError as exc:
+            # a Ctrl-C that came while compiled code ran (the numba pose search): Python
+            # reports it as a SystemError caused by the KeyboardInterrupt
+            if not isinstance(exc.__cause__, KeyboardInterrupt):
+                raise
+            status, reason = "INTERRUPTED", "interrupted by the user"
         except TreeRuntimeError as exc:
             status, reason = "ERROR", str(exc)
         if status in ("BUDGET", "INTERRUPTED", "ERROR"):

@@ -4,6 +4,7 @@ its outputs follow the JSON Schemas of docs/schemas."""
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -73,10 +74,25 @@ def test_an_interrupted_bench_keeps_its_episodes_and_resume_completes_it(
     assert len((tmp_path / "cut" / LOG_NAME).read_text().splitlines()) == 7
 
 
+def _interrupt_from_compiled_code() -> None:
+    """What Python raises when a Ctrl-C comes while a compiled (numba) function runs."""
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as ctrl_c:
+        raise SystemError("CPUDispatcher(<function _search>) returned a result with an "
+                          "exception set") from ctrl_c
+
+
+def _raise_keyboard_interrupt() -> None:
+    raise KeyboardInterrupt
+
+
+@pytest.mark.parametrize("interrupt", [_raise_keyboard_interrupt, _interrupt_from_compiled_code])
 def test_ctrl_c_during_an_episode_stops_a_one_process_bench(
-        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The runner turns a Ctrl-C into an INTERRUPTED run (tree halted, robots stopped); the
-    bench then stops too, keeping only the episodes that finished."""
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch, interrupt: Callable[[], None]) -> None:
+    """The runner turns a Ctrl-C into an INTERRUPTED run (tree halted, robots stopped), also
+    one that comes while compiled code runs; the bench then stops too, keeping only the
+    episodes that finished."""
     from bt_manip.sim.world import World
 
     tree = _tree(tmp_path)
@@ -84,7 +100,7 @@ def test_ctrl_c_during_an_episode_stops_a_one_process_bench(
 
     def ctrl_c_in_seed_2(self: World, n: int = 1) -> None:
         if self.seed == 2 and self.time > 0.1:
-            raise KeyboardInterrupt
+            interrupt()
         real_step(self, n)
 
     monkeypatch.setattr(World, "step", ctrl_c_in_seed_2)
