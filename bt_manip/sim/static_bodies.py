@@ -16,6 +16,7 @@ PyBullet adds and takes away included.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import pybullet as pb
@@ -26,24 +27,29 @@ from bt_manip.sim import pybullet_queries as pbq
 _DATA: Memo[tuple[pbq.ShapeData, ...]] = Memo(1024)
 """The collision shape data of each shape asked for, by its creation arguments."""
 
-_probe: list[int] = []
-"""The hidden client that :func:`collision_data` asks (made on first use)."""
-
 _PROBE_RESET_EVERY = 256
 """Shapes made in the hidden client before it is reset (PyBullet keeps every shape made)."""
 
-_made = [0]
+
+@dataclass
+class _Probe:
+    """The hidden client that :func:`collision_data` asks (connected on first use)."""
+
+    client: int = -1
+    made: int = 0
+
+    def connected(self) -> int:
+        """The client, connected (again if needed) and reset every so many shapes."""
+        if self.client >= 0 and pb.isConnected(self.client):
+            if self.made >= _PROBE_RESET_EVERY:
+                pb.resetSimulation(physicsClientId=self.client)
+                self.made = 0
+            return self.client
+        self.client, self.made = int(pb.connect(pb.DIRECT)), 0
+        return self.client
 
 
-def _probe_client() -> int:
-    if _probe and pb.isConnected(_probe[0]):
-        if _made[0] >= _PROBE_RESET_EVERY:
-            pb.resetSimulation(physicsClientId=_probe[0])
-            _made[0] = 0
-        return _probe[0]
-    _probe[:] = [int(pb.connect(pb.DIRECT))]
-    _made[0] = 0
-    return _probe[0]
+_PROBE = _Probe()
 
 
 def _key(array: bool, shape: dict[str, Any]) -> str:
@@ -58,11 +64,11 @@ def collision_data(array: bool, shape: dict[str, Any]) -> tuple[pbq.ShapeData, .
     known = _DATA.get(key)
     if known is not None:
         return known
-    c = _probe_client()
+    c = _PROBE.connected()
     make = pb.createCollisionShapeArray if array else pb.createCollisionShape
     col = make(**shape, physicsClientId=c)
     body = pb.createMultiBody(0, col, -1, [0.0, 0.0, 0.0], physicsClientId=c)
-    _made[0] += 1
+    _PROBE.made += 1
     try:
         # every shape is the base's (PyBullet fills the body and link of a compound's later
         # children with whatever its buffer held)

@@ -119,3 +119,14 @@ def test_an_object_fastened_to_a_wall_stays_where_it_was(world: World) -> None:
     pos, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)
     assert pos == pytest.approx((1.0, 0.2, 0.6), abs=2e-3)
     assert fastenings(world) == {"crate": "wall_a"}
+
+
+def test_the_hidden_client_is_reset_now_and_then_and_still_answers(
+        monkeypatch: pytest.MonkeyPatch) -> None:
+    import bt_manip.sim.static_bodies as sb
+
+    first = collision_data(False, {"shapeType": pb.GEOM_SPHERE, "radius": 0.123})
+    monkeypatch.setattr(sb._PROBE, "made", sb._PROBE_RESET_EVERY)
+    again = collision_data(False, {"shapeType": pb.GEOM_SPHERE, "radius": 0.321})
+    assert sb._PROBE.made == 1  # reset, then one shape made
+    assert first[0].dimensions[0] == 0.123 and again[0].dimensions[0] == 0.321
