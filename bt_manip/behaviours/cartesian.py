@@ -37,6 +37,12 @@ def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
     return pose_base
 
 
+def _solver(services: RobotServices, tip: str, free_yaw: bool) -> IKSolver:
+    """The IK solver for ``tip``: the one leaving the yaw about the tool axis free, or not."""
+    ik = arm_ik(services, tip)
+    return ik.free_yaw if free_yaw else ik.full
+
+
 def _world_to_arm_base(robot: Any) -> np.ndarray:
     """The transform (4x4) taking world coordinates to the arm's base link frame."""
     base = robot.link_transform(robot.description.arm.base_link)
@@ -52,9 +58,8 @@ def solve(
     free_yaw: bool = False,
 ) -> np.ndarray:
     """Joint values putting ``tip`` at ``pose_world``; ActionFailed with IK's reason if none."""
-    ik = arm_ik(services, tip)
-    solver = ik.free_yaw if free_yaw else ik.full
-    return _solved(solver, _world_to_arm_base(services.robot) @ pose_world, pose_world, seed)
+    pose_base = _world_to_arm_base(services.robot) @ pose_world
+    return _solved(_solver(services, tip, free_yaw), pose_base, pose_world, seed)
 
 
 def _solved(
@@ -90,8 +95,7 @@ def line(
     a, b = start_world[:3, 3], goal_world[:3, 3]
     turning = _Turn(start_world[:3, :3], goal_world[:3, :3])
     n = max(1, int(np.ceil(max(float(np.linalg.norm(b - a)) / STEP, turning.angle / TURN_STEP))))
-    ik = arm_ik(services, tip)
-    solver = ik.free_yaw if free_yaw else ik.full
+    solver = _solver(services, tip, free_yaw)
     to_base = _world_to_arm_base(services.robot)
     out = []
     q = seed
@@ -133,9 +137,7 @@ class _Turn:
         else:
             axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
             axis /= 2.0 * np.sin(angle)
-        self.k = k = np.array(
-            [[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]
-        )
+        k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
         kk = k @ k
         self._k = k.ravel().tolist()
         self._kk = kk.ravel().tolist()

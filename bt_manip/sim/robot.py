@@ -373,11 +373,11 @@ class Robot:
 
     def arm_positions(self) -> np.ndarray:
         """Arm joint positions (rad) in descriptor order."""
-        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[0])
+        return self._positions(self.arm_joint_ids)
 
     def arm_velocities(self) -> np.ndarray:
         """Arm joint velocities (rad/s) in descriptor order."""
-        return np.array(pbq.joint_motion(self.client, self.body, self.arm_joint_ids)[1])
+        return np.array(self.arm_motion()[1])
 
     def arm_motion(self) -> tuple[list[float], list[float]]:
         """Arm joint positions (rad) and velocities (rad/s) in descriptor order, as plain

@@ -62,19 +62,24 @@ class Pose2D(NamedTuple):
     yaw: float
 
 
+class _SharedByCopies:
+    """A frozen record of numbers and text only: a deep copy of a spec shares it (a copy
+    would be the same value)."""
+
+    def __deepcopy__(self, memo: dict[int, Any]) -> _SharedByCopies:
+        return self
+
+
 @dataclass(frozen=True)
-class Pose3D:
+class Pose3D(_SharedByCopies):
     """A full pose: position and quaternion (x, y, z, w)."""
 
     xyz: tuple[float, float, float]
     quat: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
 
-    def __deepcopy__(self, memo: dict[int, Any]) -> Pose3D:
-        return self  # frozen, of numbers and text only: a copy would be the same value
-
 
 @dataclass(frozen=True)
-class Range2D:
+class Range2D(_SharedByCopies):
     """Uniform offsets sampled per seed: each is (low, high)."""
 
     x: tuple[float, float] = (0.0, 0.0)
@@ -84,12 +89,9 @@ class Range2D:
     def is_zero(self) -> bool:
         return self.x == (0.0, 0.0) and self.y == (0.0, 0.0) and self.yaw == (0.0, 0.0)
 
-    def __deepcopy__(self, memo: dict[int, Any]) -> Range2D:
-        return self  # frozen, of numbers and text only: a copy would be the same value
-
 
 @dataclass(frozen=True)
-class Part:
+class Part(_SharedByCopies):
     """One primitive: ``box`` (size = full extents), ``cylinder`` (radius, height) or ``sphere``."""
 
     shape: str
@@ -97,9 +99,6 @@ class Part:
     xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
     rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
     colour: tuple[float, float, float, float] | None = None
-
-    def __deepcopy__(self, memo: dict[int, Any]) -> Part:
-        return self  # frozen, of numbers and text only: a copy would be the same value
 
     def bottom(self) -> float:
         """Lowest z of the part in its body frame (rotation about z only is exact)."""
@@ -149,16 +148,13 @@ class BodySpec:
 
 
 @dataclass(frozen=True)
-class BatterySpec:
+class BatterySpec(_SharedByCopies):
     """A robot's simulated battery: its charge (0..1) and voltage at the start, and how much
     charge it loses per second of sim time (the voltage stays as given)."""
 
     percentage: float = 1.0
     voltage: float = 12.0
     drain: float = 0.0
-
-    def __deepcopy__(self, memo: dict[int, Any]) -> BatterySpec:
-        return self  # frozen, of numbers and text only: a copy would be the same value
 
     def percentage_at(self, t: float) -> float:
         """The charge left after ``t`` seconds of sim time (never below 0)."""
