@@ -147,7 +147,7 @@ _MESHES_SEEN: Memo[tuple[tuple[str, tuple[int, int, int] | None], ...]] = Memo(1
 with the size, modification time and inode each had when checked."""
 
 
-def _file_stamp(path: str) -> tuple[int, int, int] | None:
+def file_stamp(path: str | Path) -> tuple[int, int, int] | None:
     """A file's size, modification time (ns) and inode; None if it cannot be read."""
     try:
         st = os.stat(path)
@@ -162,15 +162,15 @@ def _resolve_single(path: Path) -> Path:
     seen_key = (str(path), bytes_key(data))
     seen = _MESHES_SEEN.get(seen_key)
     root = None
-    if seen is None or any(_file_stamp(mesh) != stamp for mesh, stamp in seen):
+    if seen is None or any(file_stamp(mesh) != stamp for mesh, stamp in seen):
         # bytes not read before, or a mesh changed since: parse them and check the meshes
         root = _read_urdf(path)
         meshes = dict.fromkeys(el.get("filename", "") for el in root.iter("mesh"))
-        seen = tuple((mesh, _file_stamp(mesh)) for mesh in meshes)
+        seen = tuple((mesh, file_stamp(mesh)) for mesh in meshes)
         _MESHES_SEEN.put(seen_key, seen)
     if not seen:
         return path
-    key = _hash_inputs({"version": COMPOSER_VERSION, "file": str(path)}, [path])
+    key = _hash_contents({"version": COMPOSER_VERSION, "file": str(path)}, [(path, data)])
     target = cache_dir() / f"{path.stem}-{key}.urdf"
     if not target.is_file():
         _write_atomic(target, _to_text(root if root is not None else _read_urdf(path)))
@@ -178,10 +178,17 @@ def _resolve_single(path: Path) -> Path:
 
 
 def _hash_inputs(recipe: dict, files: list[Path]) -> str:
+    return _hash_contents(
+        recipe, [(f, read_bounded(f, MAX_URDF_BYTES, "URDF file")) for f in files]
+    )
+
+
+def _hash_contents(recipe: dict, contents: list[tuple[Path, bytes]]) -> str:
+    """:func:`_hash_inputs` of files already read (path and bytes of each)."""
     digest = hashlib.sha256(json.dumps(recipe, sort_keys=True, default=str).encode())
-    for f in files:
+    for f, data in contents:
         digest.update(str(f).encode())
-        digest.update(read_bounded(f, MAX_URDF_BYTES, "URDF file"))
+        digest.update(data)
     return digest.hexdigest()[:16]
 
 

@@ -40,7 +40,7 @@ import defusedxml.ElementTree as SafeET
 import numpy as np
 
 from bt_manip.input_files import read_bounded
-from bt_manip.sim.compose import MAX_URDF_BYTES, cache_dir, write_atomic_bytes
+from bt_manip.sim.compose import MAX_URDF_BYTES, cache_dir, file_stamp, write_atomic_bytes
 from bt_manip.sim.fixed_links import MergedFrame, merge_fixed_links
 from bt_manip.sim.mesh_check import MAX_MESH_BYTES
 
@@ -208,8 +208,6 @@ _BINARY_TRIANGLE = np.dtype(
 
 
 def _file_stamp(path: Path) -> bytes:
-    try:
-        st = path.stat()
-    except OSError:
-        return f"{path}:missing".encode()
-    return f"{path}:{st.st_size}:{st.st_mtime_ns}".encode()
+    """The path, size, modification time and inode of a file (``None`` when missing), as the
+    bytes a cache key is made of."""
+    return f"{path}:{file_stamp(path)}".encode()
