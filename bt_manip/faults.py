@@ -18,7 +18,8 @@ Specifications (``--inject``, repeatable):
                     the pose the robot perceives of each object is off by an offset drawn once
                     per object and episode: x and y normal with sigma SIGMA_M (m), yaw normal
                     with sigma SIGMA_DEG (deg, default 2). Nodes that plan from an object's pose
-                    read it through :func:`bt_manip.perception.perceived_pose`; checks and
+                    read it through
+                    :func:`bt_manip.manipulation.perception.perceived_pose`; checks and
                     physics keep the ground truth.
 
 This module is the whole fault layer. Node failures are wrapped around the targeted nodes when

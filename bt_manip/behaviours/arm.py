@@ -22,6 +22,8 @@ from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix
+from bt_manip.manipulation import cartesian
+from bt_manip.manipulation.base_search import object_grasp
 
 if TYPE_CHECKING:
     from bt_manip.sim.robot import Robot
@@ -303,8 +305,6 @@ class Lift(JointMove):
             raise ActionFailed('give exactly one of deltas="..." or height="..."')
         n = len(q_now)
         if height:
-            from bt_manip.behaviours import cartesian
-
             robot = self.robot()
             tip = robot.description.grasp_frame
             start = robot.link_transform(tip)
@@ -331,20 +331,20 @@ class Lift(JointMove):
 class MoveToPose(JointMove):
     """Moves the gripper (or ``frame``) to a pose in the world, found by inverse kinematics.
 
-    The target position is ``position`` (x;y;z) or the centre of ``object``, plus ``offset``
-    (x;y;z, world frame); an object's pose is the one the robot perceives (ground truth plus
-    any ``--inject pose_noise``). With ``grasp="top"`` the target is the object's top grasp
-    frame instead (:mod:`bt_manip.grasps`: from above, at the middle of its top face, the
-    fingers closing across its thinner side; ``orientation`` and ``match_object_yaw`` are then
-    not used). The orientation is ``orientation`` (quaternion x;y;z;w, world frame;
-    default ``0;1;0;0``: the tool pointing straight down). With ``match_object_yaw`` the
-    orientation is turned about the vertical to the object's yaw (modulo 90 deg, the turn
-    nearest the current wrist), so a parallel gripper closes on two faces of a box; with
-    ``free_yaw`` the rotation about the tool axis is left to the solver. ``path="line"`` moves
-    the tool on a straight line from where it is (orientation turning evenly); the default
-    ``joint`` interpolates the joints. With ``approach`` > 0 the last ``approach`` metres are a
-    straight line along the tool axis; with ``retreat`` > 0 the move starts by backing out that
-    far along the tool axis from where the tool is (leaving a grasp or a drop the way it came).
+    The target position is ``position`` (x;y;z) or the centre of ``object``, plus ``offset`` (x;y;z,
+    world frame); an object's pose is the one the robot perceives (ground truth plus any ``--inject
+    pose_noise``). With ``grasp="top"`` the target is the object's top grasp frame instead
+    (:mod:`bt_manip.manipulation.grasps`: from above, at the middle of its top face, the fingers
+    closing across its thinner side; ``orientation`` and ``match_object_yaw`` are then not used).
+    The orientation is ``orientation`` (quaternion x;y;z;w, world frame; default ``0;1;0;0``: the
+    tool pointing straight down). With ``match_object_yaw`` the orientation is turned about the
+    vertical to the object's yaw (modulo 90 deg, the turn nearest the current wrist), so a parallel
+    gripper closes on two faces of a box; with ``free_yaw`` the rotation about the tool axis is left
+    to the solver. ``path="line"`` moves the tool on a straight line from where it is (orientation
+    turning evenly); the default ``joint`` interpolates the joints. With ``approach`` > 0 the last
+    ``approach`` metres are a straight line along the tool axis; with ``retreat`` > 0 the move
+    starts by backing out that far along the tool axis from where the tool is (leaving a grasp or a
+    drop the way it came).
 
     - RUNNING while the arm moves through the joint waypoints;
     - SUCCESS when the last waypoint is reached within ``tolerance``;
@@ -386,8 +386,6 @@ class MoveToPose(JointMove):
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
-        from bt_manip.behaviours import cartesian
-
         robot = self.robot()
         tip = self.get_input("frame") or robot.description.grasp_frame
         position = list(self.get_input("position"))
@@ -406,9 +404,9 @@ class MoveToPose(JointMove):
         if len(position) != 3 or len(offset) != 3:
             raise ActionFailed("position and offset take three numbers x;y;z")
         if grasp:
-            from bt_manip.behaviours.base_placement import object_grasp
-
-            target = object_grasp(self, robot, name, grasp, robot.base_pose2d()[2])
+            target = object_grasp(
+                self.world, self.faults(), robot, name, grasp, robot.base_pose2d()[2]
+            )
             target[:3, 3] += np.asarray(offset, dtype=float)
         else:
             target = pose_matrix(np.add(position, offset), self.get_input("orientation"))

@@ -18,8 +18,10 @@ from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
 from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
+from bt_manip.manipulation.errors import ManipulationError
+from bt_manip.manipulation.grasps import grasped_object
+from bt_manip.manipulation.perception import PerceptionError, movable_body, perceived_pose
 from bt_manip.overlay import Overlay
-from bt_manip.perception import perceived_pose
 from bt_manip.run_context import RobotServices, RunContext
 
 ROBOT_PORT = PortInformation(
@@ -32,6 +34,11 @@ ROBOT_PORT = PortInformation(
 
 class ActionFailed(Exception):
     """Raised inside a behaviour to end it with FAILURE and this reason."""
+
+
+FAILS = (ActionFailed, PortError, ManipulationError)
+"""What ends a behaviour with FAILURE, its message the reason: the node's own failures, a port
+value it cannot take, and what the manipulation helpers it calls cannot do."""
 
 
 def skid_steer_refusal(robot: Any, node_id: str) -> str | None:
@@ -119,12 +126,10 @@ class WorldAccess:
 
     def object_body(self, name: str) -> int:
         """PyBullet id of a movable object of the world."""
-        movable: dict[str, int] = self.world.movable
-        if name not in movable:
-            raise ActionFailed(
-                f"no movable object named '{name}'; objects: {', '.join(sorted(movable)) or 'none'}"
-            )
-        return movable[name]
+        try:
+            return movable_body(self.world, name)
+        except PerceptionError as exc:
+            raise ActionFailed(str(exc)) from None
 
     def faults(self) -> FaultInjector | None:
         """The run's fault injector, when faults are injected."""
@@ -134,7 +139,7 @@ class WorldAccess:
     def perceived_pose(self, name: str) -> np.ndarray:
         """The pose (4x4) at which the robot sees the movable object ``name``, for planning:
         the ground truth plus the episode's ``pose_noise`` offset of that object (see
-        :func:`bt_manip.perception.perceived_pose`)."""
+        :func:`bt_manip.manipulation.perception.perceived_pose`)."""
         self.object_body(name)
         return perceived_pose(self.world, self.faults(), name)
 
@@ -167,7 +172,7 @@ class RobotAction(WorldAccess, ActionNode):
             self.start()
             if self.CARRIES:
                 self._draw_slip()
-        except (ActionFailed, PortError) as exc:
+        except FAILS as exc:
             self._start_error = str(exc)
         if self._start_error is None:
             self._list_running()
@@ -199,8 +204,6 @@ class RobotAction(WorldAccess, ActionNode):
         faults = self.faults()
         if faults is None or not faults.specs:
             return
-        from bt_manip.behaviours.gripper import grasped_object
-
         robot = self.robot()
         held = [a.object_name for a in self.world.attachments.held_by(self.robot_name())]
         held += [grasped_object(self.world, robot)] if not held else []
@@ -220,7 +223,7 @@ class RobotAction(WorldAccess, ActionNode):
                 slip, self._slip = self._slip, None
                 slip_out(self.world, self.robot(), slip)
             return self.step()
-        except (ActionFailed, PortError) as exc:
+        except FAILS as exc:
             self.feedback_message = str(exc)
             self._make_safe()
             return Status.FAILURE
@@ -260,7 +263,7 @@ class WorldCondition(WorldAccess, ConditionNode):
     def update(self) -> Status:
         try:
             ok, reason = self.check()
-        except (ActionFailed, PortError) as exc:
+        except FAILS as exc:
             ok, reason = False, str(exc)
         self.feedback_message = "" if ok else reason
         return Status.SUCCESS if ok else Status.FAILURE

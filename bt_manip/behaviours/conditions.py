@@ -10,11 +10,11 @@ import pybullet as pb
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ROBOT_PORT, ActionFailed, WorldCondition
-from bt_manip.behaviours.gripper import grasped_object
 from bt_manip.behaviours.regions import region_of
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port, count_of
 from bt_manip.geometry import rotation_matrix
+from bt_manip.manipulation.grasps import grasped_object
 from bt_manip.sim import pybullet_queries as pbq
 
 OBJECT = PortInformation(str, True, "name of a movable object of the world")

@@ -24,8 +24,8 @@ from bt_manip.behaviours.place import (
 )
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
-from bt_manip.perception import true_pose
-from bt_manip.placing import deviation
+from bt_manip.manipulation.perception import true_pose
+from bt_manip.manipulation.placing import deviation
 from bt_manip.sim.fasteners import fasten, fastenings, structures_near
 
 DEFAULT_MAX_GAP = 0.01

@@ -10,6 +10,7 @@ from py_trees.ports import PortInformation
 from bt_manip.behaviours.base import ActionFailed, RobotAction
 from bt_manip.bt import registry
 from bt_manip.bt.ports import POSITIVE, Accepts, Port
+from bt_manip.manipulation.grasps import grasped_object
 
 OPENING = Accepts(low=0, also=(-1,))
 """An opening is a distance between the pads, or -1 (fully open or closed)."""
@@ -21,15 +22,6 @@ MIN_MOVE_TIME = 0.2
 """A gripper move lasts longer than this (sim s): the fingers need time to start moving."""
 TIME_EPS = 1e-9
 """Tolerance (s) when comparing sim-time differences."""
-
-
-def grasped_object(world: Any, robot: Any) -> str:
-    """Name of the movable object every finger touches, or ''."""
-    movable: dict[str, int] = world.movable
-    for name, body in movable.items():
-        if robot.is_grasping(body):
-            return name
-    return ""
 
 
 class _GripperMove(RobotAction):

@@ -3,8 +3,8 @@
 The object is held through an attach joint (:mod:`bt_manip.behaviours.attach`), so where the
 hand must go follows from where the object is in the hand now: the grasp frame's target is the
 object's target pose composed with the inverse of the object's pose in the grasp frame. Of the
-two turns of the target that are the same box (:mod:`bt_manip.placing`), the one nearer the
-hand's orientation now is tried first.
+two turns of the target that are the same box (:mod:`bt_manip.manipulation.placing`), the one
+nearer the hand's orientation now is tried first.
 
 The move has two parts: a joint move to the pre-place point, ``approach`` metres straight above
 the target, and the final motion, a straight line down to the target (left ``gap`` metres
@@ -29,14 +29,17 @@ from bt_manip.behaviours.base import ActionFailed
 from bt_manip.behaviours.collisions import arm_link_ids
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port
-from bt_manip.perception import true_pose
-from bt_manip.placing import (
+from bt_manip.manipulation import cartesian
+from bt_manip.manipulation.cartesian import CartesianError
+from bt_manip.manipulation.perception import true_pose
+from bt_manip.manipulation.placing import (
     Deviation,
     Target,
     TargetError,
     deviation,
+    lifted,
     parse_target,
-    rotation_angle,
+    place_frames,
     target_problem,
     yaw_of_matrix,
 )
@@ -100,22 +103,6 @@ def held_body(node: Any, name: str) -> int:
     return int(body)
 
 
-def place_frames(target: Target, object_in_grasp: np.ndarray, hand: np.ndarray) -> list[np.ndarray]:
-    """Grasp-frame poses (4x4) that put the object held as ``object_in_grasp`` at ``target``:
-    the two turns of the target, the one nearer the hand's orientation ``hand`` first."""
-    to_grasp = np.linalg.inv(object_in_grasp)
-    frames = [target.matrix(flip) @ to_grasp for flip in (False, True)]
-    frames.sort(key=lambda f: rotation_angle(hand[:3, :3], f[:3, :3]))
-    return frames
-
-
-def lifted(frame: np.ndarray, height: float) -> np.ndarray:
-    """``frame`` moved up by ``height`` (m)."""
-    out = frame.copy()
-    out[2, 3] += height
-    return out
-
-
 def static_names(world: Any) -> dict[int, str]:
     """Walls, furniture and the floor by body id."""
     return {
@@ -170,8 +157,6 @@ class Place(JointMove):
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
-        from bt_manip.behaviours import cartesian
-
         robot = self.robot()
         name = self.get_input("object")
         body = held_body(self, name)
@@ -197,7 +182,7 @@ class Place(JointMove):
             try:
                 q_pre = cartesian.solve(services, tip, pre, q_now)
                 down = cartesian.line(services, tip, pre, goal, q_pre)
-            except ActionFailed as exc:
+            except CartesianError as exc:
                 reasons.append(str(exc))
                 continue
             self.final_from = 1

@@ -15,9 +15,10 @@ from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.arm import VIA, JointMove, Stage, _through
 from bt_manip.behaviours.base import ActionFailed
-from bt_manip.behaviours.base_placement import planar
 from bt_manip.bt import registry
 from bt_manip.bt.ports import Accepts, Port, count_of
+from bt_manip.manipulation import cartesian
+from bt_manip.manipulation.base_search import planar
 
 MAX_OFFSET = 1.0
 """Largest offset (m) along each axis."""
@@ -51,8 +52,6 @@ class MoveToolBy(JointMove):
     }
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
-        from bt_manip.behaviours import cartesian
-
         offset = np.asarray(self.get_input("offset"), dtype=float)
         if offset.shape != (3,):
             raise ActionFailed(f"offset takes three numbers x;y;z, got {offset.size}")

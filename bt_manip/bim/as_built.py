@@ -8,7 +8,7 @@ and compares it with its planned (BIM) pose. One row per element, in schedule or
 - ``planned``: the target pose ``[x, y, z, yaw]`` (m, rad);
 - ``placed``: the element's pose at the end of the run, the same way;
 - ``deviation_mm``, ``deviation_deg``: distance of the centres and rotation between the two
-  (:mod:`bt_manip.placing`: a box turned half a turn is the same box);
+  (:mod:`bt_manip.manipulation.placing`: a box turned half a turn is the same box);
 - ``fastened_to``: the structure it is fixed to, or null;
 - ``status``: ``installed`` (fastened within the tolerance), ``out of tolerance`` (fastened
   outside it), ``in hand`` (still attached to the robot), ``not fastened`` (loose within
@@ -22,8 +22,8 @@ import math
 from pathlib import Path
 from typing import Any
 
-from bt_manip.perception import true_pose
-from bt_manip.placing import Target, deviation, yaw_of_matrix
+from bt_manip.manipulation.perception import true_pose
+from bt_manip.manipulation.placing import Target, deviation, yaw_of_matrix
 
 POSITION_TOLERANCE = 0.02
 """Largest distance (m) of an installed element's centre from its planned one."""

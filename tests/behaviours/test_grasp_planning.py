@@ -1,5 +1,5 @@
-"""Grasp frames from an object's box, PlanBaseForGrasp, MoveToPose grasp="top" and
-ObjectUpright."""
+"""PlanBaseForGrasp, MoveToPose grasp="top" and ObjectUpright (the grasp frames themselves:
+tests/manipulation/test_grasps.py)."""
 
 from __future__ import annotations
 
@@ -12,70 +12,10 @@ import pybullet as pb
 import pytest
 from bhelpers import place_robot, reasons, run_xml
 
-from bt_manip.faults import FaultInjector, FaultSpec
-from bt_manip.geometry import pose_matrix, quat_from_euler
-from bt_manip.grasps import GRASP_DEPTH, GraspError, top_grasp
-from bt_manip.perception import perceived_pose, true_pose
+from bt_manip.geometry import quat_from_euler
 from bt_manip.sim.world import World
 
 HERE = Path(__file__).resolve().parent
-PANEL = (1.2, 0.02, 0.15)
-
-
-def _frame(xyz: tuple[float, float, float], rpy: tuple[float, float, float]) -> np.ndarray:
-    return pose_matrix(xyz, quat_from_euler(rpy))
-
-
-def _is_rotation(r: np.ndarray) -> bool:
-    return bool(np.allclose(r.T @ r, np.eye(3), atol=1e-9) and np.isclose(np.linalg.det(r), 1.0))
-
-
-@pytest.mark.parametrize("yaw", [0.0, 0.5236, -1.22693, 2.8])
-def test_top_grasp_of_an_upright_panel_closes_across_its_thickness(yaw: float) -> None:
-    pose = _frame((1.0, -2.0, 0.075), (0.0, 0.0, yaw))
-    g = top_grasp(PANEL, pose, side=(0.0, 1.0), max_opening=0.1)
-    assert _is_rotation(g[:3, :3])
-    np.testing.assert_allclose(g[:3, 2], [0.0, 0.0, -1.0], atol=1e-9)  # from above
-    thickness_axis = pose[:3, 1]  # the panel's 2 cm side
-    assert abs(float(g[:3, 1] @ thickness_axis)) == pytest.approx(1.0)
-    assert abs(float(g[:3, 0] @ pose[:3, 0])) == pytest.approx(1.0)  # x along the panel
-    assert float(g[:2, 0] @ np.array([0.0, 1.0])) >= 0.0
-    # the middle of the top edge, GRASP_DEPTH below it
-    np.testing.assert_allclose(g[:3, 3], [1.0, -2.0, 0.15 - GRASP_DEPTH], atol=1e-9)
-
-
-def test_the_side_picks_one_of_the_two_frames_half_a_turn_apart() -> None:
-    pose = _frame((0.0, 0.0, 0.075), (0.0, 0.0, 0.3))
-    left = top_grasp(PANEL, pose, side=(0.0, 1.0))
-    right = top_grasp(PANEL, pose, side=(0.0, -1.0))
-    np.testing.assert_allclose(right[:3, 0], -left[:3, 0], atol=1e-12)
-    np.testing.assert_allclose(right[:3, 1], -left[:3, 1], atol=1e-12)
-    np.testing.assert_allclose(right[:3, 2:], left[:3, 2:], atol=1e-12)
-
-
-def test_a_leaning_panel_is_approached_along_its_own_up_axis() -> None:
-    lean = math.radians(20)
-    pose = _frame((0.0, 0.0, 0.07), (lean, 0.0, 0.0))  # turned about its long side
-    g = top_grasp(PANEL, pose)
-    up = pose[:3, 2]
-    np.testing.assert_allclose(g[:3, 2], -up, atol=1e-9)
-    np.testing.assert_allclose(g[:3, 3], pose[:3, 3] + up * (0.075 - GRASP_DEPTH), atol=1e-9)
-    assert abs(float(g[:3, 1] @ pose[:3, 1])) == pytest.approx(1.0)
-
-
-def test_a_box_on_its_side_is_taken_by_the_face_now_on_top() -> None:
-    size = (0.3, 0.04, 0.06)
-    pose = _frame((0.0, 0.0, 0.02), (math.pi / 2, 0.0, 0.0))  # local y points up
-    g = top_grasp(size, pose, max_opening=0.1)
-    np.testing.assert_allclose(g[:3, 2], [0.0, 0.0, -1.0], atol=1e-9)
-    # the top face is 0.3 x 0.06: the fingers close across the 6 cm side (local z)
-    assert abs(float(g[:3, 1] @ pose[:3, 2])) == pytest.approx(1.0)
-    np.testing.assert_allclose(g[2, 3], 0.02 + 0.02 - min(GRASP_DEPTH, 0.02), atol=1e-9)
-
-
-def test_a_box_too_wide_for_the_fingers_is_refused_with_the_widths() -> None:
-    with pytest.raises(GraspError, match=r"15\.0 cm across at its narrowest.*open 10\.0 cm"):
-        top_grasp((1.2, 0.15, 0.02), np.eye(4), max_opening=0.1)
 
 
 # -- PlanBaseForGrasp ---------------------------------------------------------------------------
@@ -170,20 +110,6 @@ def test_plan_base_for_grasp_refuses_an_object_the_fingers_cannot_span(
         "cannot grasp 'panel': its top face is 15.0 cm across at its narrowest, and the fingers "
         "open 10.0 cm"
     )
-
-
-def test_plans_read_the_perceived_pose_and_checks_the_true_one(grasp_room: World) -> None:
-    world = grasp_room
-    faults = FaultInjector([FaultSpec("pose_noise", 0.0, sigma_m=0.02, sigma_deg=3.0)], seed=5)
-    offset = faults.pose_offset("panel")
-    assert offset is not None
-    seen = perceived_pose(world, faults, "panel")
-    truth = true_pose(world, world.movable["panel"])
-    np.testing.assert_allclose(seen[:2, 3] - truth[:2, 3], [offset.dx, offset.dy], atol=1e-12)
-    assert seen[2, 3] == truth[2, 3]
-    turn = math.atan2(seen[1, 0], seen[0, 0]) - math.atan2(truth[1, 0], truth[0, 0])
-    assert math.remainder(turn - offset.dyaw, math.tau) == pytest.approx(0.0, abs=1e-9)
-    assert perceived_pose(world, None, "panel").tolist() == truth.tolist()
 
 
 # -- ObjectUpright ------------------------------------------------------------------------------

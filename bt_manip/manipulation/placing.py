@@ -1,4 +1,5 @@
-"""Target poses of placed objects and how far an object is from one.
+"""Target poses of placed objects, how far an object is from one, and where the hand goes to
+put a held object at one.
 
 A place target is the pose an object's centre must take: ``x;y;z;yaw`` (metres, radians; the
 object upright as it stands in the world file, turned by ``yaw`` about the vertical). A box is
@@ -17,13 +18,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bt_manip.manipulation.errors import ManipulationError
+
 TARGET_PARTS = 4
 """Numbers in a target: x;y;z;yaw."""
 MAX_COORDINATE = 1000.0
 """Largest target coordinate (m) accepted."""
 
 
-class TargetError(ValueError):
+class TargetError(ManipulationError, ValueError):
     """A target text that is not x;y;z;yaw; the message says why."""
 
 
@@ -113,3 +116,19 @@ def deviation(pose: np.ndarray, target: Target) -> Deviation:
 def yaw_of_matrix(pose: np.ndarray) -> float:
     """Heading (rad) of a pose's x axis in the horizontal plane."""
     return math.atan2(float(pose[1, 0]), float(pose[0, 0]))
+
+
+def place_frames(target: Target, object_in_grasp: np.ndarray, hand: np.ndarray) -> list[np.ndarray]:
+    """Grasp-frame poses (4x4) that put the object held as ``object_in_grasp`` at ``target``:
+    the two turns of the target, the one nearer the hand's orientation ``hand`` first."""
+    to_grasp = np.linalg.inv(object_in_grasp)
+    frames = [target.matrix(flip) @ to_grasp for flip in (False, True)]
+    frames.sort(key=lambda f: rotation_angle(hand[:3, :3], f[:3, :3]))
+    return frames
+
+
+def lifted(frame: np.ndarray, height: float) -> np.ndarray:
+    """``frame`` moved up by ``height`` (m)."""
+    out = frame.copy()
+    out[2, 3] += height
+    return out

@@ -16,6 +16,22 @@ import numpy as np
 import pybullet as pb
 
 from bt_manip.geometry import pose_matrix
+from bt_manip.manipulation.errors import ManipulationError
+
+
+class PerceptionError(ManipulationError):
+    """The robot cannot see the object asked for; the message says why."""
+
+
+def movable_body(world: Any, name: str) -> int:
+    """PyBullet id of the movable object ``name`` of ``world``; PerceptionError naming the
+    world's movable objects when it has no such object."""
+    movable: dict[str, int] = world.movable
+    if name not in movable:
+        raise PerceptionError(
+            f"no movable object named '{name}'; objects: {', '.join(sorted(movable)) or 'none'}"
+        )
+    return movable[name]
 
 
 def true_pose(world: Any, body: int) -> np.ndarray:
@@ -42,3 +58,10 @@ def perceived_pose(world: Any, faults: Any, name: str) -> np.ndarray:
     seen[0, 3] += offset.dx
     seen[1, 3] += offset.dy
     return seen
+
+
+def seen_pose(world: Any, faults: Any, name: str) -> np.ndarray:
+    """:func:`perceived_pose` of the movable object ``name``; PerceptionError when the world
+    has no such object."""
+    movable_body(world, name)
+    return perceived_pose(world, faults, name)

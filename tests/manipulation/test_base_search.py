@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 import pytest
 
-from bt_manip.behaviours.base_placement import (
+from bt_manip.manipulation.base_search import (
     REJECTIONS,
     Candidate,
     ExtraCheck,
@@ -18,7 +18,7 @@ from bt_manip.behaviours.base_placement import (
     SearchSite,
     search_bases,
 )
-from bt_manip.behaviours.place_base import PLACE_REJECTIONS
+from bt_manip.manipulation.place_search import PLACE_REJECTIONS
 
 RES = 0.05
 ORIGIN = np.array([-2.0, -2.0])

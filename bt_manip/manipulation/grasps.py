@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.manipulation.errors import ManipulationError
+
 GRASPS = ("top",)
 """The grasps :func:`grasp_frame` knows."""
 GRASP_DEPTH = 0.03
@@ -34,7 +36,7 @@ OPENING_MARGIN = 0.01
 """The fingers must open this much (m) wider than the side they close across."""
 
 
-class GraspError(ValueError):
+class GraspError(ManipulationError, ValueError):
     """The object cannot be grasped that way; the message says why."""
 
 
@@ -110,3 +112,12 @@ def box_size(world: Any, name: str) -> tuple[float, float, float]:
     scale = float(getattr(spec, "scale", 1.0))
     sx, sy, sz = (float(v) * scale for v in part.size)
     return (sx, sy, sz)
+
+
+def grasped_object(world: Any, robot: Any) -> str:
+    """Name of the movable object every finger of ``robot`` touches, or ''."""
+    movable: dict[str, int] = world.movable
+    for name, body in movable.items():
+        if robot.is_grasping(body):
+            return name
+    return ""

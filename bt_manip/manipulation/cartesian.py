@@ -1,9 +1,10 @@
-"""Cartesian targets for arm behaviours: IK on the robot's own model, straight-line paths.
+"""Cartesian targets for the arm: IK on the robot's own model, straight-line paths.
 
 Each robot gets one :class:`~bt_manip.kinematics.ArmModel` and solver per tip frame, built from
 the same URDF PyBullet loaded and kept for the run by its
 :class:`~bt_manip.run_context.RobotServices`. Solves are deterministic (no
 wall-clock budget, a bounded number of seeded restarts), so the same run gives the same joints.
+A target the arm cannot reach raises :class:`CartesianError` with IK's reason.
 """
 
 from __future__ import annotations
@@ -12,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.behaviours.base import ActionFailed
 from bt_manip.kinematics import IKSolver, KinematicsError
+from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.run_context import ArmIK, RobotServices
 
 STEP = 0.02
@@ -22,13 +23,17 @@ TURN_STEP = 0.1
 """Largest turn (rad) of the tool between two waypoints of a straight-line move."""
 
 
+class CartesianError(ManipulationError):
+    """The arm has no such chain, or no configuration reaches a pose; the message says why."""
+
+
 def arm_ik(services: RobotServices, tip: str) -> ArmIK:
     """The run's model and solvers of the robot's arm from its base link to ``tip``."""
     try:
         return services.arm_ik(tip)
     except KinematicsError as exc:  # PyBullet loaded the URDF already: a bad tip name
         desc = services.robot.description
-        raise ActionFailed(f"no kinematic chain {desc.arm.base_link} -> {tip}: {exc}") from None
+        raise CartesianError(f"no kinematic chain {desc.arm.base_link} -> {tip}: {exc}") from None
 
 
 def to_arm_base(robot: Any, pose_world: np.ndarray) -> np.ndarray:
@@ -57,7 +62,7 @@ def solve(
     seed: np.ndarray,
     free_yaw: bool = False,
 ) -> np.ndarray:
-    """Joint values putting ``tip`` at ``pose_world``; ActionFailed with IK's reason if none."""
+    """Joint values putting ``tip`` at ``pose_world``; CartesianError with IK's reason if none."""
     pose_base = _world_to_arm_base(services.robot) @ pose_world
     return _solved(_solver(services, tip, free_yaw), pose_base, pose_world, seed)
 
@@ -66,14 +71,14 @@ def _solved(
     solver: IKSolver, pose_base: np.ndarray, pose_world: np.ndarray, seed: np.ndarray
 ) -> np.ndarray:
     """The joints ``solver`` finds for ``pose_base`` (the arm base frame's ``pose_world``);
-    ActionFailed with IK's reason if none."""
+    CartesianError with IK's reason if none."""
     q = solver.solve_q(pose_base, seed)  # the usual case: the attempt from the seed succeeds
     if q is not None:
         return q
     result = solver.solve(pose_base, q_seed=seed)
     if not result.success:
         where = ", ".join(f"{v:.3f}" for v in pose_world[:3, 3])
-        raise ActionFailed(f"no arm configuration reaches ({where}): {result.reason}")
+        raise CartesianError(f"no arm configuration reaches ({where}): {result.reason}")
     return np.asarray(result.q, dtype=float)
 
 
