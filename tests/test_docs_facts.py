@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from bt_manip.sim.world_spec import parse_world
+from bt_manip.sim.world_reader import parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -12,7 +12,7 @@ from bt_manip import bundled
 from bt_manip.cli import main
 from bt_manip.sim import assets
 from bt_manip.sim.robot_description import ROBOTS_DIR
-from bt_manip.sim.world_spec import parse_world
+from bt_manip.sim.world_reader import parse_world
 
 ROOT = Path(__file__).resolve().parents[1]
 

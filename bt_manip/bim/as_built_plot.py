@@ -67,7 +67,7 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
     from matplotlib import cm, colors
 
     from bt_manip.geometry import yaw_of
-    from bt_manip.sim.world_spec import parse_world
+    from bt_manip.sim.world_reader import parse_world
 
     spec = parse_world(world_path)
     sizes = {o.name: o.parts[0].size for o in spec.objects if o.parts}

@@ -510,6 +510,6 @@ def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
 
 def _check_world(path: Path) -> None:
     """The written world must load: a problem here is bt-manip's, reported as such."""
-    from bt_manip.sim.world_spec import parse_world
+    from bt_manip.sim.world_reader import parse_world
 
     parse_world(path)

@@ -18,21 +18,22 @@ members keep their poses relative to each other exactly. A member belongs to one
 most and cannot have a ``randomize`` of its own. A name that is both a body and a named pose
 moves both.
 
-:func:`parse_groups` checks the entries (each problem with its file and line);
-:func:`place_groups` returns the world spec with every group moved for one seed.
+:func:`parse_groups` checks the entries (each problem with its file and line) into
+:class:`~bt_manip.sim.world_spec.GroupSpec` records;
+:func:`bt_manip.sim.randomize.place_groups` returns the world spec with every group moved for
+one seed.
 """
 
 from __future__ import annotations
 
 import difflib
 import math
-from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from bt_manip.sim.world_spec import BodySpec, Pose2D, Pose3D, Range2D
+from bt_manip.sim.world_spec import BodySpec, GroupSpec, Range2D, WorldSpec
 
 if TYPE_CHECKING:
-    from bt_manip.sim.world_spec import WorldSpec, _Reader
+    from bt_manip.sim.world_reader import _Reader
     from bt_manip.sim.yaml_lines import LineDict, LineList
 
 GROUP_KEYS = {"name", "members", "origin", "move", "randomize"}
@@ -43,73 +44,6 @@ MAX_TURN = 2.0 * math.pi
 """Largest turn (rad) a group's ``move`` or ``randomize`` may give."""
 MAX_MEMBERS = 1000
 """Members a group may list at most."""
-
-
-@dataclass(frozen=True)
-class Rigid2D:
-    """A planar rigid motion: turn by ``dyaw`` about ``origin``, then shift by (dx, dy)."""
-
-    origin: tuple[float, float]
-    dx: float = 0.0
-    dy: float = 0.0
-    dyaw: float = 0.0
-
-    def point(self, x: float, y: float) -> tuple[float, float]:
-        """Where the point (x, y) goes."""
-        ox, oy = self.origin
-        c, s = math.cos(self.dyaw), math.sin(self.dyaw)
-        rx, ry = x - ox, y - oy
-        return ox + c * rx - s * ry + self.dx, oy + s * rx + c * ry + self.dy
-
-    def pose2d(self, pose: Pose2D) -> Pose2D:
-        """A planar pose moved: its point moved, its heading turned."""
-        x, y = self.point(pose.x, pose.y)
-        return Pose2D(x, y, pose.yaw + self.dyaw)
-
-    def pose3d(self, pose: Pose3D) -> Pose3D:
-        """A full pose moved: position moved in x and y (z kept), orientation turned about
-        the world's z axis."""
-        x, y = self.point(pose.xyz[0], pose.xyz[1])
-        half = self.dyaw / 2.0
-        qz = (0.0, 0.0, math.sin(half), math.cos(half))
-        return Pose3D((x, y, pose.xyz[2]), _quat_mul(qz, pose.quat))
-
-    def is_identity(self) -> bool:
-        return self.dx == 0.0 and self.dy == 0.0 and self.dyaw == 0.0
-
-
-def _quat_mul(
-    a: tuple[float, float, float, float], b: tuple[float, float, float, float]
-) -> tuple[float, float, float, float]:
-    """Hamilton product a * b of quaternions (x, y, z, w): rotate by b, then by a."""
-    ax, ay, az, aw = a
-    bx, by, bz, bw = b
-    return (
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-        aw * bw - ax * bx - ay * by - az * bz,
-    )
-
-
-@dataclass(frozen=True)
-class GroupSpec:
-    """One ``groups:`` entry, checked: its members, pivot, fixed move and random ranges."""
-
-    name: str
-    members: tuple[str, ...]
-    origin: tuple[float, float]
-    move: tuple[float, float, float]
-    randomize: Range2D
-    line: int
-
-    def transform(self, seed: int) -> Rigid2D:
-        """The group's rigid motion for a world seed: ``move`` plus the seeded offsets."""
-        from bt_manip.sim.world import entity_rng, sample_offset
-
-        rx, ry, ryaw = sample_offset(entity_rng(seed, self.name), self.randomize)
-        dx, dy, dyaw = self.move
-        return Rigid2D(self.origin, dx + rx, dy + ry, dyaw + ryaw)
 
 
 def parse_groups(rd: _Reader, data: LineDict, spec: WorldSpec) -> list[GroupSpec]:
@@ -260,34 +194,3 @@ def _check_ranges(rd: _Reader, d: LineDict, where: str, r: Range2D) -> None:
         if abs(lo) > bound or abs(hi) > bound:
             rd.fail(lines.line_of(key), f"{where}.randomize.{key} must lie within "
                     f"+-{bound:.4g} {unit}, got [{lo}, {hi}]")
-
-
-def place_groups(spec: WorldSpec, seed: int) -> tuple[WorldSpec, dict[str, Rigid2D]]:
-    """``spec`` with every group's members moved by the group's transform for ``seed``
-    (``spec`` itself when it has no groups), and each group's transform by name."""
-    groups: list[GroupSpec] = spec.groups
-    if not groups:
-        return spec, {}
-    moves: dict[str, Rigid2D] = {}
-    by_member: dict[str, Rigid2D] = {}
-    for group in groups:
-        t = group.transform(seed)
-        moves[group.name] = t
-        by_member.update(dict.fromkeys(group.members, t))
-
-    def body(b: BodySpec) -> BodySpec:
-        t = by_member.get(b.name)
-        return b if t is None else replace(b, pose=t.pose3d(b.pose))
-
-    poses = {
-        name: (by_member[name].pose2d(p) if name in by_member else p)
-        for name, p in spec.poses.items()
-    }
-    placed = replace(
-        spec,
-        furniture=[body(b) for b in spec.furniture],
-        objects=[body(b) for b in spec.objects],
-        models=[body(b) for b in spec.models],
-        poses=poses,
-    )
-    return placed, moves

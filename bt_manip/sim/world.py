@@ -1,15 +1,16 @@
 """The World: a world file built into a PyBullet simulation with its own clock.
 
-``World(path, seed=...)`` reads a world file (:mod:`bt_manip.sim.world_spec`), connects a private
+``World(path, seed=...)`` reads a world file (:mod:`bt_manip.sim.world_reader`), connects a private
 PyBullet client in DIRECT mode, builds walls, furniture, movable objects and robots, and then
 only moves when :meth:`World.step` is called. The sim clock advances by one physics period per
 step, so everything timed against it is independent of the wall clock, and the same seed gives
 the same run bit for bit.
 
-Randomisation: each object or robot with a ``randomize`` range gets offsets drawn from a
-generator seeded by (world seed, entity name), so adding an entity does not change the others.
-Groups (:mod:`bt_manip.sim.groups`) move their members, named poses included, by one rigid
-motion per seed before anything is built; ``World.spec`` is the world file so placed.
+Randomisation (:mod:`bt_manip.sim.randomize`): each object or robot with a ``randomize`` range
+gets offsets drawn from a generator seeded by (world seed, entity name), so adding an entity does
+not change the others. Groups (:mod:`bt_manip.sim.groups`) move their members, named poses
+included, by one rigid motion per seed before anything is built; ``World.spec`` is the world
+file so placed.
 
 Movable objects at rest sleep (see :data:`SLEEP_THRESHOLD`): Bullet leaves them out of the
 solver until a moving body touches them or is fixed to them, and removing a body wakes them all.
@@ -19,7 +20,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-import zlib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -33,17 +33,11 @@ from bt_manip.geometry import euler_from_quat, quat_from_euler, quat_from_yaw, r
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.attach import Attachments
 from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
+from bt_manip.sim.randomize import Rigid2D, entity_rng, place_groups, sample_offset
+from bt_manip.sim.robot import Robot, RobotDescription
 from bt_manip.sim.static_bodies import make_static
-from bt_manip.sim.world_spec import (
-    BodySpec,
-    Part,
-    Pose2D,
-    Pose3D,
-    Range2D,
-    WallSpec,
-    WorldSpec,
-    parse_world,
-)
+from bt_manip.sim.world_reader import parse_world
+from bt_manip.sim.world_spec import BodySpec, Part, Pose2D, Pose3D, WallSpec, WorldSpec
 
 OVERLAP_TOLERANCE = 0.002
 """Penetration (m) between two bodies at spawn beyond which they are reported as overlapping."""
@@ -63,16 +57,6 @@ class BodyInfo:
     kind: str  # "ground" | "wall" | "furniture" | "object" | "robot"
     spec: Any
     line: int
-
-
-def sample_offset(rng: np.random.Generator, r: Range2D) -> tuple[float, float, float]:
-    """Offsets (dx, dy, dyaw) drawn uniformly from the ranges of ``r``."""
-    return (float(rng.uniform(*r.x)), float(rng.uniform(*r.y)), float(rng.uniform(*r.yaw)))
-
-
-def entity_rng(seed: int, name: str) -> np.random.Generator:
-    """The random generator of one named entity for one world seed."""
-    return np.random.default_rng([int(seed) & 0xFFFFFFFF, zlib.crc32(name.encode())])
 
 
 def _half(part: Part) -> list[float]:
@@ -110,8 +94,6 @@ class World:
     """
 
     def __init__(self, path: str | Path, seed: int = 0, *, gui: bool = False) -> None:
-        from bt_manip.sim.groups import Rigid2D, place_groups
-
         self.spec: WorldSpec
         self.group_moves: dict[str, Rigid2D]
         """Each group's rigid motion for this seed (the spec's members are already moved)."""
@@ -340,8 +322,6 @@ class World:
         return int(body)
 
     def _make_robot(self, rspec: Any) -> Any:
-        from bt_manip.sim.robot import Robot, RobotDescription
-
         desc = RobotDescription.load(rspec.description_path)
         dx, dy, dyaw = sample_offset(entity_rng(self.seed, rspec.name), rspec.randomize)
         pose = rspec.pose

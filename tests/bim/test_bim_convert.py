@@ -16,7 +16,7 @@ from ifc_buildings import PANELS, Panel, three_rooms
 
 from bt_manip.bim.convert import BimOptions, convert
 from bt_manip.cli import main
-from bt_manip.sim.world_spec import parse_world
+from bt_manip.sim.world_reader import parse_world
 
 
 @pytest.fixture(scope="module")

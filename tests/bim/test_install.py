@@ -243,7 +243,7 @@ def test_the_stock_moves_as_one_per_seed(two_panels):
 
 
 def test_office_panels_cross_the_door_straight(tmp_path):
-    from bt_manip.sim.world_spec import parse_world
+    from bt_manip.sim.world_reader import parse_world
 
     ifc = three_rooms().write(tmp_path / "b.ifc")
     conversion = convert(BimOptions(ifc, tmp_path / "out"))

@@ -18,7 +18,7 @@ from bt_manip.nav2.path import Nav2Path
 from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 from bt_manip.sim.world import World
-from bt_manip.sim.world_spec import parse_world
+from bt_manip.sim.world_reader import parse_world
 
 ROOM = Path(__file__).resolve().parent / "room.yaml"
 

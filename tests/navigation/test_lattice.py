@@ -14,13 +14,11 @@ from bt_manip.navigation.lattice import (
     BACKWARD,
     TURN,
     LatticeOptions,
-    _GoalField,
-    _heuristic,
-    _move,
     clearance_at_least,
     outline_samples,
     plan_poses,
 )
+from bt_manip.navigation.lattice_search import GoalField, _heuristic, _move
 from bt_manip.navigation.shapes import Disc
 
 
@@ -110,11 +108,11 @@ def test_goal_field_computed_on_demand_equals_the_whole_search() -> None:
         rows, cols = (int(v) for v in rng.integers(2, 50, 2))
         free = rng.random((rows, cols)) > float(rng.choice([0.0, 0.1, 0.3, 0.5]))
         goal = (int(rng.integers(rows)), int(rng.integers(cols)))
-        whole = _GoalField(free, goal).whole()
+        whole = GoalField(free, goal).whole()
         ref = reference_goal_distances(free, goal) if free[goal] else np.full(free.shape, np.inf)
         assert np.array_equal(np.isinf(whole), np.isinf(ref))
         assert np.allclose(whole[np.isfinite(ref)], ref[np.isfinite(ref)], rtol=1e-12, atol=0)
-        lazy = _GoalField(free, goal)
+        lazy = GoalField(free, goal)
         for _ in range(40):  # queries in any order get the final distance at once
             r, c = int(rng.integers(rows)), int(rng.integers(cols))
             h, lazy.heap_d, lazy.heap_i = _heuristic(

@@ -117,7 +117,7 @@ def test_sim_clock_follows_steps() -> None:
 
 def test_solver_tolerance_is_read_and_bounded(tmp_path: Path) -> None:
     from bt_manip.errors import InputError
-    from bt_manip.sim.world_spec import parse_world
+    from bt_manip.sim.world_reader import parse_world
 
     ok = tmp_path / "ok.yaml"
     ok.write_text("name: ok\nphysics: {solver_tolerance: 0.01}\n")

@@ -11,9 +11,10 @@ import pytest
 
 from bt_manip.cli import main
 from bt_manip.errors import InputError
-from bt_manip.sim.groups import Rigid2D, place_groups
+from bt_manip.sim.randomize import Rigid2D, place_groups
 from bt_manip.sim.world import World
-from bt_manip.sim.world_spec import Pose2D, parse_world
+from bt_manip.sim.world_reader import parse_world
+from bt_manip.sim.world_spec import Pose2D
 
 ROOT = Path(__file__).resolve().parents[2]
 

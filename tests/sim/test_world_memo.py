@@ -11,7 +11,7 @@ import pytest
 
 from bt_manip.errors import InputError
 from bt_manip.sim.world import World
-from bt_manip.sim.world_spec import parse_world
+from bt_manip.sim.world_reader import parse_world
 
 ROOT = Path(__file__).resolve().parents[2]
 TRIANGLE = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"

@@ -8,7 +8,8 @@ from pathlib import Path
 import pytest
 
 from bt_manip.cli import main
-from bt_manip.sim.world_spec import WORLD_SCHEMA_VERSION, parse_world
+from bt_manip.sim.world_reader import parse_world
+from bt_manip.sim.world_spec import WORLD_SCHEMA_VERSION
 
 ROOM = """\
 name: versioned
