@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from bt_manip.errors import InputError
+from bt_manip.outputs import check_output_folder, make_folder
 from bt_manip.sim.assets import DATA_FOLDERS, data_root
 
 __all__ = [
@@ -77,8 +78,6 @@ def copy_examples(destination: str | Path, overwrite: bool = False) -> list[Path
     overwritten is an :class:`InputError` naming it, unless ``overwrite``; nothing is copied
     then. The copied worlds find the copied robots (``../robots/`` from a world).
     """
-    from bt_manip.outputs import check_output_folder, make_folder
-
     dest = check_output_folder("examples copy", destination)
     root = data_root()
     pairs = [(src, dest / src.relative_to(root))

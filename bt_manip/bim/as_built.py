@@ -24,6 +24,7 @@ from typing import Any
 
 from bt_manip.manipulation.perception import true_pose
 from bt_manip.manipulation.placing import Target, deviation, yaw_of_matrix
+from bt_manip.sim.fasteners import fastenings
 
 POSITION_TOLERANCE = 0.02
 """Largest distance (m) of an installed element's centre from its planned one."""
@@ -59,8 +60,6 @@ def _pose_list(pose: Any) -> list[float]:
 
 def as_built(world: Any, schedule: dict[str, Any]) -> list[dict[str, Any]]:
     """The table (see the module docstring) for the elements of ``schedule`` in ``world``."""
-    from bt_manip.sim.fasteners import fastenings
-
     fixed = fastenings(world)
     rows = []
     for e in schedule["elements"]:

@@ -15,6 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError
+from bt_manip.geometry import yaw_of
+from bt_manip.sim.world_reader import parse_world
 
 MAX_REPORT_BYTES = 64 * 1024 * 1024
 """Largest report read."""
@@ -65,9 +67,6 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib import cm, colors
-
-    from bt_manip.geometry import yaw_of
-    from bt_manip.sim.world_reader import parse_world
 
     spec = parse_world(world_path)
     sizes = {o.name: o.parts[0].size for o in spec.objects if o.parts}

@@ -21,7 +21,8 @@ from typing import Any
 
 import yaml
 
-from bt_manip.bim.building import Building, Names, choose_storey, read_building
+from bt_manip.bim import require_ifcopenshell
+from bt_manip.bim.building import Building, Names, choose_storey, read_building, storey_of
 from bt_manip.bim.doorways import crossings, door_poses
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
@@ -49,6 +50,9 @@ from bt_manip.bim.stock import (
 )
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.errors import InputError
+from bt_manip.outputs import check_output_folder, make_folder
+from bt_manip.sim.robot_description import RobotDescription, find_descriptor
+from bt_manip.sim.world_reader import parse_world
 
 DEFAULT_DENSITY = 420.0
 """Mass density (kg/m3) of an element whose material gives none: a light board, like Scenario
@@ -134,10 +138,6 @@ def _count(n: int, noun: str) -> str:
 
 def convert(options: BimOptions) -> Conversion:
     """Read the building, check it, write the world and the schedule; InputError on problems."""
-    from bt_manip.bim import require_ifcopenshell
-    from bt_manip.outputs import check_output_folder, make_folder
-    from bt_manip.sim.robot_description import RobotDescription, find_descriptor
-
     require_ifcopenshell()
     check_output_folder("--out", options.out)
     descriptor = find_descriptor(options.robot)
@@ -293,8 +293,6 @@ def _elements(
 ) -> list[InstallElement]:
     """Target pose, size and mass of each element to install (on ``storey``)."""
     import ifcopenshell.util.element as util
-
-    from bt_manip.bim.building import storey_of
 
     reader = ShapeReader(source.scale)
     single = len(source.model.by_type("IfcBuildingStorey")) == 1
@@ -510,6 +508,4 @@ def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
 
 def _check_world(path: Path) -> None:
     """The written world must load: a problem here is bt-manip's, reported as such."""
-    from bt_manip.sim.world_reader import parse_world
-
     parse_world(path)

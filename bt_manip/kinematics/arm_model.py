@@ -28,6 +28,8 @@ from typing import cast
 import numpy as np
 import pinocchio as pin
 
+from bt_manip.kinematics.compiled import cache_dir
+
 
 class KinematicsError(ValueError):
     """A robot description that cannot serve as an arm (bad link names, unsupported joints)."""
@@ -302,8 +304,6 @@ _REACH_VERSION = b"reach-1:16-starts:rng-12345:"
 
 
 def _reach_file(key: bytes) -> Path:
-    from bt_manip.kinematics.compiled import cache_dir
-
     digest = hashlib.sha256(_REACH_VERSION + key).hexdigest()[:32]
     return cache_dir() / "reach" / f"{digest}.txt"
 
