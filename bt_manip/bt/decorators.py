@@ -11,7 +11,7 @@ from typing import Any, ClassVar, cast
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.context import TIME_EPS
-from bt_manip.bt.node import BtNode, DecoratorNode, PortError
+from bt_manip.bt.node import BtNode, DecoratorNode, PortError, TreeRuntimeError, _truth
 from bt_manip.bt.ports import NON_NEGATIVE, Port, Ref
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
@@ -353,8 +353,6 @@ class _ScriptHolder:
             try:
                 self._script = parse_script(text)
             except ScriptSyntaxError as e:
-                from bt_manip.bt.node import TreeRuntimeError
-
                 raise TreeRuntimeError(
                     f"{node.describe()}: script in '{port}' (column {e.column}): {e.message}"
                 ) from None
@@ -388,8 +386,6 @@ class Precondition(DecoratorNode):
         otherwise = self.get_input("else")
         if not self._child_running:
             script = self._script.get(self, "if")
-            from bt_manip.bt.node import _truth
-
             self._child_running = _truth(self, "if", script)
         if not self._child_running:
             return cast(NodeStatus, otherwise)  # the "else" port holds a NodeStatus

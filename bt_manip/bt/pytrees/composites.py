@@ -1,9 +1,10 @@
 """py_trees' composites and decorators as bt-manip nodes, with py_trees' semantics.
 
-:func:`bt_manip.bt.from_py_trees` uses a BehaviorTree.CPP built-in where it ticks like the
-py_trees node, and these nodes otherwise (``PyTreesSequence``, ``PyTreesRepeat``, ...). Each
-runs py_trees' own tick logic (``py_trees.composites.Sequence.tick`` and so on), so it does
-exactly what py_trees does, tick by tick:
+:func:`bt_manip.bt.from_py_trees` (:mod:`bt_manip.bt.pytrees.convert`) uses a
+BehaviorTree.CPP built-in where it ticks like the py_trees node, and these nodes otherwise
+(``PyTreesSequence``, ``PyTreesRepeat``, ...). Each runs py_trees' own tick logic
+(``py_trees.composites.Sequence.tick`` and so on), so it does exactly what py_trees does, tick
+by tick:
 
 - its children keep their status after they finish (py_trees parents stop them with INVALID
   when they start again, which runs a RUNNING child's ``terminate(INVALID)``);
@@ -11,8 +12,9 @@ exactly what py_trees does, tick by tick:
 - halted (by a BT.CPP parent or ``Tree.halt()``) it is stopped as py_trees stops it.
 
 They are registered (not as built-ins), so ``to_xml()`` writes them with their ports and a
-TreeNodesModel that declares them, and the XML loads back. Durations (``PyTreesTimeout``,
-``PyTreesTimer``) read the tree's clock: the simulation clock under a world.
+TreeNodesModel that declares them, and the XML loads back. Durations (``PyTreesTimeout``, and
+``PyTreesTimer`` in :mod:`bt_manip.bt.pytrees.leaf`) read the tree's clock: the simulation
+clock under a world.
 """
 
 from __future__ import annotations
@@ -26,16 +28,9 @@ import py_trees
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt.node import (
-    AttributeCheck,
-    BtNode,
-    ControlNode,
-    DecoratorNode,
-    LeafNode,
-    TreeRuntimeError,
-    _truth,
-)
-from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage, raised_as_tree_error
+from bt_manip.bt.attributes import AttributeCheck
+from bt_manip.bt.node import BtNode, ControlNode, DecoratorNode, TreeRuntimeError, _truth
+from bt_manip.bt.pytrees.storage import EntryView, py_trees_storage, raised_as_tree_error
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script
 from bt_manip.bt.status import STATUS_OF_PY_TREES, NodeStatus
@@ -500,34 +495,6 @@ class PyTreesForEach(_ClientDecorator):
     def terminate(self, new_status: Status) -> None:
         self._items = None
         self._current = None
-
-
-# ---------------------------------------------------------------------- leaves
-
-
-@registry.register
-class PyTreesTimer(LeafNode):
-    """py_trees' ``Timer`` on the tree's clock: RUNNING until more than ``duration`` seconds
-    have passed since it started, then SUCCESS."""
-
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
-        "duration": PortInformation(float, description="seconds", default_value=5.0)}
-
-    def __init__(self, name: str | None = None, **attributes: Any) -> None:
-        super().__init__(name, **attributes)
-        self.duration = float(self.get_input("duration"))
-        self.finish_time = 0.0
-
-    def initialise(self) -> None:
-        self.finish_time = self.now() + self.duration
-        self.feedback_message = f"configured to fire in '{self.duration}' seconds"
-
-    def update(self) -> Status:
-        if self.now() > self.finish_time:
-            self.feedback_message = f"timer ran out [{self.duration}]"
-            return Status.SUCCESS
-        self.feedback_message = "still running"
-        return Status.RUNNING
 
 
 # py_trees' display and dot export pick their glyphs and shapes by isinstance.
