@@ -89,10 +89,11 @@ class BtNode(PortsMixin):
     DESCRIPTION: ClassVar[str] = ""
     MIN_CHILDREN: ClassVar[int] = 0
     MAX_CHILDREN: ClassVar[int | None] = 0
-    # "py_trees stub" below: py_trees annotates the two as instance attributes, though they are
-    # class-level declarations, and mypy lets no ClassVar override an instance attribute.
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
+    # py_trees' PortsMixin annotates the two as instance attributes, though every node class
+    # declares them at class level: mypy lets no ClassVar override an instance attribute, so
+    # port declarations go without ClassVar (ruff's RUF012 is off for them, pyproject.toml).
+    INPUT_PORTS: dict[str, PortInformation] = {}
+    OUTPUT_PORTS: dict[str, PortInformation] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     started_order: int = 0
     failure_order: int = 0

@@ -85,7 +85,7 @@ class _PyTreesComposite(_PyTreesNode, ControlNode):
 class _MemoryComposite(_PyTreesComposite):
     """A py_trees composite with the ``memory`` flag (``Sequence``, ``Selector``)."""
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "memory": PortInformation(bool, description="resume from the RUNNING child",
                                   default_value=False)}
 
@@ -134,7 +134,7 @@ class PyTreesParallel(_PyTreesComposite):
     """
 
     PY = py_trees.composites.Parallel
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "policy": PortInformation(str, description="SuccessOnAll, SuccessOnOne or "
                                                    "SuccessOnSelected",
                                   default_value="SuccessOnAll"),
@@ -236,7 +236,7 @@ class PyTreesRepeat(_PyTreesDecorator):
     RUNNING gives RUNNING. One cycle per tick."""
 
     PY = py_trees.decorators.Repeat
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "num_success": PortInformation(int, description="successes needed; -1 repeats forever")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -252,7 +252,7 @@ class PyTreesRetry(_PyTreesDecorator):
     FAILURE); child SUCCESS gives SUCCESS; RUNNING gives RUNNING. One attempt per tick."""
 
     PY = py_trees.decorators.Retry
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "num_failures": PortInformation(int, description="failures before giving up")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -269,7 +269,7 @@ class PyTreesTimeout(_PyTreesDecorator):
     otherwise returns the child's status."""
 
     PY = py_trees.decorators.Timeout
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "duration": PortInformation(float, description="seconds", default_value=5.0)}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -320,7 +320,7 @@ class PyTreesOneShot(_PyTreesDecorator):
     status for ever without ticking the child."""
 
     PY = py_trees.decorators.OneShot
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "policy": PortInformation(str, description="ON_COMPLETION or ON_SUCCESSFUL_COMPLETION",
                                   default_value="ON_COMPLETION")}
 
@@ -346,7 +346,7 @@ class PyTreesCondition(_PyTreesDecorator):
     ``status``, RUNNING otherwise."""
 
     PY = py_trees.decorators.Condition
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "status": PortInformation(NodeStatus, description="child status that means SUCCESS",
                                   default_value=NodeStatus.SUCCESS)}
 
@@ -372,7 +372,7 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
     ``variable_name`` after each tick and returns it."""
 
     PY = py_trees.decorators.StatusToBlackboard
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "variable_name": PortInformation(str, description="entry to write the status to")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -398,7 +398,7 @@ class PyTreesEternalGuard(_ClientDecorator):
     """
 
     PY = py_trees.decorators.EternalGuard
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "condition": PortInformation(object, description="script (XML) or Python callable"),
         "blackboard_keys": PortInformation(list[str], required=False,
                                            description="entries a Python condition reads"),
@@ -450,7 +450,7 @@ class PyTreesForEach(_ClientDecorator):
     returned as is."""
 
     PY = py_trees.decorators.ForEach
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "source_key": PortInformation(str, description="entry holding the items"),
         "target_key": PortInformation(str, description="entry receiving the current item"),
     }

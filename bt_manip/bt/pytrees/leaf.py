@@ -242,7 +242,7 @@ class PyTreesTimer(LeafNode):
     """py_trees' ``Timer`` on the tree's clock: RUNNING until more than ``duration`` seconds
     have passed since it started, then SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "duration": PortInformation(float, description="seconds", default_value=5.0)}
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
