@@ -153,6 +153,7 @@ def _checked_attributes(cls: type[BtNode], attributes: Mapping[str, Any]) -> Att
                  f"{_describe(info)}; add {port}=\"...\"", None))
     return check
 
+
 def _bind_port(
     cls: type[BtNode], port: str, value: Any, info: PortInformation, check: AttributeCheck
 ) -> None:
@@ -204,6 +205,7 @@ def _bind_port(
         return
     check.bindings[port] = Literal(value)
     check.texts[port] = format_literal(value)
+
 
 def _describe(info: PortInformation) -> str:
     return f" ({info.description})" if info.description else ""

@@ -80,7 +80,6 @@ class PortError(TreeRuntimeError):
     """An input port has no usable value, or an output port cannot be written."""
 
 
-
 class BtNode(PortsMixin):
     """Mixin giving a py_trees behaviour BT.CPP's node protocol (see the module docstring)."""
 

@@ -215,4 +215,3 @@ def port_info(p: Param) -> PortInformation:
     except TypeError:
         return PortInformation(object, required=p.required, description=description,
                                default_value=default)
-

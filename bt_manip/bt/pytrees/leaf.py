@@ -233,7 +233,6 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
     return wrapper
 
 
-
 # ---------------------------------------------------------------------- clock readers
 
 
