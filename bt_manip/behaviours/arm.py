@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 import operator
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, ClassVar
+from typing import TYPE_CHECKING
 
 import numpy as np
 from py_trees.common import Status
@@ -75,7 +75,7 @@ class JointMove(RobotAction):
 
     CARRIES = True
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "units": UNITS,
         "tolerance": TOLERANCE,
@@ -211,7 +211,7 @@ class MoveJointsSequentially(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
         "order": Port(
@@ -248,7 +248,7 @@ class MoveJoints(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(list[float], False, "joint targets (or use state)", []),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
@@ -290,7 +290,7 @@ class Lift(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "deltas": PortInformation(list[float], False, "change of each arm joint", []),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
@@ -353,7 +353,7 @@ class MoveToPose(JointMove):
     Halted: the arm holds where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),

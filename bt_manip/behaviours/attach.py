@@ -6,8 +6,6 @@ The joint is made only when the object touches a finger or is within ``max_dista
 
 from __future__ import annotations
 
-from typing import ClassVar
-
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
@@ -28,7 +26,7 @@ class Attach(RobotAction):
       gives the distance), unknown, or already attached.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
         "link": PortInformation(str, False, "robot link to attach to (default: end effector)", ""),
@@ -58,7 +56,7 @@ class Detach(RobotAction):
     - FAILURE when it was not attached.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
     }

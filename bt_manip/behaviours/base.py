@@ -158,7 +158,7 @@ class RobotAction(WorldAccess, ActionNode):
       cancelled.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {"robot": ROBOT_PORT}
     CARRIES: ClassVar[bool] = False
     """Moves what the robot holds: a ``slip`` fault may make it let go on the way."""
 

@@ -7,7 +7,7 @@ writes the base pose it found; a search that finds none, or cannot start, is its
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -56,7 +56,7 @@ class PlanBaseForGrasp(RobotAction):
     and halting has nothing to undo.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "object": PortInformation(str, True, "name of a movable object of the world"),
         "grasp": Port(str, False, "grasp of the object: top", "top", Accepts(choices=GRASPS)),
@@ -74,7 +74,7 @@ class PlanBaseForGrasp(RobotAction):
             Accepts(0.2, 2.0),
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "base_pose": BASE_POSE,
         "staging_pose": STAGING_POSE,
         "grasp_pose": PortInformation(str, False, "grasp frame x;y;z;qx;qy;qz;qw (world)"),

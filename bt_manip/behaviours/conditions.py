@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-from typing import ClassVar
 
 import numpy as np
 import pybullet as pb
@@ -24,7 +23,7 @@ OBJECT = PortInformation(str, True, "name of a movable object of the world")
 class IsAttached(WorldCondition):
     """SUCCESS when ``object`` is held by an attach joint (of ``robot``, if given), else FAILURE."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT, "robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {"object": OBJECT, "robot": ROBOT_PORT}
 
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")
@@ -40,7 +39,7 @@ class IsHolding(WorldCondition):
     """SUCCESS when the gripper holds ``object`` (every finger touches it, or it is attached);
     with ``object`` empty, when it holds anything. FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "object": PortInformation(str, False, "object name (empty: any object)", ""),
         "robot": ROBOT_PORT,
     }
@@ -68,7 +67,7 @@ class ObjectInRegion(WorldCondition):
     as ``x;y;z``.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "object": OBJECT,
         "inside": PortInformation(str, False, "body whose box is the region", ""),
         "min": Port(list[float], False, "lower corner x;y;z", [], count_of(0, 3)),
@@ -100,7 +99,7 @@ class ObjectInRegion(WorldCondition):
 class ObjectAbove(WorldCondition):
     """SUCCESS when the lowest point of ``object`` is at least ``height`` m above the floor."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "object": OBJECT,
         "height": Port(float, False, "clearance above the floor (m)", 0.1, NON_NEGATIVE),
     }
@@ -120,7 +119,7 @@ class CarriedClear(WorldCondition):
     """SUCCESS when ``object`` has touched no wall, furniture or floor while attached, since
     it was last attached; FAILURE naming what it touched (or when it is not attached)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"object": OBJECT}  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {"object": OBJECT}
 
     def check(self) -> tuple[bool, str]:
         name = self.get_input("object")
@@ -156,7 +155,7 @@ class ObjectUpright(WorldCondition):
     it has been tilted and moving for ``settle`` sim seconds, when it is judged as it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "object": OBJECT,
         "max_tilt": Port(float, False, "largest tilt that counts as upright (deg)", 30.0,
                          Accepts(0.0, 90.0)),

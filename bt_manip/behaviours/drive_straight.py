@@ -10,7 +10,6 @@ while a path follower corrects its heading at the goal.
 from __future__ import annotations
 
 import math
-from typing import ClassVar
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -52,7 +51,7 @@ class DriveStraight(RobotAction):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "goal": PortInformation(str, True, "pose x;y;yaw or a named pose of the world"),
         "speed": Port(float, False, "driving speed (m/s)", 0.15, Accepts(0.0, 1.0, low_open=True)),

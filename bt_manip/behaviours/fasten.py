@@ -9,8 +9,6 @@ then opens the gripper and detaches: the object stays where it was fastened.
 
 from __future__ import annotations
 
-from typing import ClassVar
-
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
@@ -45,7 +43,7 @@ class Fasten(RobotAction):
     undo.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "object": PortInformation(str, True, "name of a movable object of the world"),
         "target": TARGET,
@@ -56,7 +54,7 @@ class Fasten(RobotAction):
             Accepts(0.0, 0.05),
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "fastened_to": PortInformation(str, False, "the structure the object is fixed to"),
     }
 

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import ClassVar
 
 import numpy as np
 from py_trees.common import Status
@@ -87,7 +86,7 @@ class GetClear(RobotAction):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "distance": Port(
             float, False, "clearance to reach (m)", 0.5, Accepts(low=0, high=5, low_open=True)

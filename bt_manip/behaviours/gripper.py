@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -27,7 +27,7 @@ TIME_EPS = 1e-9
 class _GripperMove(RobotAction):
     """Command an opening, then wait until the fingers stop moving."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "timeout": Port(float, False, "sim seconds allowed", 3.0, POSITIVE),
     }
@@ -77,7 +77,7 @@ class OpenGripper(_GripperMove):
     - FAILURE if they are still moving after ``timeout`` s.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **_GripperMove.INPUT_PORTS,
         "opening": Port(
             float, False, "opening between the pads (m); -1 = fully", -1.0, OPENING
@@ -98,7 +98,7 @@ class CloseGripper(_GripperMove):
     - FAILURE if ``require_object`` is true and the fingers closed on nothing, or on a time-out.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **_GripperMove.INPUT_PORTS,
         "opening": Port(
             float, False, "target opening (m); -1 = fully closed", -1.0, OPENING
@@ -107,7 +107,7 @@ class CloseGripper(_GripperMove):
             bool, False, "fail when nothing is between the fingers", False
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "holding": PortInformation(bool, False, "an object is between the fingers"),
         "object": PortInformation(str, False, "name of the object between the fingers"),
     }

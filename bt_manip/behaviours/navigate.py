@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -101,7 +101,7 @@ class Navigate(RobotAction):
     """
 
     CARRIES = True
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "goal": Port(str, True, "named world pose, or x;y;yaw", accepts=Accepts(check=_goal_text)),
         "xy_tolerance": Port(
@@ -112,7 +112,7 @@ class Navigate(RobotAction):
             float, False, "sim seconds; 0 = from the path length", 0.0, NON_NEGATIVE
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "path_length": PortInformation(float, False, "length of the planned path (m)"),
     }
 
@@ -223,7 +223,7 @@ class Reverse(RobotAction):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "distance": Port(float, False, "how far to reverse (m)", 0.5, POSITIVE),
         "speed": Port(float, False, "reversing speed (m/s)", 0.2, POSITIVE),

@@ -18,7 +18,7 @@ set on or against), not other objects; the arm itself may touch none of them.
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -137,7 +137,7 @@ class Place(JointMove):
     """
 
     CARRIES = True
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "object": OBJECT,
         "target": TARGET,
@@ -150,7 +150,7 @@ class Place(JointMove):
         "angle_tolerance": ANGLE_TOLERANCE,
         "via_tolerance": VIA,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "placed_pose": PortInformation(str, False, "the object's pose now x;y;z;yaw"),
         "deviation_mm": PortInformation(float, False, "distance from the target (mm)"),
         "deviation_deg": PortInformation(float, False, "rotation from the target (deg)"),

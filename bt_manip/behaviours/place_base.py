@@ -7,8 +7,6 @@ writes the base pose it found; a search that finds none, or cannot start, is its
 
 from __future__ import annotations
 
-from typing import ClassVar
-
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
@@ -44,14 +42,14 @@ class PlanBaseForPlace(RobotAction):
     nothing to undo.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "object": OBJECT,
         "target": TARGET,
         "approach": APPROACH,
         "clearance": CLEARANCE,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "base_pose": BASE_POSE,
         "staging_pose": STAGING_POSE,
     }

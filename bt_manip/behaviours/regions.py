@@ -17,7 +17,7 @@ Nodes:
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 import pybullet as pb
@@ -173,7 +173,7 @@ class DropPoint(WorldAccess, SyncActionNode):
     It finishes within its tick (never RUNNING), so there is nothing to halt.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "region": PortInformation(str, True, "body of the world whose box is the region (bin)"),
         "index": Port(int, True, "cell number, row by row from the lowest x and y", None,
                       NON_NEGATIVE),
@@ -186,7 +186,7 @@ class DropPoint(WorldAccess, SyncActionNode):
         "clearance": Port(float, False, "height of the point above the region's top (m)", 0.06,
                           Accepts(0, MAX_CLEARANCE)),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "point": PortInformation(list[float], False, "the drop point x;y;z (world)"),
     }
 

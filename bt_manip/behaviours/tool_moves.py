@@ -8,8 +8,6 @@ out again to set it down.
 
 from __future__ import annotations
 
-from typing import ClassVar
-
 import numpy as np
 from py_trees.ports import PortInformation
 
@@ -38,7 +36,7 @@ class MoveToolBy(JointMove):
     """
 
     CARRIES = True
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "offset": Port(
             list[float], True, "how far to move the tool x;y;z (m)", [0.0, 0.0, 0.0],

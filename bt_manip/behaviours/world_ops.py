@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -45,7 +45,7 @@ class SpawnModel(RobotAction):
       inside another body.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "model": PortInformation(str, True, "a model of the world file, or a new name"),
         "shape": Port(str, False, "box, cylinder or sphere", "box",
                       Accepts(choices=tuple(SHAPE_SIZES))),
@@ -134,7 +134,7 @@ class DeleteModel(RobotAction):
     - FAILURE when there is no such model.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "model": PortInformation(str, True, "name of the model to remove"),
     }
 

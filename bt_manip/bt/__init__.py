@@ -16,7 +16,6 @@ from bt_manip.bt import (  # noqa: F401  (register the built-ins)
 )
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
-from bt_manip.bt.from_py_trees import from_py_trees
 from bt_manip.bt.node import (
     ActionNode,
     BtNode,
@@ -28,7 +27,7 @@ from bt_manip.bt.node import (
     TreeRuntimeError,
 )
 from bt_manip.bt.ports import InOutPortInformation
-from bt_manip.bt.pytrees_leaf import register_py_trees_behaviours
+from bt_manip.bt.pytrees import from_py_trees, register_py_trees_behaviours  # installs itself
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree

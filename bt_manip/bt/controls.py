@@ -8,7 +8,7 @@ runs once), then every child goes back to IDLE.
 from __future__ import annotations
 
 import re
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.ports import PortInformation
 
@@ -222,7 +222,7 @@ class Parallel(ControlNode):
     all of them. A finished child is not ticked again until the Parallel completes.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "success_count": PortInformation(
             int, required=False, default_value=-1,
             description="number of children that must succeed; -1 means all"),
@@ -291,7 +291,7 @@ class ParallelAll(ControlNode):
     the number of children), SUCCESS otherwise, and resets the children.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "max_failures": PortInformation(
             int, required=False, default_value=1,
             description="if this many children fail, the node fails; -1 means all"),

@@ -11,7 +11,7 @@ from typing import Any, ClassVar, cast
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.context import TIME_EPS
-from bt_manip.bt.node import BtNode, DecoratorNode, PortError
+from bt_manip.bt.node import BtNode, DecoratorNode, PortError, TreeRuntimeError, _truth
 from bt_manip.bt.ports import NON_NEGATIVE, Port, Ref
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script, ScriptSyntaxError, parse_script
@@ -76,7 +76,7 @@ class Repeat(DecoratorNode):
     SKIPPED child makes the node SKIPPED (the count is kept).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "num_cycles": PortInformation(
             int, description="repeat a successful child N times; -1 repeats forever"),
     }
@@ -129,7 +129,7 @@ class RetryUntilSuccessful(DecoratorNode):
     the node SKIPPED.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "num_attempts": PortInformation(
             int, description="try the child up to N times; -1 tries forever"),
     }
@@ -198,7 +198,7 @@ class Timeout(DecoratorNode):
     the blackboard, it makes the node fail (halting the child) with the reason.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "msec": Port(
             int, description="After a certain amount of time, halt() the child if it is still "
                              "running.", accepts=NON_NEGATIVE),
@@ -260,7 +260,7 @@ class Delay(DecoratorNode):
     ``delay_msec`` is refused at load (an unsigned int in BT.CPP).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "delay_msec": Port(
             int, description="Tick the child after a few milliseconds", accepts=NON_NEGATIVE),
     }
@@ -308,7 +308,7 @@ class RunOnce(DecoratorNode):
     returns the child's remembered status forever.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "then_skip": PortInformation(
             bool, required=False, default_value=True,
             description="if true, skip after the first execution, otherwise return the "
@@ -353,8 +353,6 @@ class _ScriptHolder:
             try:
                 self._script = parse_script(text)
             except ScriptSyntaxError as e:
-                from bt_manip.bt.node import TreeRuntimeError
-
                 raise TreeRuntimeError(
                     f"{node.describe()}: script in '{port}' (column {e.column}): {e.message}"
                 ) from None
@@ -370,7 +368,7 @@ class Precondition(DecoratorNode):
     it is ticked until it finishes, then the node returns the child's status.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "if": PortInformation(str, description="script: the condition"),
         "else": PortInformation(
             NodeStatus, required=False, default_value=NodeStatus.FAILURE,
@@ -388,8 +386,6 @@ class Precondition(DecoratorNode):
         otherwise = self.get_input("else")
         if not self._child_running:
             script = self._script.get(self, "if")
-            from bt_manip.bt.node import _truth
-
             self._child_running = _truth(self, "if", script)
         if not self._child_running:
             return cast(NodeStatus, otherwise)  # the "else" port holds a NodeStatus

@@ -15,7 +15,7 @@ A child that returned RUNNING is ticked again at the next tick without looking a
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -53,7 +53,7 @@ class _EntryWatch:
 class WasEntryUpdated(SyncActionNode):
     """SUCCESS if the entry ``entry`` was written since this node's last tick, else FAILURE."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = (  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = (
         ENTRY_PORT)
     PORT_TYPE_NAMES = ENTRY_TYPE
 
@@ -67,7 +67,7 @@ class WasEntryUpdated(SyncActionNode):
 
 class _EntryUpdatedDecorator(DecoratorNode):
     IF_NOT_UPDATED = NodeStatus.SKIPPED
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = (  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = (
         ENTRY_PORT)
     PORT_TYPE_NAMES = ENTRY_TYPE
 

@@ -44,7 +44,7 @@ class AlwaysFailure(SyncActionNode):
 class Script(SyncActionNode):
     """Runs the script ``code`` on the blackboard and returns SUCCESS."""
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "code": PortInformation(str, description="script to run")}
     SCRIPT_PORTS = ("code",)
 
@@ -62,7 +62,7 @@ class Script(SyncActionNode):
 class ScriptCondition(ConditionNode):
     """Evaluates the script ``code``: SUCCESS if its value is true, FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "code": PortInformation(
             object, description="Piece of code that can be parsed. Must return false or true")}
     SCRIPT_PORTS = ("code",)
@@ -86,7 +86,7 @@ class SetBlackboard(SyncActionNode):
     ``{key}`` there names the entry whose *value* is the name to write to.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: dict[str, PortInformation] = {
         "value": PortInformation(
             object, description="Value to be written into the output_key"),
         "output_key": InOutPortInformation(
@@ -145,7 +145,7 @@ class UnsetBlackboard(SyncActionNode):
     entry a SubTree shares with its parent is not removed from the parent.
     """
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "key": PortInformation(str, description="name of the entry to remove")}
 
     def update(self) -> Status:
@@ -164,7 +164,7 @@ class Sleep(ActionNode):
     node fail with the reason.
     """
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "msec": Port(int, description="", accepts=NON_NEGATIVE)}
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {"msec": "unsigned int"}
 

@@ -23,10 +23,8 @@ them with :meth:`BtNode.set_output`, and put a failure reason in ``feedback_mess
 from __future__ import annotations
 
 import copy
-import difflib
 import itertools
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from typing import Any, ClassVar, Protocol, cast
 
 import py_trees
@@ -45,6 +43,9 @@ except ImportError:  # pragma: no cover - another py_trees release
             getattr(getattr(cls, name, None), "__isabstractmethod__", False) for name in dir(cls)
         )
 
+from bt_manip.bt import py_trees_hook
+from bt_manip.bt.attributes import IMMUTABLE_TYPES, AttributeCheck, check_attributes
+from bt_manip.bt.attributes import closest as closest  # where behaviours import it from
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.ports import (
@@ -53,21 +54,13 @@ from bt_manip.bt.ports import (
     Literal,
     Ref,
     convert_literal,
-    format_literal,
-    parse_reference,
     takes_infinity,
     value_problem,
 )
-from bt_manip.bt.script import Script, ScriptRuntimeError, ScriptSyntaxError, parse_script
+from bt_manip.bt.script import Script, ScriptRuntimeError, to_bool
 from bt_manip.bt.status import PY_TREES_OF, RESULT_OF_PY_TREES, STATUS_OF_PY_TREES, NodeStatus
 
-PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
-POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
-IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
-
 _MISSING = object()
-_IMMUTABLE = frozenset({int, float, bool, str, bytes, type(None)})
-"""Types whose values ``copy.deepcopy`` gives back as they are."""
 _ORDER = itertools.count(1)
 _RUNNING = Status.RUNNING
 # Enum members hash in Python code: the hot path maps statuses through identity lookups.
@@ -87,60 +80,6 @@ class PortError(TreeRuntimeError):
     """An input port has no usable value, or an output port cannot be written."""
 
 
-@dataclass
-class AttributeCheck:
-    """Result of checking a node's attributes against its class."""
-
-    bindings: dict[str, Binding] = field(default_factory=dict)
-    texts: dict[str, str] = field(default_factory=dict)
-    pre: list[tuple[str, Script]] = field(default_factory=list)
-    post: dict[str, Script] = field(default_factory=dict)
-    errors: list[tuple[str, int | None]] = field(default_factory=list)  # (message, column)
-
-    def copy(self) -> AttributeCheck:
-        """A check with its own dicts and lists (the bindings and scripts themselves shared)."""
-        return AttributeCheck(
-            dict(self.bindings), dict(self.texts), list(self.pre), dict(self.post),
-            list(self.errors),
-        )
-
-    def shareable(self) -> bool:
-        """Whether nodes may share what this check holds: no scripts, no errors, and every
-        literal an immutable value (a number, a flag, a text)."""
-        return not (self.pre or self.post or self.errors) and all(
-            isinstance(b, Ref) or type(b.value) in _IMMUTABLE for b in self.bindings.values()
-        )
-
-
-def closest(word: str, choices: list[str] | set[str], n: int = 3) -> str:
-    """' (did you mean 'a', 'b'?)' or '' when nothing is close."""
-    matches = difflib.get_close_matches(word, sorted(choices), n=n, cutoff=0.5)
-    if not matches:
-        return ""
-    return " (did you mean " + ", ".join(f"'{m}'" for m in matches) + "?)"
-
-
-def parse_condition_scripts(
-    attributes: Mapping[str, Any], check: AttributeCheck, where: str
-) -> None:
-    """Parse the ``_skipIf``... attributes present in ``attributes`` into ``check``."""
-    for key in PRE_CONDITIONS + POST_CONDITIONS:
-        if key not in attributes:
-            continue
-        code = str(attributes[key])
-        check.texts[key] = code
-        try:
-            script = parse_script(code)
-        except ScriptSyntaxError as e:
-            check.errors.append((f"script syntax error in {key} of {where}: {e.message}", e.column))
-            continue
-        if key in PRE_CONDITIONS:
-            check.pre.append((key, script))
-        else:
-            check.post[key] = script
-    check.pre.sort(key=lambda item: PRE_CONDITIONS.index(item[0]))
-
-
 class BtNode(PortsMixin):
     """Mixin giving a py_trees behaviour BT.CPP's node protocol (see the module docstring)."""
 
@@ -149,10 +88,11 @@ class BtNode(PortsMixin):
     DESCRIPTION: ClassVar[str] = ""
     MIN_CHILDREN: ClassVar[int] = 0
     MAX_CHILDREN: ClassVar[int | None] = 0
-    # "py_trees stub" below: py_trees annotates the two as instance attributes, though they are
-    # class-level declarations, and mypy lets no ClassVar override an instance attribute.
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]
+    # py_trees' PortsMixin annotates the two as instance attributes, though every node class
+    # declares them at class level: mypy lets no ClassVar override an instance attribute, so
+    # port declarations go without ClassVar (ruff's RUF012 is off for them, pyproject.toml).
+    INPUT_PORTS: dict[str, PortInformation] = {}
+    OUTPUT_PORTS: dict[str, PortInformation] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
     started_order: int = 0
     failure_order: int = 0
@@ -208,104 +148,9 @@ class BtNode(PortsMixin):
 
         A tree repeats the same node with the same text attributes (a subtree used once per
         object): the check of text attributes that holds no script and only immutable
-        literals is kept per class (:data:`_CHECKS_PER_CLASS` at most) and handed out as a
-        copy, so each node still has its own bindings."""
-        key = tuple(attributes.items())
-        if not all(type(v) is str for _, v in key):
-            return cls._checked_attributes(attributes)
-        memo: dict[tuple[tuple[str, Any], ...], AttributeCheck] | None = cls.__dict__.get(
-            _CHECKS_FLAG
-        )
-        if memo is None:
-            memo = {}
-            setattr(cls, _CHECKS_FLAG, memo)
-        known = memo.get(key)
-        if known is not None:
-            return known.copy()
-        check = cls._checked_attributes(attributes)
-        if check.shareable():
-            if len(memo) >= _CHECKS_PER_CLASS:
-                memo.pop(next(iter(memo)), None)
-            memo[key] = check.copy()
-        return check
-
-    @classmethod
-    def _checked_attributes(cls, attributes: Mapping[str, Any]) -> AttributeCheck:
-        """:meth:`check_attributes` worked out."""
-        check = AttributeCheck()
-        where = f"{cls.NODE_ID}"
-        parse_condition_scripts(attributes, check, where)
-        ports = set(cls.INPUT_PORTS) | set(cls.OUTPUT_PORTS)
-        for key, value in attributes.items():
-            if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
-                continue
-            info = cls.port_info(key)
-            if info is None:
-                known = ", ".join(sorted(ports)) if ports else "none"
-                check.errors.append(
-                    (f"'{key}' is not a port of {cls.NODE_ID}{closest(key, ports)}; "
-                     f"its ports are: {known}", None))
-                continue
-            cls._bind_port(key, value, info, check)
-        for port, info in cls.INPUT_PORTS.items():
-            if port not in attributes and info.required and not info.has_default:
-                check.errors.append(
-                    (f"{cls.NODE_ID} is missing its required port '{port}'"
-                     f"{_describe(info)}; add {port}=\"...\"", None))
-        return check
-
-    @classmethod
-    def _bind_port(
-        cls, port: str, value: Any, info: PortInformation, check: AttributeCheck
-    ) -> None:
-        is_output = port in cls.OUTPUT_PORTS
-        if isinstance(value, (Ref, Literal)):
-            check.bindings[port] = value
-            check.texts[port] = (
-                "{" + value.key + "}" if isinstance(value, Ref) else format_literal(value.value))
-            return
-        if isinstance(value, str):
-            key = parse_reference(value)
-            if key is not None:
-                if key in ("=", ""):
-                    key = port
-                check.bindings[port] = Ref(key)
-                check.texts[port] = value
-                return
-            if is_output and not isinstance(info, InOutPortInformation):
-                check.errors.append(
-                    (f"output port '{port}' of {cls.NODE_ID} must be a blackboard reference "
-                     f"like \"{{{port}}}\", got '{value}'", None))
-                return
-            if port in cls.SCRIPT_PORTS:
-                try:
-                    script = parse_script(value)
-                except ScriptSyntaxError as e:
-                    check.errors.append(
-                        (f"script syntax error in {port} of {cls.NODE_ID}: {e.message}", e.column))
-                    return
-                check.bindings[port] = Literal(script)
-                check.texts[port] = value
-                return
-            try:
-                converted = convert_literal(value, info.data_type, takes_infinity(info))
-            except ValueError as e:
-                check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {e}", None))
-                return
-            problem = value_problem(info, converted, value)
-            if problem is not None:
-                check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {problem}",
-                                     None))
-                return
-            check.bindings[port] = Literal(converted)
-            check.texts[port] = value
-            return
-        problem = value_problem(info, value)
-        if problem is not None:
-            check.errors.append((f"bad value for port '{port}' of {cls.NODE_ID}: {problem}", None))
-            return
-        check.bindings[port] = Literal(value)
-        check.texts[port] = format_literal(value)
+        literals is kept per class and handed out as a copy, so each node still has its own
+        bindings (:mod:`bt_manip.bt.attributes`)."""
+        return check_attributes(cls, attributes)
 
     def _init_node(self, attributes: Mapping[str, Any]) -> None:
         check = type(self).check_attributes(attributes)
@@ -338,7 +183,7 @@ class BtNode(PortsMixin):
             if info.has_default:
                 value = info.default_value
                 # deepcopy returns these unchanged; skip its cost on the tick path
-                return value if type(value) in _IMMUTABLE else copy.deepcopy(value)
+                return value if type(value) in IMMUTABLE_TYPES else copy.deepcopy(value)
             if default is not _MISSING:
                 return default
             raise PortError(f"{self.describe()}: input port '{port_name}' has no value")
@@ -520,9 +365,6 @@ class BtNode(PortsMixin):
 
 
 _ABSTRACT_FLAG = "_bt_ports_abstract"
-_CHECKS_FLAG = "_bt_attribute_checks"
-_CHECKS_PER_CLASS = 256
-"""The most attribute checks kept per node class (the oldest goes first)."""
 
 
 def _class_is_abstract(cls: type) -> bool:
@@ -537,17 +379,11 @@ def _class_is_abstract(cls: type) -> bool:
 
 
 def _truth(node: BtNode, key: str, script: Script) -> bool:
-    from bt_manip.bt.script import to_bool
-
     value = node._run_script(key, script)
     try:
         return to_bool(value)
     except ScriptRuntimeError as e:
         raise TreeRuntimeError(f"{node.describe()}: {key}=\"{script.code}\": {e}") from None
-
-
-def _describe(info: PortInformation) -> str:
-    return f" ({info.description})" if info.description else ""
 
 
 class LeafNode(BtNode, py_trees.behaviour.Behaviour):
@@ -718,9 +554,8 @@ def children_rule(cls: ChildCounts) -> str:
 
 
 def as_bt_node(node: Any) -> BtNode:
-    """``node`` itself, or a plain py_trees behaviour (or whole py_trees tree) converted."""
+    """``node`` itself, or a plain py_trees behaviour (or whole py_trees tree) converted by the
+    py_trees adapter (:mod:`bt_manip.bt.py_trees_hook`)."""
     if isinstance(node, BtNode) or not isinstance(node, py_trees.behaviour.Behaviour):
         return node
-    from bt_manip.bt.from_py_trees import convert_node
-
-    return convert_node(node)
+    return py_trees_hook.adapter().convert_node(node)

@@ -10,7 +10,9 @@ behaviours) register themselves when their module is imported::
         ...
 
 A py_trees behaviour class (any ``py_trees.behaviour.Behaviour`` subclass) can be registered
-too: it is wrapped as a leaf (see :mod:`bt_manip.bt.pytrees_leaf`) under its class name.
+too: it is wrapped as a leaf (see :mod:`bt_manip.bt.pytrees.leaf`) under its class name, by
+the py_trees adapter that importing :mod:`bt_manip.bt` installs
+(:mod:`bt_manip.bt.py_trees_hook`).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from typing import Any, TypeVar, overload
 
 import py_trees
 
+from bt_manip.bt import py_trees_hook
 from bt_manip.bt.node import BtNode
 
 N = TypeVar("N", bound=type[Any])  # a BtNode or py_trees Behaviour subclass
@@ -48,8 +51,7 @@ class NodeRegistry:
         def add(node_cls: N) -> N:
             if isinstance(node_cls, type) and issubclass(node_cls, py_trees.behaviour.Behaviour) \
                     and not issubclass(node_cls, BtNode):
-                from bt_manip.bt.pytrees_leaf import leaf_class_for
-
+                leaf_class_for = py_trees_hook.adapter().leaf_class_for
                 self.register(leaf_class_for(node_cls), builtin=builtin)
                 return node_cls  # the user's class stays as it is
             if not (isinstance(node_cls, type) and issubclass(node_cls, BtNode)):

@@ -12,16 +12,15 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from bt_manip.bt.blackboard import Blackboard
-from bt_manip.bt.node import (
+from bt_manip.bt.attributes import (
     IGNORED_ATTRIBUTES,
     POST_CONDITIONS,
     PRE_CONDITIONS,
     AttributeCheck,
-    BtNode,
-    DecoratorNode,
     parse_condition_scripts,
 )
+from bt_manip.bt.blackboard import Blackboard
+from bt_manip.bt.node import BtNode, DecoratorNode
 from bt_manip.bt.ports import Literal, Ref, convert_literal, format_literal, parse_reference
 from bt_manip.bt.status import NodeStatus
 

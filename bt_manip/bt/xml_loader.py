@@ -17,24 +17,26 @@ from typing import Any, cast
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.attributes import (
+    IGNORED_ATTRIBUTES,
+    POST_CONDITIONS,
+    PRE_CONDITIONS,
+    AttributeCheck,
+    closest,
+    parse_condition_scripts,
+)
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.documents import Document, TreeDef, read_document, read_model_file
 from bt_manip.bt.models import NodeSpec, PortSpec, spec_of
 from bt_manip.bt.node import (
-    IGNORED_ATTRIBUTES,
-    POST_CONDITIONS,
-    PRE_CONDITIONS,
     ActionNode,
-    AttributeCheck,
     BtNode,
     ConditionNode,
     ControlNode,
     DecoratorNode,
     TreeRuntimeError,
     children_rule,
-    closest,
-    parse_condition_scripts,
 )
 from bt_manip.bt.ports import convert_literal, parse_reference, type_from_name
 from bt_manip.bt.registry import SUBTREE_ID, NodeRegistry, registry

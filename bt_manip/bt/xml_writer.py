@@ -9,7 +9,9 @@ from __future__ import annotations
 
 from xml.sax.saxutils import quoteattr
 
+from bt_manip.bt.models import write_models
 from bt_manip.bt.node import BtNode
+from bt_manip.bt.registry import registry
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 from bt_manip.bt.walk import walk_nodes
@@ -65,9 +67,6 @@ def root_to_xml(root: BtNode, tree_id: str = "MainTree") -> str:
 def _models(root: BtNode) -> list[str]:
     """A ``<TreeNodesModel>`` declaring the tree's nodes that are not BT.CPP built-ins (so
     Groot2 knows their kind and ports)."""
-    from bt_manip.bt.models import write_models
-    from bt_manip.bt.registry import registry
-
     classes: dict[str, type[BtNode]] = {}
     for walked in walk_nodes(root):
         node = walked.node

@@ -183,12 +183,12 @@ class ComputePathToPose(PlanAction):
     """
 
     UNKNOWN = PlannerError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "goal": PortInformation(object, True, "Destination to plan to (x;y;yaw or a pose name)"),
         **PLAN_PORTS,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathToPose node"),
         **error_ports("The compute path to pose"),
     }
@@ -244,7 +244,7 @@ class FollowPath(Nav2Action):
     """
 
     UNKNOWN = ControllerError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "path": PortInformation(Nav2Path, True, "Path to follow"),
         "controller_id": PortInformation(str, False, "Mapped name of the controller plugin", ""),
@@ -253,7 +253,7 @@ class FollowPath(Nav2Action):
             str, False, "Mapped name of the progress checker", ""
         ),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("The follow path")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("The follow path")
 
     def _path(self) -> Nav2Path:
         try:
@@ -381,11 +381,11 @@ class Spin(_BaseBehavior):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **BEHAVIOR_PORTS,
         "spin_dist": Port(float, False, "Spin distance (rad)", 1.57),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Spin")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("Spin")
 
     def begin(self) -> None:
         super().begin()
@@ -431,12 +431,12 @@ class BackUp(_Drive):
     Halted: the base is braked where it is.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **BEHAVIOR_PORTS,
         "backup_dist": Port(float, False, "Distance to backup (m)", 0.15, POSITIVE),
         "backup_speed": Port(float, False, "Speed at which to backup (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Back up")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("Back up")
 
     def begin(self) -> None:
         super().begin()
@@ -450,12 +450,12 @@ class DriveOnHeading(_Drive):
     """Drives the base straight along its heading by ``dist_to_travel`` at ``speed``
     (a negative distance drives backwards); statuses as :class:`BackUp`."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **BEHAVIOR_PORTS,
         "dist_to_travel": Port(float, False, "Distance to travel (m)", 0.15),
         "speed": Port(float, False, "Speed at which to travel (m/s)", 0.025, POSITIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Drive on heading")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("Drive on heading")
 
     def begin(self) -> None:
         super().begin()
@@ -466,10 +466,10 @@ class DriveOnHeading(_Drive):
 class Wait(Nav2Action):
     """Waits ``wait_duration`` seconds of sim time: RUNNING until then, then SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "wait_duration": Port(float, False, "Wait time (s)", 1.0, NON_NEGATIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = error_ports("Wait")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("Wait")
     UNKNOWN = BehaviorError.UNKNOWN
 
     def begin(self) -> None:

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
@@ -82,7 +82,7 @@ class IsBatteryLow(WorldCondition):
     docstring).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "min_battery": Port(float, False, "Min battery percentage or voltage before triggering",
                             0.0, NON_NEGATIVE),

@@ -40,7 +40,7 @@ class _Cancel(WorldAccess, SyncActionNode):
     """
 
     CANCELS: ClassVar[type] = object
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = CANCEL_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = CANCEL_PORTS
 
     def update(self) -> Status:
         try:

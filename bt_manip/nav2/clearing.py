@@ -64,7 +64,7 @@ def square_round(nav: Navigator, x: float, y: float, half: float) -> np.ndarray:
 
 
 class _Clear(Nav2Action):
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {}  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {}
 
     def _set_result(self, code: int, message: str) -> None:
         pass  # Nav2's clearing services report no result code
@@ -77,7 +77,7 @@ class _Clear(Nav2Action):
 class ClearEntireCostmap(_Clear):
     """Forgets every object drawn on the robot's map. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = SERVICE_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = SERVICE_PORTS
 
     def begin(self) -> None:
         clear_map(synced_navigator(self, self.base()))
@@ -111,7 +111,7 @@ class ClearCostmapAroundRobot(_ClearSquare):
     """Forgets the objects drawn within ``reset_distance`` (half the side of a square) of the
     robot. SUCCESS."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("clear")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _square_ports("clear")
 
 
 @registry.register
@@ -120,4 +120,4 @@ class ClearCostmapExceptRegion(_ClearSquare):
     from the robot, keeping those near it. SUCCESS."""
 
     INSIDE = False
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _square_ports("keep")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _square_ports("keep")

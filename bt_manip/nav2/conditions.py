@@ -29,7 +29,7 @@ def _codes(text: Any) -> frozenset[int]:
 class AreErrorCodesPresent(ConditionNode):
     """SUCCESS when ``error_code`` is one of ``error_codes_to_check``, FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "error_code": PortInformation(int, False, "The active error code to compare against", 0),
         "error_codes_to_check": PortInformation(
             str, False, "Error codes to check, separated by commas", ""
@@ -50,7 +50,7 @@ class _WouldARecoveryHelp(AreErrorCodesPresent):
     """SUCCESS when ``error_code`` is one of the fixed codes ``CODES``, FAILURE otherwise."""
 
     CODES: ClassVar[frozenset[Any]] = frozenset()
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "error_code": PortInformation(int, False, "The active error code to compare against", 0),
     }
 
@@ -125,7 +125,7 @@ class GoalUpdated(GoalsReader, ConditionNode):
     SUCCESS (and records them) when they differ, FAILURE when they are the same.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = GOAL_PORTS
 
     def __init__(self, name: str | None = None, **attributes: Any) -> None:
         super().__init__(name, **attributes)

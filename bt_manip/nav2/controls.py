@@ -7,7 +7,7 @@ that finished is only set back to IDLE.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.ports import PortInformation
 
@@ -89,7 +89,7 @@ class RecoveryNode(ControlNode):
 
     MIN_CHILDREN = 2
     MAX_CHILDREN = 2
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "number_of_retries": Port(int, False, "Number of retries", 1, NON_NEGATIVE),
     }
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.ports import PortInformation
 
@@ -35,7 +35,7 @@ class RateController(DecoratorNode):
     On a tick where the child is not due it returns RUNNING without ticking it.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "hz": Port(float, False, "Rate", 10.0, POSITIVE),
     }
 
@@ -73,7 +73,7 @@ class DistanceController(WorldAccess, DecoratorNode):
     now); child RUNNING: RUNNING; child FAILURE: FAILURE.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "distance": Port(float, False, "Distance", 1.0, POSITIVE),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
@@ -143,7 +143,7 @@ class GoalUpdatedController(GoalsReader, DecoratorNode):
     the child's status when ticked, RUNNING otherwise.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = GOAL_PORTS  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = GOAL_PORTS
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
                  **attributes: Any) -> None:
@@ -178,7 +178,7 @@ class SpeedController(GoalsReader, WorldAccess, DecoratorNode):
     base's speed now (Nav2 smooths odometry over ``filter_duration``).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         **GOAL_PORTS,
         "min_rate": Port(float, False, "Minimum rate (Hz)", 0.1, POSITIVE),

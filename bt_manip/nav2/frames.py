@@ -3,7 +3,7 @@
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.ports import PortInformation
 
@@ -26,7 +26,7 @@ class TransformAvailable(WorldCondition):
     of the world or of the robot); from then on SUCCESS at every tick, as Nav2's latches.
     FAILURE, naming the unknown frame, until then."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "child": PortInformation(str, False, "Child frame for transform", ""),
         "parent": PortInformation(str, False, "Parent frame for transform", ""),

@@ -10,7 +10,7 @@ input goal itself is changed.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar
+from typing import Any
 
 from py_trees.ports import PortInformation
 
@@ -80,11 +80,11 @@ class GoalUpdater(DecoratorNode):
     received are kept (as Nav2's subscription keeps its last message).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "input_goal": PortInformation(object, False, "Original Goal"),
         "input_goals": PortInformation(object, False, "Original Goals"),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_goal": PortInformation(object, False,
                                        "Received Goal by subscription if newer, else the "
                                        "original"),

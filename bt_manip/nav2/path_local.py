@@ -12,7 +12,7 @@ path stays the same one.
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -68,7 +68,7 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
       unknown robot) and no ``pose`` is given; the reason is in the feedback message.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "input_path": PortInformation(Nav2Path, True, "Original Path"),
         "distance_forward": Port(float, False, "Distance in forward direction (m); negative: "
@@ -88,7 +88,7 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
                                            "pose) to bound the search for the closest pose to "
                                            "the robot", math.inf, NON_NEGATIVE_OR_INF),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_path": PortInformation(Nav2Path, False, "Truncated Path"),
     }
 

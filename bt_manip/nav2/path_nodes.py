@@ -4,7 +4,7 @@ and InitialPoseReceived, which reads the blackboard."""
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -45,12 +45,12 @@ class TruncatePath(SyncActionNode):
     ``output_path``, the new last pose facing the goal (to stop short of it). SUCCESS; FAILURE
     when ``input_path`` is not a path."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "input_path": PortInformation(Nav2Path, True, "Original path"),
         "distance": Port(float, False, "Distance to truncate from the goal (m)", 1.0,
                          NON_NEGATIVE),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_path": PortInformation(Nav2Path, False, "Truncated path"),
     }
 
@@ -78,7 +78,7 @@ class PathLongerOnApproach(DecoratorNode):
     with once the child finished). Otherwise it remembers the new path and returns SUCCESS.
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "path": PortInformation(Nav2Path, True, "Planned Path"),
         "prox_len": Port(float, False, "Proximity length (m) for the path to be longer on "
                          "approach", 3.0, POSITIVE),

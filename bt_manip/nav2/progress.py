@@ -5,7 +5,7 @@ clock."""
 from __future__ import annotations
 
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -37,7 +37,7 @@ def _inactive(node: Any) -> bool:
 class GoalReached(WorldCondition):
     """SUCCESS when the robot is within 0.25 m of ``goal`` (x, y), FAILURE otherwise."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **FRAME_PORTS,
         "goal": PortInformation(object, True, "Destination"),
     }
@@ -92,7 +92,7 @@ class DistanceTraveled(_Every):
     was at the last SUCCESS; FAILURE otherwise and on its first tick (which records the pose).
     """
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **FRAME_PORTS,
         "distance": Port(float, False, "The distance that must travel before returning success",
                          1.0, POSITIVE),
@@ -111,7 +111,7 @@ class TimeExpired(_Every):
     """SUCCESS each time ``seconds`` have passed (on the tree's clock) since the last SUCCESS;
     FAILURE otherwise and on its first tick (which starts the clock)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "seconds": Port(float, False, "Time to check if expired", 1.0, NON_NEGATIVE),
     }
 
@@ -128,7 +128,7 @@ class IsPathValid(WorldCondition):
     robot's costmap, redrawn with the movable objects where they are now; FAILURE when an
     obstacle now lies on it (or there is no path)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "path": PortInformation(Nav2Path, True, "Path to check"),
         "server_timeout": PortInformation(float, False, "Server timeout (ms)", 20.0),
@@ -175,7 +175,7 @@ class IsStuck(WorldCondition):
     (it ran into something), FAILURE otherwise (and on the first tick, which has nothing to
     compare with)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {"robot": ROBOT_PORT}  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {"robot": ROBOT_PORT}
 
     previous: tuple[float, float] | None = None
 

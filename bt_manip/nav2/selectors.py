@@ -43,8 +43,8 @@ class PlannerSelector(_Selector):
     """Selects the planner for ComputePathToPose (``selected_planner``)."""
 
     WHAT = "planner"
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _ports("planner", "planner_selector")  # type: ignore[misc]  # py_trees stub: not ClassVar
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _out("planner")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _ports("planner", "planner_selector")
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("planner")
 
 
 @registry.register
@@ -52,8 +52,8 @@ class ControllerSelector(_Selector):
     """Selects the controller for FollowPath (``selected_controller``)."""
 
     WHAT = "controller"
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _ports("controller", "controller_selector")  # type: ignore[misc]  # py_trees stub: not ClassVar
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _out("controller")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _ports("controller", "controller_selector")
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("controller")
 
 
 @registry.register
@@ -61,10 +61,10 @@ class GoalCheckerSelector(_Selector):
     """Selects the goal checker for FollowPath (``selected_goal_checker``)."""
 
     WHAT = "goal_checker"
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _ports(  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _ports(
         "goal_checker", "goal_checker_selector"
     )
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _out("goal_checker")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("goal_checker")
 
 
 @registry.register
@@ -72,5 +72,5 @@ class SmootherSelector(_Selector):
     """Selects the smoother for SmoothPath (``selected_smoother``)."""
 
     WHAT = "smoother"
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = _ports("smoother", "smoother_selector")  # type: ignore[misc]  # py_trees stub: not ClassVar
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = _out("smoother")  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = _ports("smoother", "smoother_selector")
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("smoother")

@@ -15,7 +15,6 @@ from __future__ import annotations
 import dataclasses
 import enum
 from dataclasses import dataclass
-from typing import ClassVar
 
 import numpy as np
 from py_trees.common import Status
@@ -111,7 +110,7 @@ class SmoothPath(Nav2Action):
     """
 
     UNKNOWN = SmootherError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "unsmoothed_path": PortInformation(Nav2Path, True, "Path to be smoothed"),
         "max_smoothing_duration": Port(float, False, "Maximum smoothing duration (s)", 3.0,
@@ -122,7 +121,7 @@ class SmoothPath(Nav2Action):
         "server_name": PortInformation(str, False, "Action server name", ""),
         "server_timeout": Port(int, False, "Action server timeout (ms)", 20, Accepts(low=0)),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "smoothed_path": PortInformation(Nav2Path, False, "Path smoothed by SmootherServer"),
         "smoothing_duration": PortInformation(float, False, "Time taken to smooth path"),
         "was_completed": PortInformation(bool, False,

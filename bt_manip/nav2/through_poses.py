@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import enum
 import math
-from typing import Any, ClassVar
+from typing import Any
 
 import numpy as np
 from py_trees.common import Status
@@ -64,12 +64,12 @@ class ComputePathThroughPoses(PlanAction):
     """
 
     UNKNOWN = ThroughPosesError.UNKNOWN
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "goals": PortInformation(object, True, "Destinations to plan through"),
         **PLAN_PORTS,
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
         **error_ports("The compute path through poses"),
     }
@@ -121,7 +121,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
     (always keeping the last) and writes the rest to ``output_goals``. SUCCESS (FAILURE without
     a world or with goals it cannot read)."""
 
-    INPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "input_goals": PortInformation(object, True, "Original goals to remove viapoints from"),
         "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
@@ -129,7 +129,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
         "global_frame": PortInformation(str, False, "Global frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),
     }
-    OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
+    OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_goals": PortInformation(object, False, "Goals with passed viapoints removed"),
     }
 

@@ -108,7 +108,7 @@ class Listed(ActionNode):
 
 
 def test_repeated_text_attributes_are_checked_once_and_never_shared() -> None:
-    from bt_manip.bt.node import _CHECKS_FLAG, _CHECKS_PER_CLASS
+    from bt_manip.bt.attributes import _CHECKS_FLAG, _CHECKS_PER_CLASS
 
     text = {"n": "5", "key": "{entry}"}
     first = Listed.check_attributes(text)

@@ -10,7 +10,7 @@ after every tick.
 
 Half of the seeds convert with BT.CPP built-ins where they tick alike (``builtins=True``);
 there py_trees' extra ``terminate(INVALID)`` on a child that had already finished (see
-:mod:`bt_manip.bt.from_py_trees`) is left out of the comparison; halting a RUNNING child is
+:mod:`bt_manip.bt.pytrees.convert`) is left out of the comparison; halting a RUNNING child is
 compared. The other half convert every
 node to its py_trees counterpart and compare every call.
 """

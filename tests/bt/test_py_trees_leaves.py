@@ -24,7 +24,7 @@ from bt_manip.bt.context import TreeContext
 from bt_manip.bt.controls import ReactiveSequence, Sequence
 from bt_manip.bt.decorators import Inverter
 from bt_manip.bt.leaves import AlwaysSuccess
-from bt_manip.bt.pytrees_leaf import PyTreesLeaf, register_py_trees_behaviours
+from bt_manip.bt.pytrees.leaf import PyTreesLeaf, register_py_trees_behaviours
 from bt_manip.bt.xml_loader import load_tree
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError

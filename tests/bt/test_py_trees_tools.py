@@ -6,7 +6,7 @@ import py_trees
 from py_trees.common import Status
 
 from bt_manip.bt import Tree, from_py_trees, load_tree_string
-from bt_manip.bt.pytrees_leaf import register_py_trees_behaviours
+from bt_manip.bt.pytrees.leaf import register_py_trees_behaviours
 
 TREE = """<root BTCPP_format="4"><BehaviorTree ID="Main">
   <Sequence name="root">

@@ -22,293 +22,42 @@ and ``OUTPUT_PORTS``) gets them as bt-manip ports: ``port="{key}"`` wires the po
 blackboard entry, other text is a literal converted to the port's type; the behaviour's own
 ``get_input()``/``_set_output()`` then read and write those.
 
-Blackboard clients of the behaviour (``attach_blackboard_client()``, ports) read and write the
-blackboard of the (sub)tree the leaf sits in, while it runs: py_trees' absolute key ``/foo``
-and the relative ``foo`` both name entry ``foo`` (``/a/b`` names entry ``a/b``).
+The blackboard bridge is :mod:`bt_manip.bt.pytrees.storage`, the conversion of constructor
+arguments :mod:`bt_manip.bt.pytrees.arguments`.
 """
 
 from __future__ import annotations
 
-import contextlib
-import enum
-import inspect
-import json
 import typing
-from collections.abc import Callable, Iterator, MutableMapping
-from dataclasses import dataclass
-from typing import Any, ClassVar, cast, get_args, get_origin
+from collections.abc import Callable
+from typing import Any, ClassVar, cast
 
 import py_trees
 from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 from py_trees.ports import PortInformation, PortsMixin
 
-from bt_manip.bt.blackboard import Blackboard
-from bt_manip.bt.node import AttributeCheck, LeafNode, TreeRuntimeError
-from bt_manip.bt.ports import Literal, Ref, convert_literal
+from bt_manip.bt.attributes import AttributeCheck
+from bt_manip.bt.node import LeafNode, TreeRuntimeError
+from bt_manip.bt.ports import Literal, Ref
+from bt_manip.bt.pytrees.arguments import (
+    Param,
+    constructor_params,
+    convert_param,
+    format_param,
+    port_info,
+    recover_arguments,
+)
+from bt_manip.bt.pytrees.storage import (
+    PORT_PREFIX,
+    EntryView,
+    py_trees_storage,
+    raised_as_tree_error,
+)
+from bt_manip.bt.registry import registry
 from bt_manip.bt.status import RESULT_OF_PY_TREES, NodeStatus
 
-PORT_PREFIX = "/__bt_manip_port__/"
-"""py_trees key of a port that is not wired to an entry (kept by the leaf itself)."""
-
-_NONE_TEXT = ("", "null", "none")
 _UNKNOWN = object()  # a constructor argument of a wrapped object that its attributes hide
-
-
-# ---------------------------------------------------------------------- blackboard bridge
-
-
-class EntryView(MutableMapping[str, Any]):
-    """py_trees' key-value store seen through a bt-manip :class:`Blackboard`.
-
-    ``/foo`` and ``foo`` are entry ``foo``; keys under :data:`PORT_PREFIX` live in ``local``.
-    """
-
-    def __init__(self, blackboard: Blackboard, local: dict[str, Any] | None = None) -> None:
-        self.blackboard = blackboard
-        self.local = local if local is not None else {}
-
-    @staticmethod
-    def entry(key: str) -> str:
-        return key[1:] if key.startswith("/") else key
-
-    def __getitem__(self, key: str) -> Any:
-        if key.startswith(PORT_PREFIX):
-            return self.local[key]
-        return self.blackboard.get(self.entry(key))
-
-    def __setitem__(self, key: str, value: Any) -> None:
-        if key.startswith(PORT_PREFIX):
-            self.local[key] = value
-        else:
-            self.blackboard.set(self.entry(key), value)
-
-    def __delitem__(self, key: str) -> None:
-        if key.startswith(PORT_PREFIX):
-            del self.local[key]
-            return
-        name = self.entry(key)
-        if not self.blackboard.has_value(name):
-            raise KeyError(key)
-        self.blackboard.unset(name)
-
-    def __contains__(self, key: object) -> bool:
-        if not isinstance(key, str):
-            return False
-        if key.startswith(PORT_PREFIX):
-            return key in self.local
-        return self.blackboard.has_value(self.entry(key))
-
-    def __iter__(self) -> Iterator[str]:
-        names = self.blackboard.keys()  # a bt-manip Blackboard, not a dict
-        yield from ("/" + k for k in names)
-        yield from self.local
-
-    def __len__(self) -> int:
-        return len(list(self.blackboard.keys())) + len(self.local)
-
-
-@contextlib.contextmanager
-def py_trees_storage(view: MutableMapping[str, Any]) -> Iterator[None]:
-    """Make py_trees' blackboard clients use ``view`` while the block runs."""
-    storage = py_trees.blackboard.Blackboard
-    saved = storage.storage
-    storage.storage = view  # type: ignore[assignment]  # py_trees types it dict; a mapping does
-    try:
-        yield
-    finally:
-        storage.storage = saved
-
-
-@contextlib.contextmanager
-def raised_as_tree_error(node: Any) -> Iterator[None]:
-    """An exception raised by py_trees code (a behaviour's ``update()``...) becomes a
-    :class:`TreeRuntimeError` naming the node, so a run ends with an error, not a traceback."""
-    try:
-        yield
-    except TreeRuntimeError:
-        raise
-    except Exception as e:
-        raise TreeRuntimeError(f"{node.describe()}: {type(e).__name__}: {e}") from e
-
-
-# ---------------------------------------------------------------------- constructor arguments
-
-
-@dataclass(frozen=True)
-class Param:
-    """One keyword parameter of a behaviour's constructor."""
-
-    name: str
-    annotation: Any
-    required: bool
-    default: Any = None
-
-
-def _hints(cls: type[Any]) -> dict[str, Any]:
-    try:
-        return typing.get_type_hints(cls.__init__)
-    except Exception:  # unresolvable annotations: use them as written
-        return dict(getattr(cls.__init__, "__annotations__", {}))
-
-
-def constructor_params(cls: type[Behaviour]) -> dict[str, Param]:
-    """Keyword parameters of ``cls``'s constructor other than ``name`` (and ``*args``)."""
-    try:
-        signature = inspect.signature(cls.__init__)
-    except (TypeError, ValueError):
-        return {}
-    hints = _hints(cls)
-    params: dict[str, Param] = {}
-    for index, p in enumerate(signature.parameters.values()):
-        if index == 0 or p.name == "name" or p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
-            continue
-        if p.name == "behaviour_class_name":  # PortsMixin's own bookkeeping
-            continue
-        required = p.default is inspect.Parameter.empty
-        params[p.name] = Param(p.name, hints.get(p.name, Any), required,
-                               None if required else p.default)
-    return params
-
-
-def _is_optional(annotation: Any) -> tuple[bool, list[Any]]:
-    origin = get_origin(annotation)
-    if origin is typing.Union or str(origin) == "<class 'types.UnionType'>":
-        args = list(get_args(annotation))
-        return type(None) in args, [a for a in args if a is not type(None)]
-    return False, [annotation]
-
-
-def convert_param(text: str, annotation: Any) -> Any:
-    """Convert an XML attribute to a constructor argument of type ``annotation``.
-
-    Raises ValueError saying what was expected."""
-    optional, options = _is_optional(annotation)
-    if optional and text.strip().lower() in _NONE_TEXT:
-        return None
-    errors = []
-    for option in options:
-        try:
-            return _convert_one(text, option)
-        except ValueError as e:
-            errors.append(str(e))
-    raise ValueError("; ".join(dict.fromkeys(errors)))
-
-
-def _convert_one(text: str, annotation: Any) -> Any:
-    if annotation is Status:
-        return _status(text)
-    if isinstance(annotation, type) and issubclass(annotation, enum.Enum):
-        return _enum(text, annotation)
-    origin = get_origin(annotation)
-    if origin in (list, tuple, dict, set) or annotation in (list, tuple, dict, set):
-        try:
-            value = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
-        return _from_json(value, annotation)
-    if annotation in (int, float, bool, str):
-        return convert_literal(text, annotation)
-    if annotation is Any or annotation is object or annotation is inspect.Parameter.empty:
-        try:
-            return json.loads(text)
-        except json.JSONDecodeError:
-            return text
-    name = getattr(annotation, "__name__", str(annotation))
-    raise ValueError(f"a {name} cannot be written in XML; build this node in Python")
-
-
-def _status(text: Any) -> Status:
-    word = str(text).strip().upper().removeprefix("STATUS.")
-    try:
-        return Status[word]
-    except KeyError:
-        raise ValueError(
-            f"expected one of SUCCESS, FAILURE, RUNNING, INVALID, got '{text}'") from None
-
-
-def _enum(text: str, annotation: type[enum.Enum]) -> enum.Enum:
-    word = text.strip().split(".")[-1]
-    for member in annotation:
-        if member.name.lower() == word.lower():
-            return member
-    names = ", ".join(m.name for m in annotation)
-    raise ValueError(f"expected one of {names}, got '{text}'")
-
-
-def _from_json(value: Any, annotation: Any) -> Any:
-    origin = get_origin(annotation) or annotation
-    args = get_args(annotation)
-    if origin in (list, tuple, set):
-        if not isinstance(value, list):
-            raise ValueError(f"expected a JSON list, got {json.dumps(value)}")
-        item = args[0] if args else Any
-        items = [_json_item(v, item) for v in value]
-        return origin(items) if origin is not list else items
-    if origin is dict:
-        if not isinstance(value, dict):
-            raise ValueError(f"expected a JSON object, got {json.dumps(value)}")
-        return value
-    return value
-
-
-def _json_item(value: Any, annotation: Any) -> Any:
-    optional, options = _is_optional(annotation)
-    if value is None and optional:
-        return None
-    option = options[0] if options else Any
-    if option is Status or (isinstance(option, type) and issubclass(option, enum.Enum)):
-        return _status(value) if option is Status else _enum(str(value), option)
-    if option is float and isinstance(value, int) and not isinstance(value, bool):
-        return float(value)
-    if option in (int, float, bool, str) and not isinstance(value, option):
-        raise ValueError(f"expected a list of {option.__name__}, got {json.dumps(value)}")
-    return value
-
-
-def format_param(value: Any) -> str:
-    """XML text of a constructor argument (read back by :func:`convert_param`)."""
-    if value is None:
-        return "null"
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, enum.Enum):
-        return value.name
-    if isinstance(value, (list, tuple, set, dict)):
-        return json.dumps(_jsonable(value))
-    return str(value)
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, enum.Enum):
-        return value.name
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple, set)):
-        return [_jsonable(v) for v in value]
-    return value
-
-
-# Where py_trees' own behaviours keep their constructor arguments (for saving a wrapped
-# instance as XML); other classes are read from an attribute named like the parameter.
-_STORED_AS = {"n": ("every_n", "period")}
-
-
-def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[str, Any]:
-    """Constructor arguments of an existing behaviour, as far as its attributes tell."""
-    found: dict[str, Any] = {}
-    generator = vars(behaviour).get("variable_value_generator")
-    if "variable_value" in params and callable(generator) and \
-            "SetBlackboardVariable.__init__" in getattr(generator, "__qualname__", ""):
-        found["variable_value"] = generator()  # py_trees' wrapper around a plain value
-    for name in params:
-        if name in found:
-            continue
-        for attribute in (name, "_" + name, *_STORED_AS.get(name, ())):
-            if attribute in vars(behaviour):
-                found[name] = vars(behaviour)[attribute]
-                break
-    return found
 
 
 # ---------------------------------------------------------------------- the wrapper
@@ -463,7 +212,7 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
     params = constructor_params(cls)
     inputs: dict[str, PortInformation] = {}
     for p in params.values():
-        inputs[p.name] = _port_info(p)
+        inputs[p.name] = port_info(p)
     outputs: dict[str, PortInformation] = {}
     if issubclass(cls, PortsMixin) and hasattr(cls, "INPUT_PORTS"):
         inputs.update(cls.input_ports())
@@ -484,26 +233,37 @@ def leaf_class_for(cls: type[Behaviour], node_id: str | None = None) -> type[PyT
     return wrapper
 
 
-def _port_info(p: Param) -> PortInformation:
-    description = "constructor argument"
-    default = p.default
-    data_type = p.annotation  # as the model shows it; conversion uses the annotation itself
-    optional, options = _is_optional(data_type)
-    if get_origin(data_type) is typing.Union or optional:
-        data_type = options[0] if len(options) == 1 else object
-    try:
-        return PortInformation(data_type, required=p.required, description=description,
-                               default_value=default)
-    except TypeError:
-        return PortInformation(object, required=p.required, description=description,
-                               default_value=default)
+# ---------------------------------------------------------------------- clock readers
+
+
+@registry.register
+class PyTreesTimer(LeafNode):
+    """py_trees' ``Timer`` on the tree's clock: RUNNING until more than ``duration`` seconds
+    have passed since it started, then SUCCESS."""
+
+    INPUT_PORTS: dict[str, PortInformation] = {
+        "duration": PortInformation(float, description="seconds", default_value=5.0)}
+
+    def __init__(self, name: str | None = None, **attributes: Any) -> None:
+        super().__init__(name, **attributes)
+        self.duration = float(self.get_input("duration"))
+        self.finish_time = 0.0
+
+    def initialise(self) -> None:
+        self.finish_time = self.now() + self.duration
+        self.feedback_message = f"configured to fire in '{self.duration}' seconds"
+
+    def update(self) -> Status:
+        if self.now() > self.finish_time:
+            self.feedback_message = f"timer ran out [{self.duration}]"
+            return Status.SUCCESS
+        self.feedback_message = "still running"
+        return Status.RUNNING
 
 
 def _clock_counterparts() -> dict[type, type[PyTreesLeaf]]:
     """py_trees classes replaced by bt-manip nodes reading the tree's clock (registered
     under the py_trees class name)."""
-    from bt_manip.bt.pytrees_composites import PyTreesTimer
-
     if py_trees.timers.Timer not in _COUNTERPARTS:
         _COUNTERPARTS[py_trees.timers.Timer] = type(
             "Timer", (PyTreesTimer,), {"NODE_ID": "Timer", "__module__": __name__,
@@ -539,8 +299,6 @@ def register_py_trees_behaviours() -> list[str]:
     """Register py_trees' own leaves (:data:`PY_TREES_LEAVES`); returns their node IDs.
 
     Done when :mod:`bt_manip.bt` is imported; calling it again changes nothing."""
-    from bt_manip.bt.registry import registry
-
     ids = []
     for cls in PY_TREES_LEAVES:
         wrapper = leaf_class_for(cls)

@@ -17,7 +17,7 @@ py_trees                                    bt-manip
 ==========================================  ============================================
 
 Everything else becomes a node with py_trees' semantics from
-:mod:`bt_manip.bt.pytrees_composites`: ``Parallel`` (py_trees ticks every child before
+:mod:`bt_manip.bt.pytrees.composites`: ``Parallel`` (py_trees ticks every child before
 deciding, BT.CPP's Parallel stops at its thresholds and has no SuccessOnSelected), ``Repeat``
 and ``Retry`` (py_trees returns RUNNING between cycles), ``Timeout`` (checked after ticking
 the child, on the tree's clock), ``OneShot``, ``Count``, ``Condition``, ``EternalGuard``,
@@ -30,7 +30,7 @@ composite and decorator gets its py_trees counterpart. One difference remains wi
 py_trees stops a child that had finished when its parent starts again (its
 ``terminate(INVALID)`` runs once more); a BT.CPP parent resets it without calling it.
 
-Leaves are wrapped (:mod:`bt_manip.bt.pytrees_leaf`), the very objects of the py_trees tree,
+Leaves are wrapped (:mod:`bt_manip.bt.pytrees.leaf`), the very objects of the py_trees tree,
 so references kept to them stay live; ``py_trees.timers.Timer`` becomes ``PyTreesTimer``, which
 reads the tree's clock. Nodes that already are bt-manip nodes are kept.
 """
@@ -44,11 +44,11 @@ import py_trees
 from py_trees.behaviour import Behaviour
 
 from bt_manip.bt import controls, decorators
-from bt_manip.bt import pytrees_composites as ptc
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
-from bt_manip.bt.pytrees_leaf import wrap
+from bt_manip.bt.pytrees import composites as ptc
+from bt_manip.bt.pytrees.leaf import wrap
 from bt_manip.bt.registry import registry
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree

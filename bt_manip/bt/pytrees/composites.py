@@ -1,9 +1,10 @@
 """py_trees' composites and decorators as bt-manip nodes, with py_trees' semantics.
 
-:func:`bt_manip.bt.from_py_trees` uses a BehaviorTree.CPP built-in where it ticks like the
-py_trees node, and these nodes otherwise (``PyTreesSequence``, ``PyTreesRepeat``, ...). Each
-runs py_trees' own tick logic (``py_trees.composites.Sequence.tick`` and so on), so it does
-exactly what py_trees does, tick by tick:
+:func:`bt_manip.bt.from_py_trees` (:mod:`bt_manip.bt.pytrees.convert`) uses a
+BehaviorTree.CPP built-in where it ticks like the py_trees node, and these nodes otherwise
+(``PyTreesSequence``, ``PyTreesRepeat``, ...). Each runs py_trees' own tick logic
+(``py_trees.composites.Sequence.tick`` and so on), so it does exactly what py_trees does, tick
+by tick:
 
 - its children keep their status after they finish (py_trees parents stop them with INVALID
   when they start again, which runs a RUNNING child's ``terminate(INVALID)``);
@@ -11,8 +12,9 @@ exactly what py_trees does, tick by tick:
 - halted (by a BT.CPP parent or ``Tree.halt()``) it is stopped as py_trees stops it.
 
 They are registered (not as built-ins), so ``to_xml()`` writes them with their ports and a
-TreeNodesModel that declares them, and the XML loads back. Durations (``PyTreesTimeout``,
-``PyTreesTimer``) read the tree's clock: the simulation clock under a world.
+TreeNodesModel that declares them, and the XML loads back. Durations (``PyTreesTimeout``, and
+``PyTreesTimer`` in :mod:`bt_manip.bt.pytrees.leaf`) read the tree's clock: the simulation
+clock under a world.
 """
 
 from __future__ import annotations
@@ -26,16 +28,9 @@ import py_trees
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt.node import (
-    AttributeCheck,
-    BtNode,
-    ControlNode,
-    DecoratorNode,
-    LeafNode,
-    TreeRuntimeError,
-    _truth,
-)
-from bt_manip.bt.pytrees_leaf import EntryView, py_trees_storage, raised_as_tree_error
+from bt_manip.bt.attributes import AttributeCheck
+from bt_manip.bt.node import BtNode, ControlNode, DecoratorNode, TreeRuntimeError, _truth
+from bt_manip.bt.pytrees.storage import EntryView, py_trees_storage, raised_as_tree_error
 from bt_manip.bt.registry import registry
 from bt_manip.bt.script import Script
 from bt_manip.bt.status import STATUS_OF_PY_TREES, NodeStatus
@@ -90,7 +85,7 @@ class _PyTreesComposite(_PyTreesNode, ControlNode):
 class _MemoryComposite(_PyTreesComposite):
     """A py_trees composite with the ``memory`` flag (``Sequence``, ``Selector``)."""
 
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "memory": PortInformation(bool, description="resume from the RUNNING child",
                                   default_value=False)}
 
@@ -139,7 +134,7 @@ class PyTreesParallel(_PyTreesComposite):
     """
 
     PY = py_trees.composites.Parallel
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "policy": PortInformation(str, description="SuccessOnAll, SuccessOnOne or "
                                                    "SuccessOnSelected",
                                   default_value="SuccessOnAll"),
@@ -241,7 +236,7 @@ class PyTreesRepeat(_PyTreesDecorator):
     RUNNING gives RUNNING. One cycle per tick."""
 
     PY = py_trees.decorators.Repeat
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "num_success": PortInformation(int, description="successes needed; -1 repeats forever")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -257,7 +252,7 @@ class PyTreesRetry(_PyTreesDecorator):
     FAILURE); child SUCCESS gives SUCCESS; RUNNING gives RUNNING. One attempt per tick."""
 
     PY = py_trees.decorators.Retry
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "num_failures": PortInformation(int, description="failures before giving up")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -274,7 +269,7 @@ class PyTreesTimeout(_PyTreesDecorator):
     otherwise returns the child's status."""
 
     PY = py_trees.decorators.Timeout
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "duration": PortInformation(float, description="seconds", default_value=5.0)}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -325,7 +320,7 @@ class PyTreesOneShot(_PyTreesDecorator):
     status for ever without ticking the child."""
 
     PY = py_trees.decorators.OneShot
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "policy": PortInformation(str, description="ON_COMPLETION or ON_SUCCESSFUL_COMPLETION",
                                   default_value="ON_COMPLETION")}
 
@@ -351,7 +346,7 @@ class PyTreesCondition(_PyTreesDecorator):
     ``status``, RUNNING otherwise."""
 
     PY = py_trees.decorators.Condition
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "status": PortInformation(NodeStatus, description="child status that means SUCCESS",
                                   default_value=NodeStatus.SUCCESS)}
 
@@ -377,7 +372,7 @@ class PyTreesStatusToBlackboard(_ClientDecorator):
     ``variable_name`` after each tick and returns it."""
 
     PY = py_trees.decorators.StatusToBlackboard
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "variable_name": PortInformation(str, description="entry to write the status to")}
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -403,7 +398,7 @@ class PyTreesEternalGuard(_ClientDecorator):
     """
 
     PY = py_trees.decorators.EternalGuard
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "condition": PortInformation(object, description="script (XML) or Python callable"),
         "blackboard_keys": PortInformation(list[str], required=False,
                                            description="entries a Python condition reads"),
@@ -455,7 +450,7 @@ class PyTreesForEach(_ClientDecorator):
     returned as is."""
 
     PY = py_trees.decorators.ForEach
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
+    INPUT_PORTS: Ports = {
         "source_key": PortInformation(str, description="entry holding the items"),
         "target_key": PortInformation(str, description="entry receiving the current item"),
     }
@@ -500,34 +495,6 @@ class PyTreesForEach(_ClientDecorator):
     def terminate(self, new_status: Status) -> None:
         self._items = None
         self._current = None
-
-
-# ---------------------------------------------------------------------- leaves
-
-
-@registry.register
-class PyTreesTimer(LeafNode):
-    """py_trees' ``Timer`` on the tree's clock: RUNNING until more than ``duration`` seconds
-    have passed since it started, then SUCCESS."""
-
-    INPUT_PORTS: ClassVar[Ports] = {  # type: ignore[misc]  # py_trees stub
-        "duration": PortInformation(float, description="seconds", default_value=5.0)}
-
-    def __init__(self, name: str | None = None, **attributes: Any) -> None:
-        super().__init__(name, **attributes)
-        self.duration = float(self.get_input("duration"))
-        self.finish_time = 0.0
-
-    def initialise(self) -> None:
-        self.finish_time = self.now() + self.duration
-        self.feedback_message = f"configured to fire in '{self.duration}' seconds"
-
-    def update(self) -> Status:
-        if self.now() > self.finish_time:
-            self.feedback_message = f"timer ran out [{self.duration}]"
-            return Status.SUCCESS
-        self.feedback_message = "still running"
-        return Status.RUNNING
 
 
 # py_trees' display and dot export pick their glyphs and shapes by isinstance.

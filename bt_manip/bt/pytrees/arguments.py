@@ -1,0 +1,217 @@
+"""Constructor arguments of py_trees behaviours as XML attributes, and back.
+
+A py_trees behaviour registered as a bt-manip leaf takes its XML attributes as keyword
+arguments of its constructor, converted by the constructor's annotations: numbers,
+``true``/``false``, statuses by name (``SUCCESS``), enums by member name, ``null`` for an
+optional value, JSON for lists and dicts (``queue='["SUCCESS", "RUNNING"]'``). Each argument is
+declared as an input port (:func:`port_info`) in the TreeNodesModel.
+"""
+
+from __future__ import annotations
+
+import enum
+import inspect
+import json
+import typing
+from dataclasses import dataclass
+from typing import Any, get_args, get_origin
+
+from py_trees.behaviour import Behaviour
+from py_trees.common import Status
+from py_trees.ports import PortInformation
+
+from bt_manip.bt.ports import convert_literal
+
+_NONE_TEXT = ("", "null", "none")
+
+
+@dataclass(frozen=True)
+class Param:
+    """One keyword parameter of a behaviour's constructor."""
+
+    name: str
+    annotation: Any
+    required: bool
+    default: Any = None
+
+
+def _hints(cls: type[Any]) -> dict[str, Any]:
+    try:
+        return typing.get_type_hints(cls.__init__)
+    except Exception:  # unresolvable annotations: use them as written
+        return dict(getattr(cls.__init__, "__annotations__", {}))
+
+
+def constructor_params(cls: type[Behaviour]) -> dict[str, Param]:
+    """Keyword parameters of ``cls``'s constructor other than ``name`` (and ``*args``)."""
+    try:
+        signature = inspect.signature(cls.__init__)
+    except (TypeError, ValueError):
+        return {}
+    hints = _hints(cls)
+    params: dict[str, Param] = {}
+    for index, p in enumerate(signature.parameters.values()):
+        if index == 0 or p.name == "name" or p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
+            continue
+        if p.name == "behaviour_class_name":  # PortsMixin's own bookkeeping
+            continue
+        required = p.default is inspect.Parameter.empty
+        params[p.name] = Param(p.name, hints.get(p.name, Any), required,
+                               None if required else p.default)
+    return params
+
+
+def _is_optional(annotation: Any) -> tuple[bool, list[Any]]:
+    origin = get_origin(annotation)
+    if origin is typing.Union or str(origin) == "<class 'types.UnionType'>":
+        args = list(get_args(annotation))
+        return type(None) in args, [a for a in args if a is not type(None)]
+    return False, [annotation]
+
+
+def convert_param(text: str, annotation: Any) -> Any:
+    """Convert an XML attribute to a constructor argument of type ``annotation``.
+
+    Raises ValueError saying what was expected."""
+    optional, options = _is_optional(annotation)
+    if optional and text.strip().lower() in _NONE_TEXT:
+        return None
+    errors = []
+    for option in options:
+        try:
+            return _convert_one(text, option)
+        except ValueError as e:
+            errors.append(str(e))
+    raise ValueError("; ".join(dict.fromkeys(errors)))
+
+
+def _convert_one(text: str, annotation: Any) -> Any:
+    if annotation is Status:
+        return _status(text)
+    if isinstance(annotation, type) and issubclass(annotation, enum.Enum):
+        return _enum(text, annotation)
+    origin = get_origin(annotation)
+    if origin in (list, tuple, dict, set) or annotation in (list, tuple, dict, set):
+        try:
+            value = json.loads(text)
+        except json.JSONDecodeError as e:
+            raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
+        return _from_json(value, annotation)
+    if annotation in (int, float, bool, str):
+        return convert_literal(text, annotation)
+    if annotation is Any or annotation is object or annotation is inspect.Parameter.empty:
+        try:
+            return json.loads(text)
+        except json.JSONDecodeError:
+            return text
+    name = getattr(annotation, "__name__", str(annotation))
+    raise ValueError(f"a {name} cannot be written in XML; build this node in Python")
+
+
+def _status(text: Any) -> Status:
+    word = str(text).strip().upper().removeprefix("STATUS.")
+    try:
+        return Status[word]
+    except KeyError:
+        raise ValueError(
+            f"expected one of SUCCESS, FAILURE, RUNNING, INVALID, got '{text}'") from None
+
+
+def _enum(text: str, annotation: type[enum.Enum]) -> enum.Enum:
+    word = text.strip().split(".")[-1]
+    for member in annotation:
+        if member.name.lower() == word.lower():
+            return member
+    names = ", ".join(m.name for m in annotation)
+    raise ValueError(f"expected one of {names}, got '{text}'")
+
+
+def _from_json(value: Any, annotation: Any) -> Any:
+    origin = get_origin(annotation) or annotation
+    args = get_args(annotation)
+    if origin in (list, tuple, set):
+        if not isinstance(value, list):
+            raise ValueError(f"expected a JSON list, got {json.dumps(value)}")
+        item = args[0] if args else Any
+        items = [_json_item(v, item) for v in value]
+        return origin(items) if origin is not list else items
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise ValueError(f"expected a JSON object, got {json.dumps(value)}")
+        return value
+    return value
+
+
+def _json_item(value: Any, annotation: Any) -> Any:
+    optional, options = _is_optional(annotation)
+    if value is None and optional:
+        return None
+    option = options[0] if options else Any
+    if option is Status or (isinstance(option, type) and issubclass(option, enum.Enum)):
+        return _status(value) if option is Status else _enum(str(value), option)
+    if option is float and isinstance(value, int) and not isinstance(value, bool):
+        return float(value)
+    if option in (int, float, bool, str) and not isinstance(value, option):
+        raise ValueError(f"expected a list of {option.__name__}, got {json.dumps(value)}")
+    return value
+
+
+def format_param(value: Any) -> str:
+    """XML text of a constructor argument (read back by :func:`convert_param`)."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, enum.Enum):
+        return value.name
+    if isinstance(value, (list, tuple, set, dict)):
+        return json.dumps(_jsonable(value))
+    return str(value)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, enum.Enum):
+        return value.name
+    if isinstance(value, dict):
+        return {str(k): _jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple, set)):
+        return [_jsonable(v) for v in value]
+    return value
+
+
+# Where py_trees' own behaviours keep their constructor arguments (for saving a wrapped
+# instance as XML); other classes are read from an attribute named like the parameter.
+_STORED_AS = {"n": ("every_n", "period")}
+
+
+def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[str, Any]:
+    """Constructor arguments of an existing behaviour, as far as its attributes tell."""
+    found: dict[str, Any] = {}
+    generator = vars(behaviour).get("variable_value_generator")
+    if "variable_value" in params and callable(generator) and \
+            "SetBlackboardVariable.__init__" in getattr(generator, "__qualname__", ""):
+        found["variable_value"] = generator()  # py_trees' wrapper around a plain value
+    for name in params:
+        if name in found:
+            continue
+        for attribute in (name, "_" + name, *_STORED_AS.get(name, ())):
+            if attribute in vars(behaviour):
+                found[name] = vars(behaviour)[attribute]
+                break
+    return found
+
+
+def port_info(p: Param) -> PortInformation:
+    """The input port declaring constructor argument ``p`` in the TreeNodesModel."""
+    description = "constructor argument"
+    default = p.default
+    data_type = p.annotation  # as the model shows it; conversion uses the annotation itself
+    optional, options = _is_optional(data_type)
+    if get_origin(data_type) is typing.Union or optional:
+        data_type = options[0] if len(options) == 1 else object
+    try:
+        return PortInformation(data_type, required=p.required, description=description,
+                               default_value=default)
+    except TypeError:
+        return PortInformation(object, required=p.required, description=description,
+                               default_value=default)
