@@ -1,6 +1,6 @@
 """Where an episode's time goes besides physics: world building, tree loading, ticking.
 
-Runs the seeds of a scenario in this process through ``bt_manip.bench.run_one`` (as
+Runs the seeds of a scenario in this process through ``bt_manip.bench.episodes.run_one`` (as
 ``bt-manip bench --jobs 1`` does), after one warm-up episode (seed + 100) that fills what a
 process keeps between episodes. Each part is timed around the function that does it, in wall
 time and in CPU time of this thread (less disturbed by other programs on a busy machine):
@@ -31,7 +31,7 @@ from typing import Any
 
 import pybullet
 
-import bt_manip.bench as bench
+import bt_manip.bench.episodes as bench
 from bt_manip.episode import EpisodeSpec
 
 SCENARIOS = {

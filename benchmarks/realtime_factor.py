@@ -2,8 +2,8 @@
 
 Each checkout runs the same seeds of Scenario A (``trees/husky_carry_wall.xml`` on
 ``worlds/tb3_house.yaml``) and Scenario B (``trees/sawyer_blocks_to_bin.xml`` on
-``worlds/sawyer_table.yaml``) through its own ``bt_manip.bench.run_bench`` with one job, as
-``bt-manip bench --jobs 1`` does, in a fresh Python process started in that checkout. The
+``worlds/sawyer_table.yaml``) through its own ``run_bench`` (``bt_manip.bench.pool``) with one
+job, as ``bt-manip bench --jobs 1`` does, in a fresh Python process started in that checkout. The
 checkouts take turns, round after round and in alternating order, so that the load other
 programs put on the machine falls on both alike.
 
@@ -39,7 +39,10 @@ SCENARIOS = {
 
 DRIVER = r"""
 import json, sys, time
-import bt_manip.bench as bench
+try:
+    import bt_manip.bench.pool as bench  # run_bench, and the run_one it calls
+except ImportError:
+    import bt_manip.bench as bench  # a checkout from before the bench package
 from bt_manip.episode import EpisodeSpec
 
 tree, world, first, runs = sys.argv[1], sys.argv[2], int(sys.argv[3]), int(sys.argv[4])

@@ -1,4 +1,4 @@
-"""The JSON Schemas of bt-manip's output files, and the ``schema`` verb that shows them.
+"""The JSON Schemas of bt-manip's output files: where they are, by name.
 
 Each file bt-manip writes for other programs to read (the run report of ``run --report``, the
 bench outputs, ``bim``'s schedule) is documented by a JSON Schema (draft 2020-12) in
@@ -6,15 +6,11 @@ bench outputs, ``bim``'s schedule) is documented by a JSON Schema (draft 2020-12
 data under ``bt_manip/_data/schemas/`` (see ``setup.py``). :func:`schema_folder` is whichever of
 the two this copy of bt-manip has.
 
-``bt-manip schema`` lists them (name, title, file); ``bt-manip schema NAME`` prints one
-(``run-report``, ``bench-summary``, ...) and ``bt-manip schema NAME --path`` only its file, for
-a validator to read.
+The ``schema`` verb that lists and prints them is :mod:`bt_manip.cli.schema`.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 from pathlib import Path
 
 from bt_manip.errors import InputError
@@ -44,33 +40,3 @@ def schema_path(name: str) -> Path:
             "schema", None, f"no schema named '{name}'; known: {', '.join(names)}"
         )
     return schema_folder() / f"{name}{SUFFIX}"
-
-
-def add_schema_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    """Register ``bt-manip schema [NAME] [--path]``."""
-    schema = sub.add_parser(
-        "schema", help="list the JSON Schemas of bt-manip's output files, or print one",
-        description="Without NAME: list the JSON Schemas (draft 2020-12) of the files bt-manip "
-        "writes (the run report of run --report, bench's outputs, bim's schedule) with their "
-        "files. With NAME (run-report, bench-summary, ...): print that schema, or with --path "
-        "only its file.",
-    )
-    schema.add_argument("name", nargs="?", metavar="NAME", help="a schema's name: run-report, ...")
-    schema.add_argument("--path", action="store_true", help="print the schema's file, not its text")
-    schema.set_defaults(func=cmd_schema)
-
-
-def cmd_schema(args: argparse.Namespace) -> int:
-    """List the schemas, or print one (its text, or its path with ``--path``)."""
-    if args.name is None:
-        if args.path:
-            print(schema_folder())
-            return 0
-        for name in schema_names():
-            path = schema_folder() / f"{name}{SUFFIX}"
-            title = json.loads(path.read_text(encoding="utf-8")).get("title", "")
-            print(f"{name:<20} {title}\n{'':<20} {path}")
-        return 0
-    path = schema_path(args.name)
-    print(path if args.path else path.read_text(encoding="utf-8").rstrip("\n"))
-    return 0

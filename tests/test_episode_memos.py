@@ -11,7 +11,7 @@ import sys
 from dataclasses import asdict
 from pathlib import Path
 
-from bt_manip.bench import run_one
+from bt_manip.bench.episodes import run_one
 from bt_manip.episode import EpisodeSpec
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -22,7 +22,7 @@ PANDA = (str(ROOT / "trees" / "panda_pick_place.xml"), str(ROOT / "worlds" / "pa
 FRESH = """
 import json, sys
 from dataclasses import asdict
-from bt_manip.bench import run_one
+from bt_manip.bench.episodes import run_one
 from bt_manip.episode import EpisodeSpec
 r = asdict(run_one(EpisodeSpec(tree=sys.argv[1], world=sys.argv[2], seed=int(sys.argv[3]))))
 r.pop("wall_time")

@@ -21,8 +21,8 @@ the doors), :mod:`~bt_manip.bim.doorways` (the poses to cross them straight),
 :mod:`~bt_manip.bim.stock` (the stands), :mod:`~bt_manip.bim.world_file` (the world YAML),
 :mod:`~bt_manip.bim.install_tree` (install.xml), :mod:`~bt_manip.bim.convert` (the whole
 conversion), :mod:`~bt_manip.bim.as_built` (the as-built table of a run),
-:mod:`~bt_manip.bim.as_built_plot` (its floor plan) and :mod:`~bt_manip.bim.command` (the
-command line).
+:mod:`~bt_manip.bim.as_built_plot` (its floor plan) and :mod:`~bt_manip.bim.seeds` (a
+converted world loaded with many seeds). The verbs' arguments are in :mod:`bt_manip.cli.bim`.
 """
 
 from __future__ import annotations

@@ -16,6 +16,7 @@ counter (:meth:`Blackboard.sequence_id`), which WasEntryUpdated and its decorato
 
 from __future__ import annotations
 
+import json
 import math
 import re
 import typing
@@ -200,6 +201,21 @@ _INT_PREFIX = re.compile(r"-?\d+")
 _REAL_PREFIX = re.compile(
     r"\s*[+-]?(?:(0[xX][0-9a-fA-F]*\.?[0-9a-fA-F]*(?:[pP][+-]?\d+)?)"
     r"|((?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(inf(?:inity)?|nan))", re.IGNORECASE)
+
+
+def bb_value(text: str) -> Any:
+    """A blackboard entry given as text (``--bb KEY=VALUE``, a swept ``bb:KEY=...``):
+    ``1`` -> 1, ``2.5`` -> 2.5, ``true`` -> True, ``"a b"`` -> 'a b'; anything that is
+    not a JSON number, boolean or string (``abc``, ``[1]``, ``null``, ``NaN``) stays the text."""
+    try:
+        value = json.loads(text)
+    except ValueError:
+        return text
+    if isinstance(value, float) and not math.isfinite(value):
+        return text  # json reads NaN and Infinity; keep them as text
+    if isinstance(value, bool | int | float | str):
+        return value
+    return text
 
 
 def number_from_text(text: str, data_type: type) -> int | float:

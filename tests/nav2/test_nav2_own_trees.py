@@ -13,6 +13,7 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip import cli
 from bt_manip.bt import Tree, load_tree
+from bt_manip.cli.args import bb_pair
 from bt_manip.run_context import RunContext
 from bt_manip.runner import Runner, RunOptions, RunReport
 from bt_manip.sim.world import World
@@ -28,7 +29,7 @@ REPLANNING_TREES = ("replan_on_distance", "replan_on_time", "replan_if_path_inva
 
 def bb(**pairs: str) -> dict[str, Any]:
     """Blackboard entries as ``--bb key=value`` reads them."""
-    return dict(cli._bb_pair(f"{k}={v}") for k, v in pairs.items())
+    return dict(bb_pair(f"{k}={v}") for k, v in pairs.items())
 
 
 def load(world: World, name: str, entries: dict[str, Any]) -> Tree:

@@ -228,7 +228,7 @@ def test_through_poses_without_goals_gives_no_viapoints() -> None:
 
 
 def test_a_crate_falling_in_front_of_the_robot_takes_it_through_the_recovery_branch() -> None:
-    from bt_manip.bench import count_leaf_failures
+    from bt_manip.bench.episodes import count_leaf_failures
     from bt_manip.faults import FaultInjector, FaultSpec
 
     with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:

@@ -8,7 +8,7 @@ from pathlib import Path
 import pybullet as pb
 import pytest
 
-from bt_manip.bench import count_leaf_failures
+from bt_manip.bench.episodes import count_leaf_failures
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.walk import walk_nodes
 from bt_manip.episode import Episode, EpisodeSpec

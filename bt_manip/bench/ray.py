@@ -1,4 +1,4 @@
-"""bench's Ray backend: the episodes of a bench as Ray tasks, on a local or remote cluster.
+"""The bench's Ray backend: the episodes of a bench as Ray tasks, on a local or remote cluster.
 
 ``bt-manip bench ... --backend ray [--address ADDR]`` (Ray is the optional extra
 ``bt-manip[ray]``). Each episode is one task that builds its own PyBullet client and world in
@@ -28,10 +28,11 @@ from importlib import metadata
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import bt_manip
+from bt_manip.bench.episodes import EpisodeResult, run_one
 from bt_manip.errors import InputError
 
 if TYPE_CHECKING:
-    from bt_manip.bench import EpisodeResult
     from bt_manip.episode import EpisodeSpec
 
 EXCLUDES = [".git", ".venv", "venv", "out", "__pycache__", "*.pyc", ".pytest_cache",
@@ -47,7 +48,7 @@ def _declared() -> list[str]:
     except metadata.PackageNotFoundError:
         import tomllib
 
-        pyproject = Path(__file__).resolve().parents[1] / "pyproject.toml"
+        pyproject = Path(bt_manip.__file__).resolve().parents[1] / "pyproject.toml"
         with open(pyproject, "rb") as fh:
             return list(tomllib.load(fh)["project"]["dependencies"])
 
@@ -82,8 +83,6 @@ def _relative(path: str | None, root: Path) -> str | None:
 
 def runtime_env(remote: bool, root: Path) -> dict[str, Any]:
     """The runtime environment of the bench's Ray job (see the module docstring)."""
-    import bt_manip
-
     env: dict[str, Any] = {
         "working_dir": str(root),
         "excludes": list(EXCLUDES),
@@ -104,7 +103,6 @@ def run_on_ray(specs: list[EpisodeSpec], finished: Callable[[EpisodeResult], Non
     except ImportError:
         raise InputError.single(
             "--backend", None, "ray is not installed: pip install 'bt-manip[ray]'") from None
-    from bt_manip.bench import run_one
 
     root = Path(os.getcwd()).resolve()
     specs = [

@@ -3,7 +3,8 @@
 The file's first line is the bench itself (``"kind": "bench"``): the schema version, what
 defines every episode (tree, world, blackboard entries, faults, run options, imports), the seeds
 to run, and a SHA-256 digest of the tree and world files. Each further line is one finished
-episode (``"kind": "episode"``, the fields of :class:`~bt_manip.bench.EpisodeResult`), written
+episode (``"kind": "episode"``, the fields of
+:class:`~bt_manip.bench.episodes.EpisodeResult`), written
 and flushed as soon as it finishes, so a bench that is interrupted (Ctrl-C, a lost machine)
 keeps every episode it finished. A last line cut short by a crash is ignored on reading.
 
@@ -19,19 +20,14 @@ import json
 import os
 from dataclasses import asdict, dataclass, field, fields
 from pathlib import Path
-from typing import IO, TYPE_CHECKING, Any
+from typing import IO, Any
 
+from bt_manip.bench.episodes import SCHEMA_VERSION, EpisodeResult
+from bt_manip.episode import EpisodeSpec
 from bt_manip.errors import InputError
 from bt_manip.faults import parse_fault
 from bt_manip.runner import RunOptions
 
-if TYPE_CHECKING:
-    from bt_manip.bench import EpisodeResult
-    from bt_manip.episode import EpisodeSpec
-
-SCHEMA_VERSION = 2
-"""Version of the bench's output formats (episodes.jsonl, episodes.json, summary.json,
-episodes.csv); documented by the JSON Schemas in docs/schemas/. Version 1 had none written."""
 LOG_NAME = "episodes.jsonl"
 MAX_LOG_BYTES = 64 * 1024 * 1024
 """Largest episodes.jsonl that ``--resume`` reads."""
@@ -67,8 +63,6 @@ def spec_to_json(spec: EpisodeSpec) -> dict[str, Any]:
 def spec_from_json(data: dict[str, Any]) -> EpisodeSpec:
     """The inverse of :func:`spec_to_json`; relative file paths are made relative to the
     current folder (the bench may be resumed from another one)."""
-    from bt_manip.episode import EpisodeSpec
-
     start = Path(str(data.get("cwd") or "."))
 
     def here(path: str | None) -> str | None:
@@ -172,8 +166,6 @@ class LoggedBench:
 
 def read_log(folder: str | Path) -> LoggedBench:
     """Read ``folder``/episodes.jsonl; InputError naming the file and line when it is not one."""
-    from bt_manip.bench import EpisodeResult
-
     path = Path(folder) / LOG_NAME
     where = str(path)
     if not path.is_file():

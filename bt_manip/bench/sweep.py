@@ -18,12 +18,13 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from bt_manip.bench_log import SCHEMA_VERSION
+from bt_manip.bench.episodes import SCHEMA_VERSION
+from bt_manip.bt.blackboard import bb_value
 from bt_manip.errors import InputError
 from bt_manip.faults import parse_fault
 
 if TYPE_CHECKING:
-    from bt_manip.bench import BenchSummary
+    from bt_manip.bench.stats import BenchSummary
     from bt_manip.episode import EpisodeSpec
 
 MAX_POINTS = 64
@@ -66,8 +67,6 @@ def _folder(index: int, value: str) -> str:
 def sweep_points(base: EpisodeSpec, text: str) -> list[SweepPoint]:
     """The points of the sweep ``text`` over the bench ``base``; InputError when the text is
     not a sweep or a value does not make a valid fault."""
-    from bt_manip.cli import bb_value
-
     before, after, values = _values(text)
     points = []
     for i, value in enumerate(values):

@@ -1,7 +1,7 @@
-"""The ``validate``, ``show`` and ``nodes`` sub-commands of ``bt-manip``.
+"""The ``validate``, ``show`` and ``nodes`` verbs: tree files checked, printed, nodes listed.
 
-``add_verbs(subparsers)`` adds them to an argparse parser; each sets ``func=handler`` where
-``handler(args) -> int`` returns the exit code (0 fine, 2 bad input).
+Each verb's parser gets ``func=handler``, where ``handler(args) -> int`` returns the exit code
+(0 fine, 2 bad input).
 """
 
 from __future__ import annotations
@@ -10,7 +10,6 @@ import argparse
 import importlib
 import sys
 from collections.abc import Iterable
-from typing import Any
 
 from bt_manip.bt.display import render_dot, render_tree
 from bt_manip.bt.models import write_models
@@ -49,30 +48,38 @@ def _common(parser: argparse.ArgumentParser, models: bool = True) -> None:
     add_import_flag(parser)
 
 
-def add_verbs(subparsers: argparse._SubParsersAction[Any]) -> None:
-    """Add ``validate``, ``show`` and ``nodes`` to ``subparsers``."""
-    p = subparsers.add_parser("validate", help="check tree files without running them",
-                              description="Check everything loading checks and report ALL "
-                                          "problems, each as file:line: message.")
+def add_validate_arguments(p: argparse.ArgumentParser) -> None:
+    """The arguments of ``bt-manip validate``."""
+    p.description = ("Check everything loading checks and report ALL problems, each as "
+                     "file:line: message.")
     p.add_argument("trees", nargs="+", type=shipped_or_given, metavar="TREE.xml")
     p.add_argument("--tree-id", default=None, help="main tree to check (default: the file's)")
     _common(p)
     p.set_defaults(func=validate_command)
 
-    p = subparsers.add_parser("show", help="print a tree as text (and Graphviz with --dot)")
+
+def add_show_arguments(p: argparse.ArgumentParser) -> None:
+    """The arguments of ``bt-manip show``."""
     p.add_argument("tree", type=shipped_or_given, metavar="TREE.xml")
     p.add_argument("--tree-id", default=None)
     p.add_argument("--dot", metavar="FILE", default=None, help="write Graphviz source to FILE")
     _common(p)
     p.set_defaults(func=show_command)
 
-    p = subparsers.add_parser("nodes", help="list registered nodes, or export a TreeNodesModel")
+
+def add_nodes_arguments(p: argparse.ArgumentParser) -> None:
+    """The arguments of ``bt-manip nodes``."""
     p.add_argument("--groot", action="store_true",
                    help="print a TreeNodesModel of every registered non-built-in node (Groot2)")
     p.add_argument("--builtins", action="store_true",
                    help="with --groot, also include the BT.CPP built-ins")
     _common(p, models=False)
     p.set_defaults(func=nodes_command)
+
+
+VERB_ARGUMENTS = {"validate": add_validate_arguments, "show": add_show_arguments,
+                  "nodes": add_nodes_arguments}
+"""The verbs of this module and the function that adds each one's arguments."""
 
 
 def validate_command(args: argparse.Namespace) -> int:

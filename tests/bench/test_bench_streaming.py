@@ -10,11 +10,11 @@ from typing import Any
 
 import pytest
 
-import bt_manip.bench as bench
-from bt_manip.bench_log import LOG_NAME, read_log
+import bt_manip.bench.pool as pool
+from bt_manip.bench.log import LOG_NAME, read_log
 from bt_manip.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCHEMAS = ROOT / "docs" / "schemas"
 WORLD = str(ROOT / "worlds" / "sawyer_table.yaml")
 
@@ -46,14 +46,14 @@ def test_an_interrupted_bench_keeps_its_episodes_and_resume_completes_it(
 ) -> None:
     tree = _tree(tmp_path)
     assert _bench(tree, tmp_path / "whole") == 1  # some seeds draw the failure
-    real_run_one = bench.run_one
+    real_run_one = pool.run_one
 
     def interrupted_at_seed_3(spec: Any) -> Any:
         if spec.seed == 3:
             raise KeyboardInterrupt
         return real_run_one(spec)
 
-    monkeypatch.setattr(bench, "run_one", interrupted_at_seed_3)
+    monkeypatch.setattr(pool, "run_one", interrupted_at_seed_3)
     assert _bench(tree, tmp_path / "cut") == 130
     assert "continue with: bt-manip bench --resume" in capsys.readouterr().out
     logged = read_log(tmp_path / "cut")
@@ -61,7 +61,7 @@ def test_an_interrupted_bench_keeps_its_episodes_and_resume_completes_it(
     assert logged.missing == [3, 4, 5]
     assert not (tmp_path / "cut" / "episodes.json").exists()
 
-    monkeypatch.setattr(bench, "run_one", real_run_one)
+    monkeypatch.setattr(pool, "run_one", real_run_one)
     # a line cut short by a crash is dropped, and the bench goes on after the whole lines
     with open(tmp_path / "cut" / LOG_NAME, "a") as fh:
         fh.write('{"kind": "episode", "seed": 3, "sta')
@@ -208,16 +208,16 @@ def test_an_interrupted_sweep_resumes_value_by_value(
     args = ["bench", str(tree), "--world", WORLD, "--runs", "3", "--jobs", "1",
             "--sweep", "step:failure:{0,1}"]
     assert main([*args, "--out", str(tmp_path / "whole")]) == 1
-    real_run_one = bench.run_one
+    real_run_one = pool.run_one
 
     def interrupted(spec: Any) -> Any:
         if spec.seed == 1 and spec.inject[-1].probability == 1.0:
             raise KeyboardInterrupt
         return real_run_one(spec)
 
-    monkeypatch.setattr(bench, "run_one", interrupted)
+    monkeypatch.setattr(pool, "run_one", interrupted)
     assert main([*args, "--out", str(tmp_path / "cut")]) == 130
-    monkeypatch.setattr(bench, "run_one", real_run_one)
+    monkeypatch.setattr(pool, "run_one", real_run_one)
     assert main(["bench", "--resume", str(tmp_path / "cut")]) == 1
     for folder in ("00_0", "01_1"):
         assert _outcomes(tmp_path / "cut" / folder) == _outcomes(tmp_path / "whole" / folder)

@@ -15,7 +15,7 @@ from tree_files import write_tree
 from bt_manip.bt import registry
 from bt_manip.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TABLE = ROOT / "worlds" / "sawyer_table.yaml"
 
 NODE_MODULE = '''\

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bt_manip.bench import EpisodeResult, summarise, wilson_interval
+from bt_manip.bench.episodes import EpisodeResult
+from bt_manip.bench.stats import summarise, wilson_interval
 from bt_manip.cli import main
 from bt_manip.episode import EpisodeSpec
 from bt_manip.errors import InputError
@@ -176,7 +177,7 @@ def test_a_tree_with_injected_failures_looks_node_for_node_like_the_tree(tmp_pat
 def test_bench_runs_episodes_in_processes_and_writes_outputs(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     tree = tmp_path / "t.xml"
     tree.write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
@@ -223,7 +224,7 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
 
 
 def test_outcomes_plot_has_integer_seed_and_count_ticks() -> None:
-    from bt_manip.bench import outcomes_figure
+    from bt_manip.bench.files import outcomes_figure
 
     results = [
         EpisodeResult(3, "SUCCESS", "", 0.8, 0.1, 16),
@@ -250,7 +251,7 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     import subprocess
     import sys
 
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     tree = tmp_path / "long.xml"
     tree.write_text(
         '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sleep msec="3600000"/>'
@@ -346,7 +347,7 @@ def test_pose_noise_sigmas_are_those_asked_for() -> None:
 
 
 def test_bench_lists_the_leaves_that_failed_and_in_how_many_episodes(tmp_path: Path) -> None:
-    from bt_manip.bench import run_one
+    from bt_manip.bench.episodes import run_one
 
     tree = _retry_tree(tmp_path)
     results = [

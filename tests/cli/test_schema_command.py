@@ -10,7 +10,7 @@ import pytest
 
 from bt_manip.cli import main
 
-SCHEMAS = Path(__file__).resolve().parents[1] / "docs" / "schemas"
+SCHEMAS = Path(__file__).resolve().parents[2] / "docs" / "schemas"
 
 
 def test_schema_prints_the_run_reports_json_schema(capsys: pytest.CaptureFixture[str]) -> None:

@@ -1,27 +1,20 @@
-"""The ``robot`` verb of the command line: ``robot init`` and ``robot check``."""
+"""The ``robot`` verb: ``robot init`` writes a robot descriptor from a URDF, ``robot check``
+moves every joint of one to its limits and back (the work is :mod:`bt_manip.sim.robot_init`'s
+and :mod:`bt_manip.sim.robot_check`'s)."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from bt_manip.sim.robot_init import MOBILE_KINDS
-
-MAX_GRIPPER_JOINTS = 4
-
-
-def _joint_list(text: str) -> tuple[str, ...]:
-    names = tuple(n.strip() for n in text.split(",") if n.strip())
-    if not 1 <= len(names) <= MAX_GRIPPER_JOINTS:
-        raise argparse.ArgumentTypeError(
-            f"expected 1..{MAX_GRIPPER_JOINTS} joint names separated by commas, got '{text}'"
-        )
-    return names
+from bt_manip.cli.args import joint_list
+from bt_manip.sim.robot_check import check_robot
+from bt_manip.sim.robot_description import RobotDescription
+from bt_manip.sim.robot_init import MOBILE_KINDS, InitOptions, init_descriptor
 
 
-def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[type-arg]
-    """Register ``bt-manip robot init`` and ``bt-manip robot check``."""
-    robot = sub.add_parser("robot", help="write a robot descriptor from a URDF, or check one")
+def add_robot_arguments(robot: argparse.ArgumentParser) -> None:
+    """The arguments of ``bt-manip robot init`` and ``bt-manip robot check``."""
     verbs = robot.add_subparsers(dest="robot_verb", metavar="init|check", parser_class=type(robot))
     verbs.required = True
     init = verbs.add_parser("init", help="write robots/NAME.yaml from a URDF and check it")
@@ -29,7 +22,7 @@ def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     init.add_argument("--base-link", required=True, help="root link of the arm chain")
     init.add_argument("--arm-tip", required=True, help="last link of the arm chain (IK tip)")
     init.add_argument(
-        "--gripper", type=_joint_list, default=(), metavar="JOINT[,JOINT]",
+        "--gripper", type=joint_list, default=(), metavar="JOINT[,JOINT]",
         help="finger joints (prismatic or revolute); open/closed from their limits",
     )
     init.add_argument(
@@ -51,9 +44,11 @@ def add_robot_verb(sub: argparse._SubParsersAction) -> None:  # type: ignore[typ
     check.set_defaults(func=cmd_robot_check)
 
 
-def cmd_robot_init(args: argparse.Namespace) -> int:
-    from bt_manip.sim.robot_init import InitOptions, init_descriptor
+VERB_ARGUMENTS = {"robot": add_robot_arguments}
+"""The verbs of this module and the function that adds each one's arguments."""
 
+
+def cmd_robot_init(args: argparse.Namespace) -> int:
     desc = init_descriptor(
         InitOptions(
             urdf=Path(args.urdf),
@@ -89,9 +84,6 @@ def _written_here(name_or_path: str) -> str:
 
 
 def cmd_robot_check(args: argparse.Namespace) -> int:
-    from bt_manip.sim.robot_check import check_robot
-    from bt_manip.sim.robot_description import RobotDescription
-
     report = check_robot(RobotDescription.load(_written_here(args.robot)))
     print(report.table())
     return 0 if report.ok else 1

@@ -14,7 +14,7 @@ from bt_manip.cli import main
 
 pytest.importorskip("ray")
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 TREE = """<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>
   <MoveJoints state="home"/>
   <Script code="n := 7"/>

@@ -1,8 +1,8 @@
-"""The validate, show and nodes verbs, through argparse and through bt_manip.cli."""
+"""The validate, show and nodes verbs (bt_manip.cli.tree), through their parser and through
+bt_manip.cli.main."""
 
 from __future__ import annotations
 
-import argparse
 from collections.abc import Iterator
 from pathlib import Path
 from typing import ClassVar
@@ -12,9 +12,9 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, NodeStatus, TreeContext, load_tree, registry
-from bt_manip.bt.cli_verbs import add_verbs
 from bt_manip.bt.display import render_status
 from bt_manip.bt.documents import Document, read_model_file
+from bt_manip.cli import build_parser
 from bt_manip.clock import ManualClock
 
 DEMO = Path(__file__).resolve().parents[2] / "trees" / "builtins_demo.xml"
@@ -57,9 +57,7 @@ def custom_nodes() -> Iterator[None]:
 
 
 def run_verb(argv: list[str]) -> int:
-    parser = argparse.ArgumentParser(prog="bt-manip")
-    add_verbs(parser.add_subparsers())
-    args = parser.parse_args(argv)
+    args = build_parser(argv[:1]).parse_args(argv)
     return int(args.func(args))
 
 

@@ -14,7 +14,7 @@ from bt_manip.sim import assets
 from bt_manip.sim.robot_description import ROBOTS_DIR
 from bt_manip.sim.world_reader import parse_world
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_a_clone_reads_its_own_folders_and_a_wheel_its_package_data(
