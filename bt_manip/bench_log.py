@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import IO, TYPE_CHECKING, Any
 
 from bt_manip.errors import InputError
-from bt_manip.faults import parse_fault
+from bt_manip.run.faults import parse_fault
 from bt_manip.runner import RunOptions
 
 if TYPE_CHECKING:

@@ -26,13 +26,14 @@ import json
 import math
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from bt_manip.bundled import shipped_or_given
 from bt_manip.errors import InputError, Problem
-from bt_manip.interrupts import terminate_as_interrupt
 from bt_manip.plugins import add_import_flag
+from bt_manip.run.interrupts import terminate_as_interrupt
 from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED, RunOptions
 
 DEFAULT_BENCH_OUT = "out/bench"
@@ -149,7 +150,7 @@ def bb_value(text: str) -> Any:
 
 
 def _fault(text: str) -> Any:
-    from bt_manip.faults import parse_fault
+    from bt_manip.run.faults import parse_fault
 
     try:
         return parse_fault(text)
@@ -459,10 +460,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         publisher = _start_groot(args, episode)
         viz = setup_viz(args, world, tree)
         hooks += viz.hooks
-        episode.spec.options.realtime = viz.realtime
+        options = replace(episode.spec.options, realtime=viz.realtime)
         keep = bool(args.keep_serving and viz.viewing)
         try:
-            report = episode.run(hooks)
+            report = episode.run(hooks, options)
         except BaseException:
             viz.close()
             raise

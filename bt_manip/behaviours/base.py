@@ -17,10 +17,10 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
-from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
 from bt_manip.overlay import Overlay
 from bt_manip.perception import perceived_pose
-from bt_manip.run_context import RobotServices, RunContext
+from bt_manip.run.context import RobotServices, RunContext
+from bt_manip.run.faults import FaultInjector, PendingSlip, plan_slip, slip_out
 
 ROBOT_PORT = PortInformation(
     data_type=str,
@@ -76,7 +76,7 @@ class WorldAccess:
             _ = self.world  # without a world, that is the problem to report
             raise ActionFailed(
                 "this node needs the services of a run: give the tree "
-                "bt_manip.run_context.RunContext.for_world(world) as its context"
+                "bt_manip.run.context.RunContext.for_world(world) as its context"
             )
         return context
 

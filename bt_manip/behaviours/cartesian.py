@@ -14,7 +14,7 @@ import numpy as np
 
 from bt_manip.behaviours.base import ActionFailed
 from bt_manip.kinematics import IKSolver, KinematicsError
-from bt_manip.run_context import ArmIK, RobotServices
+from bt_manip.run.context import ArmIK, RobotServices
 
 STEP = 0.02
 """Spacing (m) of the waypoints of a straight-line move."""

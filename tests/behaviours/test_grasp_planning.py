@@ -12,10 +12,10 @@ import pybullet as pb
 import pytest
 from bhelpers import place_robot, reasons, run_xml
 
-from bt_manip.faults import FaultInjector, FaultSpec
 from bt_manip.geometry import pose_matrix, quat_from_euler
 from bt_manip.grasps import GRASP_DEPTH, GraspError, top_grasp
 from bt_manip.perception import perceived_pose, true_pose
+from bt_manip.run.faults import FaultInjector, FaultSpec
 from bt_manip.sim.world import World
 
 HERE = Path(__file__).resolve().parent

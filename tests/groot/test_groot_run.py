@@ -16,11 +16,11 @@ import pytest
 from groot_client import GrootClient, sync_subscription
 from test_groot_breakpoints import status_of, uid_of, wait_for_breakpoint
 
-from bt_manip import runner as runner_module
 from bt_manip.bt import TreeContext, load_tree
 from bt_manip.cli import main
 from bt_manip.groot import GrootPublisher, TreeMonitor, read_btlog
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run import runner as runner_module
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 

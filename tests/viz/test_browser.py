@@ -16,7 +16,7 @@ import pytest
 from drive_tree import ROOM, DriveTree
 
 from bt_manip.cli import main
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 from bt_manip.viz.recorder import Recorder
