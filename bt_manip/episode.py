@@ -26,7 +26,7 @@ from bt_manip.groot import BtlogWriter, TreeMonitor
 from bt_manip.plugins import import_modules
 from bt_manip.run.context import RunContext
 from bt_manip.run.faults import FaultInjector, FaultSpec, inject_node_failures
-from bt_manip.run.hooks import RunHook, TickCallback
+from bt_manip.run.hooks import RunHook, TickCallback, close_hooks
 from bt_manip.run.report import RunReport
 from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
@@ -99,20 +99,20 @@ class Episode:
         ``options`` replace the spec's (``bt-manip run`` paces a run it shows live). The runner
         owns ``hooks`` (and the .btlog writer of ``spec.btlog``): they are closed when this
         returns or raises."""
-        opts = options if options is not None else self.spec.options
-        runner = Runner(self.tree, self.world, opts, on_tick=hooks)
+        watching = list(hooks)
         if self.spec.btlog:
             try:
                 writer = BtlogWriter(self.spec.btlog, self.monitor())
             except OSError as e:
-                runner.close_hooks()
+                close_hooks(watching)
                 raise InputError.single(
                     "--btlog", None, f"cannot write {self.spec.btlog}: {e.strerror}") from None
             except BaseException:
-                runner.close_hooks()
+                close_hooks(watching)
                 raise
-            runner.on_tick.insert(0, writer)  # closed first, as soon as the run ends
-        report = runner.run()
+            watching.insert(0, writer)  # closed first, as soon as the run ends
+        opts = options if options is not None else self.spec.options
+        report = Runner(self.tree, self.world, opts, on_tick=watching).run()
         report.tree = self.spec.tree
         report.world = self.spec.world or ""
         report.seed = self.spec.seed if self.world is not None else None
