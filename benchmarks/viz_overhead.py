@@ -34,7 +34,7 @@ from py_trees.common import Status
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from bt_manip.runner import Runner, RunOptions  # noqa: E402
+from bt_manip.run.runner import Runner, RunOptions  # noqa: E402
 from bt_manip.sim.world import World  # noqa: E402
 
 WORLD = REPO / "worlds" / "tb3_house.yaml"

@@ -2,7 +2,7 @@
 frames).
 
 Behaviours do not know whether anyone is watching. They write to the overlay of their run
-(:attr:`bt_manip.run_context.RunContext.overlay`)::
+(:attr:`bt_manip.run.context.RunContext.overlay`)::
 
     overlay.show_path("base_plan", [(x0, y0), (x1, y1), ...])
     overlay.show_frame("ik_target", T_world_target)   # 4x4
@@ -82,3 +82,10 @@ class Overlay:
                 self.version += 1
         elif self.items.pop(name, None) is not None:
             self.version += 1
+
+
+def run_overlay(tree: Any) -> Overlay | None:
+    """The overlay of the run that ``tree`` ticks in (the ``overlay`` of its context, a
+    :class:`~bt_manip.run.context.RunContext`); None when its context has none."""
+    overlay = getattr(getattr(tree, "context", None), "overlay", None)
+    return overlay if isinstance(overlay, Overlay) else None

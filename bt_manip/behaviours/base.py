@@ -10,19 +10,23 @@ reason in ``feedback_message``, which the console and the run report show.
 
 from __future__ import annotations
 
-from typing import Any, ClassVar, Protocol, cast
+from typing import TYPE_CHECKING, Any, ClassVar, Protocol, cast
 
 import numpy as np
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
-from bt_manip.faults import FaultInjector, PendingSlip, plan_slip, slip_out
 from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.manipulation.grasps import grasped_object
 from bt_manip.manipulation.perception import PerceptionError, movable_body, perceived_pose
 from bt_manip.overlay import Overlay
-from bt_manip.run_context import RobotServices, RunContext
+from bt_manip.run.context import RobotServices, RunContext
+from bt_manip.run.faults import FaultInjector, PendingSlip, plan_slip, slip_out
+
+if TYPE_CHECKING:
+    from bt_manip.sim.robot import Robot
+    from bt_manip.sim.world import World
 
 ROBOT_PORT = PortInformation(
     data_type=str,
@@ -41,7 +45,7 @@ FAILS = (ActionFailed, PortError, ManipulationError)
 value it cannot take, and what the manipulation helpers it calls cannot do."""
 
 
-def skid_steer_refusal(robot: Any, node_id: str) -> str | None:
+def skid_steer_refusal(robot: Robot, node_id: str) -> str | None:
     """Why ``node_id`` cannot drive ``robot`` (a :class:`bt_manip.sim.robot.Robot`), or None when
     its base is a skid-steer base, the only kind the node drives."""
     kind = robot.description.base.type
@@ -68,8 +72,8 @@ class WorldAccess:
     feedback_message: str
 
     @property
-    def world(self) -> Any:
-        world = cast(_Node, self).context.world
+    def world(self) -> World:
+        world: World | None = cast(_Node, self).context.world
         if world is None:
             raise ActionFailed("this node needs a world (run with --world)")
         return world
@@ -83,7 +87,7 @@ class WorldAccess:
             _ = self.world  # without a world, that is the problem to report
             raise ActionFailed(
                 "this node needs the services of a run: give the tree "
-                "bt_manip.run_context.RunContext.for_world(world) as its context"
+                "bt_manip.run.context.RunContext.for_world(world) as its context"
             )
         return context
 
@@ -98,7 +102,7 @@ class WorldAccess:
         context = cast(_Node, self).context
         return context.overlay if isinstance(context, RunContext) else Overlay()
 
-    def robot(self) -> Any:
+    def robot(self) -> Robot:
         """The robot named by the ``robot`` port, or the only robot of the world."""
         robots = self.world.robots
         node = cast(_Node, self)
@@ -117,8 +121,8 @@ class WorldAccess:
     def robot_name(self) -> str:
         return self.robot_name_of(self.robot())
 
-    def robot_name_of(self, robot: Any) -> str:
-        robots: dict[str, Any] = self.world.robots
+    def robot_name_of(self, robot: Robot) -> str:
+        robots: dict[str, Robot] = self.world.robots
         for name, r in robots.items():
             if r is robot:
                 return name

@@ -19,11 +19,11 @@ from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess
 from bt_manip.behaviours.collisions import carried_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
-from bt_manip.faults import block_route
 from bt_manip.navigation.controller import FollowState
 from bt_manip.navigation.grid import GridTooLarge
 from bt_manip.navigation.holonomic import HolonomicStatus
 from bt_manip.navigation.navigator import Navigator
+from bt_manip.run.faults import block_route
 from bt_manip.sim import pybullet_queries as pbq
 
 TIME_BUDGET_FACTOR = 1.5

@@ -25,8 +25,8 @@ from typing import IO, Any
 from bt_manip.bench.episodes import SCHEMA_VERSION, EpisodeResult
 from bt_manip.episode import EpisodeSpec
 from bt_manip.errors import InputError
-from bt_manip.faults import parse_fault
-from bt_manip.runner import RunOptions
+from bt_manip.run.faults import parse_fault
+from bt_manip.run.runner import RunOptions
 
 LOG_NAME = "episodes.jsonl"
 MAX_LOG_BYTES = 64 * 1024 * 1024

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 from bt_manip.bench.episodes import SCHEMA_VERSION
 from bt_manip.bt.blackboard import bb_value
 from bt_manip.errors import InputError
-from bt_manip.faults import parse_fault
+from bt_manip.run.faults import parse_fault
 
 if TYPE_CHECKING:
     from bt_manip.bench.stats import BenchSummary

@@ -70,9 +70,10 @@ PAYLOADS: dict[str, float] = {"husky_ur3": 3.0}
 """Rated payload (kg) of the arms of known robots: the UR3's is 3 kg (Universal Robots)."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class BimOptions:
-    """What ``bt-manip bim`` was asked for."""
+    """What ``bt-manip bim`` was asked for (frozen: change a copy with
+    :func:`dataclasses.replace`)."""
 
     ifc: Path
     out: Path

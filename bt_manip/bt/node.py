@@ -98,7 +98,7 @@ class BtNode(PortsMixin):
     failure_order: int = 0
     """When the node last started (was ticked while IDLE) and last returned FAILURE, as ranks
     on one counter (0: never); they tell the failures of a node's last run from older ones
-    (see :mod:`bt_manip.failure_cause`)."""
+    (see :mod:`bt_manip.run.failure_cause`)."""
     PORT_TYPE_NAMES: ClassVar[dict[str, str]] = {}  # BT.CPP type names that differ from ours
     MODEL_TYPE_NAMES: ClassVar[dict[str, str]] = {}
     """Type names the TreeNodesModel shows for ports, when they differ from those the

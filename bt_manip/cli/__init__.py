@@ -35,7 +35,8 @@ from typing import Any
 
 from bt_manip import __version__
 from bt_manip.errors import InputError, Problem
-from bt_manip.interrupts import terminate_as_interrupt
+from bt_manip.run.interrupts import terminate_as_interrupt
+from bt_manip.run.status import EXIT_BAD_INPUT, EXIT_INTERRUPTED
 
 __all__ = ["bb_value", "build_parser", "main"]
 
@@ -73,8 +74,6 @@ class Parser(argparse.ArgumentParser):
     """argparse that reports bad arguments with exit code 2 and one line, no usage dump."""
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        from bt_manip.runner import EXIT_BAD_INPUT
-
         self.exit(EXIT_BAD_INPUT, f"{self.prog}: {message} (see {self.prog} --help)\n")
 
 
@@ -116,8 +115,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``bt-manip`` console script; returns the exit code."""
     words = sys.argv[1:] if argv is None else list(argv)
     args = build_parser(_verb_of(words)).parse_args(words)
-    from bt_manip.runner import EXIT_BAD_INPUT, EXIT_INTERRUPTED
-
     try:
         with terminate_as_interrupt():
             return int(args.func(args))

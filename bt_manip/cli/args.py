@@ -13,7 +13,7 @@ from typing import Any
 
 from bt_manip.bt.blackboard import bb_value
 from bt_manip.errors import InputError
-from bt_manip.faults import FaultSpec, parse_fault
+from bt_manip.run.faults import FaultSpec, parse_fault
 
 DEFAULT_TICK_HZ = 20.0
 """Tree tick rate of ``run``, ``bench`` and ``demo`` (Hz)."""
@@ -120,7 +120,7 @@ def bb_pair(text: str) -> tuple[str, Any]:
 
 
 def fault(text: str) -> FaultSpec:
-    """An ``--inject`` fault (:func:`~bt_manip.faults.parse_fault`)."""
+    """An ``--inject`` fault (:func:`~bt_manip.run.faults.parse_fault`)."""
     try:
         return parse_fault(text)
     except InputError as exc:

@@ -15,7 +15,7 @@ import argparse
 import json
 import sys
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from bt_manip.bundled import DEMO_TREE, DEMO_WORLD, shipped_or_given
@@ -37,7 +37,9 @@ from bt_manip.groot import GrootPublisher
 from bt_manip.groot.publisher import GrootError
 from bt_manip.outputs import check_output_file, check_output_folder, write_text
 from bt_manip.plugins import add_import_flag
-from bt_manip.runner import EXIT_BAD_INPUT, RunOptions
+from bt_manip.run.hooks import RunHook
+from bt_manip.run.runner import RunOptions
+from bt_manip.run.status import EXIT_BAD_INPUT
 from bt_manip.sim.assets import data_root
 from bt_manip.viz.console import LiveTreeView, StatusLog
 from bt_manip.viz.hooks import setup_viz
@@ -274,25 +276,18 @@ def run_tree(command: RunCommand) -> int:
         tree, world = episode.tree, episode.world
         if world is not None and not command.quiet:
             print(world.summary())
-        hooks: list[Any] = [] if command.quiet else [_live_view(tree)]
+        hooks: list[RunHook] = [] if command.quiet else [_live_view(tree)]
         publisher = _start_groot(command, episode)
-        viz = setup_viz(command, world, tree)
+        if publisher is not None:
+            hooks.append(publisher)  # closed after the console view, before the viewer
+        viz = setup_viz(command, world, tree)  # with --keep-serving the viewer outlives close()
         hooks += viz.hooks
-        episode.spec.options.realtime = viz.realtime
-        keep = bool(command.keep_serving and viz.viewing)
+        options = replace(episode.spec.options, realtime=viz.realtime)
         try:
-            report = episode.run(hooks)
+            report = episode.run(hooks, options)  # the runner closes every hook
         except BaseException:
-            viz.close()
+            viz.stop()  # a viewer kept for --keep-serving goes too
             raise
-        finally:
-            for hook in hooks:
-                close = getattr(hook, "close", None)
-                if hook not in viz.hooks and callable(close):
-                    close()
-            if publisher is not None:
-                publisher.close()
-        viz.close(keep_viewer=keep)
         print(report.summary())
         if report.extra.get("injected"):
             print(f"  faults injected: {len(report.extra['injected'])}")
@@ -305,7 +300,7 @@ def run_tree(command: RunCommand) -> int:
             bb_path = command.bb_out
             writes.append(("--bb-out", bb_path, lambda: write_text(bb_path, entries)))
         status = _write_outputs(writes) or report.exit_code
-        if keep:
+        if command.keep_serving and viz.viewing:
             viz.serve_until_interrupted()
         return status
 

@@ -14,12 +14,15 @@ import struct
 import time
 from dataclasses import dataclass
 from pathlib import Path
-from typing import BinaryIO
+from typing import TYPE_CHECKING, BinaryIO
 
 from bt_manip.bt.status import STATUS_CODES, NodeStatus
 from bt_manip.groot.layout import registered_classes, tree_xml
 from bt_manip.groot.monitor import TreeMonitor
 from bt_manip.groot.protocol import decode_transitions
+
+if TYPE_CHECKING:
+    from bt_manip.run.runner import Runner
 
 MAGIC = b"BTCPP4-FileLogger2"
 _TRANSITION = struct.Struct("<IHHB")  # 48-bit timestamp as 32 + 16 bits, uid, status
@@ -27,7 +30,10 @@ VERSION = 1
 
 
 class BtlogWriter:
-    """Writes the status changes seen by ``monitor`` to ``path`` until :meth:`close`."""
+    """Writes the status changes seen by ``monitor`` to ``path`` until :meth:`close`.
+
+    A run hook (:class:`~bt_manip.run.hooks.RunHook`): the changes come from the monitor, so
+    there is nothing to do after a tick; the runner closes it when the run ends."""
 
     def __init__(self, path: str | Path, monitor: TreeMonitor, xml: str | None = None) -> None:
         self.path = Path(path)
@@ -45,8 +51,11 @@ class BtlogWriter:
             self._file.write(_TRANSITION.pack(stamp & 0xFFFF_FFFF, (stamp >> 32) & 0xFFFF, uid,
                                               STATUS_CODES[new]))
 
+    def __call__(self, runner: Runner) -> None:
+        """After a tick: nothing (the monitor has passed on every change already)."""
+
     def close(self) -> None:
-        """Flush and close the file (further changes are not written)."""
+        """Flush and close the file (further changes are not written). Idempotent."""
         if self._file is None:
             return
         with self.monitor.lock:

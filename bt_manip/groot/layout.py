@@ -15,6 +15,7 @@ from xml.sax.saxutils import escape, quoteattr
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.models import spec_of
 from bt_manip.bt.node import BtNode
+from bt_manip.bt.registry import registry
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
 from bt_manip.bt.walk import walk_nodes
@@ -167,6 +168,4 @@ def tree_xml(layout: TreeLayout, classes: list[type[BtNode]]) -> str:
 
 def registered_classes() -> list[type[BtNode]]:
     """Every node class of the registry (robot behaviours are there once imported)."""
-    from bt_manip.bt.registry import registry
-
     return registry.classes()

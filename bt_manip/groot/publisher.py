@@ -18,7 +18,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable
-from typing import Any, cast
+from typing import TYPE_CHECKING, Any, cast
 
 import msgpack
 import zmq
@@ -38,6 +38,9 @@ from bt_manip.groot.protocol import (
     status_code,
 )
 
+if TYPE_CHECKING:
+    from bt_manip.run.runner import Runner
+
 DEFAULT_GROOT_PORT = 1667
 MAX_TRANSITIONS = 1000
 _TWO_PARTS = (RequestType.BLACKBOARD, RequestType.HOOK_INSERT, RequestType.HOOK_REMOVE,
@@ -50,6 +53,9 @@ class GrootError(RuntimeError):
 
 class GrootPublisher:
     """Serves ``monitor``'s tree to Groot2 until :meth:`close`.
+
+    A run hook (:class:`~bt_manip.run.hooks.RunHook`): the status changes come from the
+    monitor, so there is nothing to do after a tick; the runner closes it when the run ends.
 
     Args:
         monitor: the tree's status-change monitor (its clock stamps the transitions).
@@ -105,6 +111,7 @@ class GrootPublisher:
         self.paused_uid: int | None = None
         """UID of the node whose breakpoint holds the tree now (None when it runs)."""
         self._active = True
+        self._closed = False
         monitor.consumers.append(self._record)
         self._thread = threading.Thread(target=self._serve, name="groot2-publisher", daemon=True)
         self._thread.start()
@@ -140,8 +147,15 @@ class GrootPublisher:
         self._pub.close(0)
         self._context.term()
 
+    def __call__(self, runner: Runner) -> None:
+        """After a tick: nothing (the monitor has passed on every change already)."""
+
     def close(self) -> None:
-        """Stop serving: hooks are removed (a paused tree goes on), the thread ends."""
+        """Stop serving: hooks are removed (a paused tree goes on), the thread ends.
+        Idempotent."""
+        if self._closed:
+            return
+        self._closed = True
         self.remove_all_hooks()
         self._active = False
         self._thread.join()

@@ -59,7 +59,7 @@ from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.manipulation.grasps import GraspError, box_size, grasp_frame, top_face
 from bt_manip.manipulation.perception import seen_pose
 from bt_manip.navigation.lattice import outline_samples
-from bt_manip.run_context import RobotServices
+from bt_manip.run.context import RobotServices
 
 SWEEP_STEP = 0.1
 """Spacing (m) of the footprint checks along the straight drive from the staging pose."""

@@ -2,7 +2,7 @@
 
 Each robot gets one :class:`~bt_manip.kinematics.ArmModel` and solver per tip frame, built from
 the same URDF PyBullet loaded and kept for the run by its
-:class:`~bt_manip.run_context.RobotServices`. Solves are deterministic (no
+:class:`~bt_manip.run.context.RobotServices`. Solves are deterministic (no
 wall-clock budget, a bounded number of seeded restarts), so the same run gives the same joints.
 A target the arm cannot reach raises :class:`CartesianError` with IK's reason.
 """
@@ -15,7 +15,7 @@ import numpy as np
 
 from bt_manip.kinematics import IKSolver, KinematicsError
 from bt_manip.manipulation.errors import ManipulationError
-from bt_manip.run_context import ArmIK, RobotServices
+from bt_manip.run.context import ArmIK, RobotServices
 
 STEP = 0.02
 """Spacing (m) of the waypoints of a straight-line move."""

@@ -3,7 +3,7 @@
 A node that plans from where an object is (MoveToPose ``object=...``, PlanBaseForGrasp, the grasp
 frame of an object) reads the object's pose with :func:`perceived_pose`: the simulator's ground
 truth, plus the episode's perception error of that object when ``--inject pose_noise:...`` is
-on (:meth:`bt_manip.faults.FaultInjector.pose_offset`: drawn once per object and episode, so
+on (:meth:`bt_manip.run.faults.FaultInjector.pose_offset`: drawn once per object and episode, so
 every node of the run sees the object at the same wrong place). Conditions and physics
 (ObjectInRegion, IsAttached, the proximity check of Attach) keep reading the ground truth.
 """

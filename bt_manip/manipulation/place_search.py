@@ -45,7 +45,7 @@ from bt_manip.manipulation.grasps import GraspError, box_size
 from bt_manip.manipulation.perception import true_pose
 from bt_manip.manipulation.placing import Target, lifted, place_frames, yaw_of_matrix
 from bt_manip.navigation.lattice import LatticeOptions, outline_samples, pose_free
-from bt_manip.run_context import RobotServices
+from bt_manip.run.context import RobotServices
 
 STANDOFFS = (0.12, 0.16, 0.2)
 """How far (m) the poses of step 1 stand back from where the object would be over its target:

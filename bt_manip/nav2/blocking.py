@@ -3,7 +3,7 @@ route.
 
 A planner node draws the fault once per goal (:func:`maybe_block`, as Navigate does); the crate
 does not fall at once but when FollowPath brings the robot within
-:data:`~bt_manip.faults.BLOCK_NEAR` of its place (:func:`drop_if_due`). A crate that appears so
+:data:`~bt_manip.run.faults.BLOCK_NEAR` of its place (:func:`drop_if_due`). A crate that appears so
 close is on the path the robot is following: the controller stops for it, and the tree's
 recoveries and replanning have to get the robot round it.
 """
@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.faults import drop_crate, plan_block
+from bt_manip.run.faults import drop_crate, plan_block
 
 
 def maybe_block(node: Any, polyline: np.ndarray, route: str) -> bool:

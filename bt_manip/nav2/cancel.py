@@ -4,7 +4,7 @@ CancelDriveOnHeading.
 In Nav2 each cancels every goal of one action server (the controller, or a behaviour of the
 behaviour server), whichever node of the tree sent it. Here the action servers are the robot
 actions of the run: a Cancel node cancels every action of its kind RUNNING on its robot now
-(the run lists them, :class:`~bt_manip.run_context.RunningActions`). A cancelled action leaves
+(the run lists them, :class:`~bt_manip.run.context.RunningActions`). A cancelled action leaves
 the robot safe at once (the base stops) and returns SUCCESS at its next tick with result code 0,
 as Nav2's action nodes do when their goal is cancelled.
 

@@ -22,7 +22,7 @@ import contextlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pybullet as pb
@@ -38,6 +38,9 @@ from bt_manip.sim.robot import Robot, RobotDescription
 from bt_manip.sim.static_bodies import make_static
 from bt_manip.sim.world_reader import parse_world
 from bt_manip.sim.world_spec import BodySpec, Part, Pose2D, Pose3D, WallSpec, WorldSpec
+
+if TYPE_CHECKING:
+    from bt_manip.sim.robot import Robot
 
 OVERLAP_TOLERANCE = 0.002
 """Penetration (m) between two bodies at spawn beyond which they are reported as overlapping."""
@@ -108,7 +111,7 @@ class World:
         self.client = pb.connect(pb.GUI if gui else pb.DIRECT)
         pbq.forget_collision_shapes(self.client)  # of an earlier client with this id
         self.infos: dict[str, BodyInfo] = {}
-        self.robots: dict[str, Any] = {}
+        self.robots: dict[str, Robot] = {}
         self.poses: dict[str, Pose2D] = dict(self.spec.poses)
         self.models: dict[str, BodySpec] = {m.name: m for m in self.spec.models}
         self.events = WorldEvents()

@@ -1,4 +1,4 @@
-"""Console views of a running tree.
+"""Console views of a running tree, as run hooks (:class:`~bt_manip.run.hooks.RunHook`).
 
 - :class:`LiveTreeView`: in a terminal, the whole tree redrawn in place with each node's status
   (at most ``fps`` times per wall-clock second, so it costs little on fast runs).
@@ -10,10 +10,14 @@ from __future__ import annotations
 
 import sys
 import time
-from typing import Any, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
+from bt_manip.bt.display import render_status
 from bt_manip.bt.status import as_status, shown
-from bt_manip.runner import NodeReport, Runner, node_reports
+from bt_manip.run.report import NodeReport, node_reports
+
+if TYPE_CHECKING:
+    from bt_manip.run.runner import Runner
 
 
 def _shown(rec: NodeReport) -> str:
@@ -42,6 +46,7 @@ class StatusLog:
                 self._last[rec.path] = now
 
     def close(self) -> None:
+        """Flush the stream (idempotent)."""
         self.stream.flush()
 
 
@@ -57,10 +62,9 @@ class LiveTreeView:
         self._next = 0.0
         self._live = Live(console=Console(), auto_refresh=False, transient=False)
         self._live.start()
+        self._closed = False
 
     def _render(self, runner: Runner | None) -> str:
-        from bt_manip.bt.display import render_status
-
         head = f"sim time {runner.sim_time:8.2f} s, tick {runner.ticks}\n" if runner else ""
         return head + render_status(self.tree)
 
@@ -73,6 +77,10 @@ class LiveTreeView:
             self._live.update(Text(self._render(runner)), refresh=True)
 
     def close(self) -> None:
+        """Draw the final statuses and stop redrawing (once)."""
+        if self._closed:
+            return
+        self._closed = True
         from rich.text import Text
 
         self._live.update(Text(self._render(None)), refresh=True)

@@ -2,26 +2,30 @@
 --keep-serving``.
 
 :func:`setup_viz` reads those options, starts what was asked for and returns the hooks to give
-the :class:`~bt_manip.runner.Runner` and the pacing to use: a live view runs at real time
-unless ``--realtime FACTOR`` says otherwise; a recording alone does not slow the run down.
-A meshcat viewer that cannot start has already warned once; the run goes on headless. A tree
-page that cannot listen where it was asked to (``--port`` taken, ``--bind`` not an address of
-this machine) is bad input: :class:`~bt_manip.errors.InputError` naming the flag. Without
-``--port``, a taken default port falls back to any free port.
+the :class:`~bt_manip.run.runner.Runner` (which closes them when the run ends) and the pacing to
+use: a live view runs at real time unless ``--realtime FACTOR`` says otherwise; a recording
+alone does not slow the run down. A meshcat viewer that cannot start has already warned once;
+the run goes on headless. A tree page that cannot listen where it was asked to (``--port``
+taken, ``--bind`` not an address of this machine) is bad input:
+:class:`~bt_manip.errors.InputError` naming the flag. Without ``--port``, a taken default port
+falls back to any free port.
 
-:meth:`VizSetup.serve_until_interrupted` keeps the live page and the 3D view up after the run
-(``--keep-serving``) until Ctrl-C or SIGTERM.
+With ``--keep-serving`` the live viewer outlives the run (its ``close()`` shows the end of the
+run and keeps serving); :meth:`VizSetup.serve_until_interrupted` keeps it up until Ctrl-C or
+SIGTERM, and :meth:`VizSetup.stop` stops it at once (when the run raised).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 from bt_manip.errors import InputError
+from bt_manip.viz.live import LiveOptions, LiveViewer
+from bt_manip.viz.recorder import Recorder, RecordOptions
 from bt_manip.viz.tree_page import DEFAULT_PORT, PortUnavailable
 
 
@@ -29,22 +33,30 @@ from bt_manip.viz.tree_page import DEFAULT_PORT, PortUnavailable
 class VizSetup:
     """What :func:`setup_viz` started."""
 
-    hooks: list[Any] = field(default_factory=list)
+    hooks: list[LiveViewer | Recorder] = field(default_factory=list)
     viewing: bool = False
     realtime: float | None = None
-    viewer: Any = None
+    viewer: LiveViewer | None = None
     """The live viewer, when one runs."""
 
     def close(self, keep_viewer: bool = False) -> None:
         """Close every hook (write the replay, stop the servers); with ``keep_viewer`` the
-        live viewer stays up, showing the end of the run."""
+        live viewer stays up, showing the end of the run, else it stops even when it was
+        started to keep serving. Idempotent (the runner has closed the hooks already when its
+        run ended)."""
         for hook in self.hooks:
-            if keep_viewer and hook is self.viewer:
-                hook.show_last()
+            if hook is self.viewer:
+                if keep_viewer:
+                    hook.show_last()
+                else:
+                    hook.stop()
                 continue
-            close = getattr(hook, "close", None)
-            if callable(close):
-                close()
+            hook.close()
+
+    def stop(self) -> None:
+        """Stop the live viewer, kept serving or not (when the run raised)."""
+        if self.viewer is not None:
+            self.viewer.stop()
 
     def serve_until_interrupted(self, say: Callable[[str], None] = print) -> None:
         """Keep serving the live view until Ctrl-C or SIGTERM (KeyboardInterrupt), then stop
@@ -59,7 +71,7 @@ class VizSetup:
         except KeyboardInterrupt:
             pass
         finally:
-            viewer.close()
+            viewer.stop()
 
 
 def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = print) -> VizSetup:
@@ -68,12 +80,11 @@ def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = pri
     out = VizSetup(realtime=getattr(args, "realtime", None))
     title = Path(getattr(args, "tree", "") or "bt-manip").name
     if getattr(args, "viz", False) or getattr(args, "zmq_url", None):
-        from bt_manip.viz.live import LiveOptions, LiveViewer
-
         port = getattr(args, "port", None)
         bind = getattr(args, "bind", None) or "127.0.0.1"
-        viewer = _start_viewer(LiveViewer, LiveOptions, world, tree, title, say, port, bind,
-                               getattr(args, "zmq_url", None))
+        options = LiveOptions(zmq_url=getattr(args, "zmq_url", None), port=port, bind=bind,
+                              keep_serving=bool(getattr(args, "keep_serving", False)))
+        viewer = _start_viewer(world, tree, options, title, say)
         if viewer is not None:
             out.hooks.append(viewer)
             out.viewer = viewer
@@ -82,8 +93,6 @@ def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = pri
                 out.realtime = 1.0
     record = getattr(args, "record", None)
     if record:
-        from bt_manip.viz.recorder import Recorder, RecordOptions
-
         info = {
             "tree": str(getattr(args, "tree", "") or ""),
             "world": str(getattr(args, "world", "") or ""),
@@ -93,20 +102,21 @@ def setup_viz(args: Any, world: Any, tree: Any, say: Callable[[str], None] = pri
     return out
 
 
-def _start_viewer(viewer_class: Any, options_class: Any, world: Any, tree: Any, title: str,
-                  say: Callable[[str], None], port: int | None, bind: str,
-                  zmq_url: str | None) -> Any:
-    """Start the live viewer on ``port`` (the default one, or any free one when the default
-    is taken); None when meshcat cannot run. Raises InputError for ``--port``/``--bind``."""
-    chosen = DEFAULT_PORT if port is None else port
+def _start_viewer(world: Any, tree: Any, options: LiveOptions, title: str,
+                  say: Callable[[str], None]) -> LiveViewer | None:
+    """Start the live viewer on ``options.port`` (the default one, or any free one when the
+    default is taken); None when meshcat cannot run. Raises InputError for
+    ``--port``/``--bind``."""
+    asked = options.port
+    options = replace(options, port=DEFAULT_PORT if asked is None else asked)
     while True:
-        viewer = viewer_class(world, tree, options_class(zmq_url=zmq_url, port=chosen, bind=bind),
-                              title=title, say=say)
+        viewer = LiveViewer(world, tree, options, title=title, say=say)
         try:
             return viewer if viewer.start() else None
         except PortUnavailable as exc:
-            if port is None and chosen != 0 and exc.in_use:
-                say(f"port {chosen} is in use; serving the tree page on a free port instead")
-                chosen = 0
+            if asked is None and options.port != 0 and exc.in_use:
+                say(f"port {options.port} is in use; serving the tree page on a free port "
+                    "instead")
+                options = replace(options, port=0)
                 continue
             raise InputError.single(exc.flag, None, exc.strerror or str(exc)) from None

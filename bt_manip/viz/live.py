@@ -1,6 +1,8 @@
 """The live view: the world in meshcat and the tree page, updated after every tick.
 
-:class:`LiveViewer` is a run hook (``hook(runner)`` after each tick, ``close()`` at the end).
+:class:`LiveViewer` is a run hook (:class:`~bt_manip.run.hooks.RunHook`: ``hook(runner)``
+after each tick, ``close()`` when the run has ended; with ``keep_serving`` it shows the end of
+the run and goes on serving until :meth:`LiveViewer.stop`).
 On :meth:`LiveViewer.start` it starts a meshcat server (or attaches to ``zmq_url``), draws the
 world as it is (:mod:`bt_manip.viz.scene`), listens to the World's announcements
 (:mod:`bt_manip.sim.events`) and serves the tree page (:mod:`bt_manip.viz.tree_page`). After
@@ -20,19 +22,22 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from bt_manip.bt.status import STATUS_CODES, NodeStatus
-from bt_manip.overlay import FrameItem, Overlay
-from bt_manip.run_context import run_overlay
+from bt_manip.overlay import FrameItem, Overlay, run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.camera import CameraView, live_camera
 from bt_manip.viz.meshcat_link import MeshcatLink, ViewerUnavailable
+from bt_manip.viz.overlay import item_json
 from bt_manip.viz.scene import ROOT, Scene, SceneBody, build_scene, column_major, row_matrix
 from bt_manip.viz.tree_page import DEFAULT_PORT, PageState, TreePageServer, reachable
 from bt_manip.viz.tree_state import TreeWatcher, run_result
+
+if TYPE_CHECKING:
+    from bt_manip.run.runner import Runner
 
 OVERLAY_ROOT = "/meshcat/bt_manip_overlay"
 HIGHLIGHT_RGBA = (0.15, 0.95, 0.55, 1.0)
@@ -46,9 +51,10 @@ FOLLOW_EPS = 0.005
 """The view re-centres on the robot when it has moved this far (m)."""
 
 
-@dataclass
+@dataclass(frozen=True)
 class LiveOptions:
-    """Where the live view is served and how often it updates."""
+    """Where the live view is served, how often it updates, and whether it outlives the run
+    (frozen: change a copy with :func:`dataclasses.replace`)."""
 
     zmq_url: str | None = None
     """Attach to this meshcat server; None starts one."""
@@ -59,6 +65,10 @@ class LiveOptions:
     max_fps: float = 30.0
     """At most this many scene updates per wall-clock second (the page shows every tick)."""
     timeout: float = 3.0
+    """Seconds to wait for a meshcat server to answer."""
+    keep_serving: bool = False
+    """Go on serving the end of the run after :meth:`LiveViewer.close` (``--keep-serving``),
+    until :meth:`LiveViewer.stop`."""
 
 
 def _warn(message: str) -> None:
@@ -126,7 +136,7 @@ class LiveViewer:
             self.link.settle()
         except ViewerUnavailable as exc:
             self._drop(str(exc))
-            self.close()
+            self.stop()
             return False
         self.say(f"meshcat view: {reachable(self.link.web_url)}")
         if self.page is not None:
@@ -250,8 +260,6 @@ class LiveViewer:
         overlay = self.overlay
         if link is None or overlay is None or overlay.version == self._overlay_version:
             return
-        from bt_manip.viz.overlay import item_json
-
         self._overlay_version = overlay.version
         for name in list(self._overlay_items):
             if name not in overlay.items:
@@ -285,7 +293,7 @@ class LiveViewer:
             if obj.rgba is not None:
                 link.set_property(obj.path, "color", list(HIGHLIGHT_RGBA if on else obj.rgba))
 
-    def _publish_state(self, runner: Any = None) -> None:
+    def _publish_state(self, runner: Runner | None = None) -> None:
         sim_time = float(getattr(runner, "sim_time", 0.0)) if runner is not None else 0.0
         ticks = int(getattr(runner, "ticks", 0)) if runner is not None else 0
         statuses = list(self.watcher.statuses)
@@ -299,7 +307,7 @@ class LiveViewer:
             self.link.close()
             self.link = None
 
-    def __call__(self, runner: Any) -> None:
+    def __call__(self, runner: Runner) -> None:
         """After a tick: statuses to the page, poses/overlays/highlights to meshcat."""
         t = float(getattr(runner, "sim_time", 0.0))
         for index, code, reason in self.watcher.update():
@@ -335,9 +343,15 @@ class LiveViewer:
             self._drop(str(exc))
 
     def close(self) -> None:
-        """Show the last poses, stop serving and disconnect (stops the meshcat server this
-        viewer started)."""
+        """The run has ended: show the last poses, then :meth:`stop`, unless the options say
+        to keep serving (``keep_serving``; :meth:`stop` ends it later). Idempotent."""
         self.show_last()
+        if not self.options.keep_serving:
+            self.stop()
+
+    def stop(self) -> None:
+        """Stop serving and disconnect (stops the meshcat server this viewer started).
+        Idempotent."""
         if self._unsubscribe is not None:
             self._unsubscribe()
             self._unsubscribe = None

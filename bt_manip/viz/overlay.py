@@ -3,19 +3,17 @@ objects, for the live viewer and the replay recorder."""
 
 from __future__ import annotations
 
+import uuid
 from typing import Any
 
 import numpy as np
 
 from bt_manip.overlay import FrameItem, PathItem
+from bt_manip.viz.scene import colour_int, column_major
 
 
 def item_json(item: PathItem | FrameItem) -> dict[str, Any]:
     """A three.js object JSON (plain lists, no binary) drawing an overlay item."""
-    import uuid
-
-    from bt_manip.viz.scene import colour_int, column_major
-
     geom_id, mat_id = str(uuid.uuid4()), str(uuid.uuid4())
     if isinstance(item, PathItem):
         positions = item.points.astype(np.float32).flatten().tolist()

@@ -1,12 +1,12 @@
 """Record a run for the replay page: the bodies as they come and go, poses at a fixed rate,
 tree status changes.
 
-:class:`Recorder` is a run hook. On creation it draws the world as it is
-(:mod:`bt_manip.viz.scene`), takes a first frame at the current sim time and listens to the
-World's announcements (:mod:`bt_manip.sim.events`): a body added later (a spawned model, a
-``block`` fault's crate) is drawn from then on, a removed one is hidden from then on (each body
-keeps its appear and disappear times), and an attached object is highlighted while held.
-After every tick it
+:class:`Recorder` is a run hook (:class:`~bt_manip.run.hooks.RunHook`). On creation it draws
+the world as it is (:mod:`bt_manip.viz.scene`), takes a first frame at the current sim time and
+listens to the World's announcements (:mod:`bt_manip.sim.events`): a body added later (a spawned
+model, a ``block`` fault's crate) is drawn from then on, a removed one is hidden from then on
+(each body keeps its appear and disappear times), and an attached object is highlighted while
+held. After every tick it
 
 - records each node whose status or reason changed (exact tick time),
 - samples every moving frame when ``1 / sample_hz`` of sim time has passed since the last
@@ -21,74 +21,35 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from bt_manip.overlay import FrameItem, Overlay
-from bt_manip.run_context import run_overlay
+from bt_manip.overlay import FrameItem, Overlay, run_overlay
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
+from bt_manip.viz.camera import replay_camera
 from bt_manip.viz.overlay import item_json
-from bt_manip.viz.scene import ROOT, Scene, SceneBody, SceneObject
+from bt_manip.viz.recording import RecordedBody, Recording
+from bt_manip.viz.replay_page import write_replay
+from bt_manip.viz.scene import ROOT, Scene
 from bt_manip.viz.tree_state import TreeWatcher, run_result
 
+if TYPE_CHECKING:
+    from bt_manip.run.runner import Runner
 
-@dataclass
+__all__ = ["RecordOptions", "RecordedBody", "Recorder", "Recording"]
+
+
+@dataclass(frozen=True)
 class RecordOptions:
-    """How densely to sample the run."""
+    """How densely to sample the run, and the page's title (frozen: change a copy with
+    :func:`dataclasses.replace`)."""
 
     sample_hz: float = 20.0
     """Pose samples per second of sim time (ticks between samples are not drawn)."""
     title: str = ""
-
-
-@dataclass
-class RecordedBody:
-    """One body in a recording: its drawing, when it was in the world, and its samples.
-
-    ``key`` names it in the recording (its name; ``name~2`` for the second body of that name,
-    when a model is spawned again after being deleted). ``samples[j]`` belongs to frame
-    ``first_frame + j``; a body without moving frames has no samples.
-    """
-
-    key: str
-    drawing: SceneBody
-    appear: float
-    disappear: float | None = None
-    first_frame: int = 0
-    samples: list[np.ndarray] = field(default_factory=list)
-
-
-@dataclass
-class Recording:
-    """Everything a replay page needs, in memory."""
-
-    bodies: list[RecordedBody]
-    nodes: list[dict[str, Any]]
-    times: list[float] = field(default_factory=list)
-    status_events: list[tuple[float, int, int, str]] = field(default_factory=list)
-    overlay_events: list[tuple[float, str, dict[str, Any] | None, list[float] | None]] = field(
-        default_factory=list
-    )
-    highlight_events: list[tuple[float, str, bool]] = field(default_factory=list)
-    """(time, body key, held)"""
-    result: str = ""
-    info: dict[str, Any] = field(default_factory=dict)
-
-    @property
-    def objects(self) -> list[SceneObject]:
-        """Every drawable of every body that was ever in the world."""
-        return [o for b in self.bodies for o in b.drawing.objects]
-
-    def track_samples(self, path: str) -> tuple[int, np.ndarray]:
-        """First frame and samples (rows x, y, z, qx, qy, qz, qw) of one moving frame."""
-        for body in self.bodies:
-            if path in body.drawing.tracks:
-                k = body.drawing.tracks.index(path)
-                return body.first_frame, np.array([s[k] for s in body.samples])
-        raise KeyError(path)
 
 
 class Recorder:
@@ -168,7 +129,7 @@ class Recorder:
                 self.rec.highlight_events.append((t, body.key, isinstance(event, Attached)))
 
     # -- sampling ---------------------------------------------------------------------------
-    def _now(self, runner: Any) -> float:
+    def _now(self, runner: Runner) -> float:
         if self.world is not None:
             return float(self.world.time) - self._t0
         return float(getattr(runner, "sim_time", 0.0))
@@ -211,7 +172,7 @@ class Recorder:
                 self.rec.overlay_events.append((t, name, obj, matrix))
             self._overlay_items[name] = item
 
-    def __call__(self, runner: Any) -> None:
+    def __call__(self, runner: Runner) -> None:
         """After a tick: bodies added or removed, status changes, and a pose sample when one
         is due (or a body just appeared)."""
         t = self._now(runner)
@@ -238,11 +199,7 @@ class Recorder:
             self._sample(self._last_time)
         elif self.world.client >= 0:  # a closed world has no poses left to read
             self._sample(self._last_time)
-            from bt_manip.viz.camera import replay_camera
-
             self.rec.info["camera"] = replay_camera(self.world, self.rec)
-        from bt_manip.viz.replay_page import write_replay
-
         try:
             size = write_replay(self.path, self.rec, title=self.options.title)
         except OSError as exc:

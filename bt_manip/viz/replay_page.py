@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.outputs import write_text
-from bt_manip.viz.recorder import Recording
+from bt_manip.viz.recording import Recording
 from bt_manip.viz.scene import ROOT, column_major, mesh_files
 from bt_manip.viz.tree_page import STATIC_DIR, meshcat_bundle, render_page
 

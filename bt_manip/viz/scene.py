@@ -33,6 +33,7 @@ import pybullet as pb
 
 from bt_manip.geometry import inverse_matrix, matrix_row, pose_matrix, row_matrix
 from bt_manip.sim import pybullet_queries as pbq
+from bt_manip.sim.compose import composed_urdf
 from bt_manip.viz.urdf_visuals import Visual, read_visuals
 
 ROOT = "/meshcat/bt_manip"
@@ -321,8 +322,6 @@ def build_scene(world: Any) -> Scene:
 def _urdf_of(info: Any, world: Any) -> Path | None:
     if info.kind == "robot":
         robot = world.robots[info.name]
-        from bt_manip.sim.compose import composed_urdf
-
         return Path(composed_urdf(robot.description))
     urdf = getattr(info.spec, "urdf", None)
     return Path(urdf) if urdf is not None else None

@@ -11,8 +11,9 @@ import pytest
 
 import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
 from bt_manip.bt import Tree, load_tree_string
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions, RunReport
+from bt_manip.run.context import RunContext
+from bt_manip.run.report import RunReport
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]

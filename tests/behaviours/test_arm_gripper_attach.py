@@ -9,7 +9,7 @@ import pybullet as pb
 import pytest
 from bhelpers import ROOT, place_robot, reasons, run_xml, sample_every_step
 
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 from bt_manip.sim.world import World
 
 PICK = """<Sequence>
@@ -214,8 +214,8 @@ def test_spawn_model_value_from_the_blackboard_out_of_range_fails_with_the_reaso
 
 def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None:
     from bt_manip.bt import load_tree_string
-    from bt_manip.faults import FaultInjector, FaultSpec
-    from bt_manip.runner import Runner, RunOptions
+    from bt_manip.run.faults import FaultInjector, FaultSpec
+    from bt_manip.run.runner import Runner, RunOptions
 
     world = house_at_pregrasp
     faults = FaultInjector([FaultSpec("slip", 1.0)], seed=0, clock=world.clock)
@@ -234,7 +234,7 @@ def test_injected_slip_drops_the_carried_panel(house_at_pregrasp: World) -> None
 
 def test_move_to_pose_reaches_the_pose_and_retreats_first(table: World) -> None:
     from bt_manip.bt import load_tree_string
-    from bt_manip.runner import Runner, RunOptions
+    from bt_manip.run.runner import Runner, RunOptions
 
     robot = table.robots["sawyer"]
     report, first = run_xml(table, '<MoveToPose position="0.75;0.2;0.9" approach="0.1"/>')

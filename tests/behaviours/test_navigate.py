@@ -11,10 +11,10 @@ import pytest
 from bhelpers import place_robot, reasons, run_xml
 
 from bt_manip.bt import load_tree_string
-from bt_manip.faults import FaultInjector, FaultSpec
 from bt_manip.navigation.navigator import NavigatorOptions
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.context import RunContext
+from bt_manip.run.faults import FaultInjector, FaultSpec
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]

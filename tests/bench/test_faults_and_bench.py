@@ -13,7 +13,7 @@ from bt_manip.bench.stats import summarise, wilson_interval
 from bt_manip.cli import main
 from bt_manip.episode import EpisodeSpec
 from bt_manip.errors import InputError
-from bt_manip.faults import FaultInjector, FaultSpec, parse_fault
+from bt_manip.run.faults import FaultInjector, FaultSpec, parse_fault
 
 
 @pytest.mark.parametrize(
@@ -297,7 +297,7 @@ class _Room:
 def test_the_block_fault_drops_a_crate_mid_route_or_says_why_not() -> None:
     import numpy as np
 
-    from bt_manip.faults import BLOCK_SIZE, CRATE_DROP_HEIGHT, CRATE_MASS, block_route
+    from bt_manip.run.faults import BLOCK_SIZE, CRATE_DROP_HEIGHT, CRATE_MASS, block_route
 
     route = np.array([[0.0, 0.0], [1.0, 0.0], [2.0, 0.0], [3.0, 0.0], [4.0, 0.0]])
     room = _Room()

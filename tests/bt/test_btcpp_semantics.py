@@ -11,7 +11,7 @@ from btcpp_reference import btcpp, document, run_btcpp, run_ours
 
 from bt_manip.bt import NodeStatus, validate_file
 from bt_manip.errors import InputError
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.runner import Runner, RunOptions
 
 
 def same(body: str, ticks: int, init: dict[str, Any] | None = None,

@@ -15,7 +15,7 @@ from groot_client import GrootClient, sync_subscription
 from bt_manip.bt.xml_parse import parse_xml_text
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.groot import GrootPublisher
-from bt_manip.runner import RunOptions
+from bt_manip.run.runner import RunOptions
 
 ROOT = Path(__file__).resolve().parents[2]
 

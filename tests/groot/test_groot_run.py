@@ -16,11 +16,11 @@ import pytest
 from groot_client import GrootClient, sync_subscription
 from test_groot_breakpoints import status_of, uid_of, wait_for_breakpoint
 
-from bt_manip import runner as runner_module
 from bt_manip.bt import TreeContext, load_tree
 from bt_manip.cli import main
 from bt_manip.groot import GrootPublisher, TreeMonitor, read_btlog
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run import runner as runner_module
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 
@@ -119,7 +119,9 @@ def test_bench_keeps_a_btlog_per_failed_episode_only(tmp_path: Path) -> None:
 def test_groot_publisher_and_meshcat_viewer_serve_the_same_run() -> None:
     world = World(ROOM, seed=3)
     tree = load_tree(str(DEMO), context=TreeContext(clock=world.clock, world=world))
-    live = LiveViewer(world, tree, LiveOptions(port=0, max_fps=1e6), say=lambda s: None)
+    # kept serving after the run (as --keep-serving does): the page is read after it
+    live = LiveViewer(world, tree, LiveOptions(port=0, max_fps=1e6, keep_serving=True),
+                      say=lambda s: None)
     monitor = TreeMonitor(tree, world.clock.now)
     publisher = GrootPublisher(monitor, port=0)
     client = GrootClient(publisher.port)
@@ -148,7 +150,7 @@ def test_groot_publisher_and_meshcat_viewer_serve_the_same_run() -> None:
     finally:
         client.close()
         publisher.close()
-        live.close()
+        live.stop()
         world.close()
 
 

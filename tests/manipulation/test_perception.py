@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from bt_manip.faults import FaultInjector, FaultSpec
 from bt_manip.manipulation.perception import perceived_pose, true_pose
+from bt_manip.run.faults import FaultInjector, FaultSpec
 from bt_manip.sim.world import World
 
 ROOM = Path(__file__).resolve().parent.parent / "behaviours" / "grasp_room.yaml"

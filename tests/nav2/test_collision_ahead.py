@@ -14,9 +14,9 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import load_tree_string
 from bt_manip.bt.status import NodeStatus
-from bt_manip.faults import BLOCK_NEAR, FaultInjector, FaultSpec, PendingBlock, plan_block
 from bt_manip.nav2.collision_ahead import stretch_ahead
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
+from bt_manip.run.faults import BLOCK_NEAR, FaultInjector, FaultSpec, PendingBlock, plan_block
 from bt_manip.sim.world import World
 
 ROOM = Path(__file__).resolve().parent / "room.yaml"

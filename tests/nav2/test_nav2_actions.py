@@ -13,8 +13,9 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import Tree, load_tree_string
 from bt_manip.nav2.path import Nav2Path
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions, RunReport
+from bt_manip.run.context import RunContext
+from bt_manip.run.report import RunReport
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
 ROOM = Path(__file__).resolve().parent / "room.yaml"

@@ -14,8 +14,9 @@ import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip import cli
 from bt_manip.bt import Tree, load_tree
 from bt_manip.cli.args import bb_pair
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions, RunReport
+from bt_manip.run.context import RunContext
+from bt_manip.run.report import RunReport
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -13,7 +13,7 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import Tree, load_tree
 from bt_manip.bt.status import NodeStatus
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 from bt_manip.sim.world import World
 from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
@@ -229,7 +229,7 @@ def test_through_poses_without_goals_gives_no_viapoints() -> None:
 
 def test_a_crate_falling_in_front_of_the_robot_takes_it_through_the_recovery_branch() -> None:
     from bt_manip.bench.episodes import count_leaf_failures
-    from bt_manip.faults import FaultInjector, FaultSpec
+    from bt_manip.run.faults import FaultInjector, FaultSpec
 
     with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
         faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)

@@ -12,9 +12,9 @@ from bt_manip.bench.episodes import count_leaf_failures
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.walk import walk_nodes
 from bt_manip.episode import Episode, EpisodeSpec
-from bt_manip.faults import parse_fault
 from bt_manip.groot.monitor import watch
-from bt_manip.runner import RunReport
+from bt_manip.run.faults import parse_fault
+from bt_manip.run.report import RunReport
 
 ROOT = Path(__file__).resolve().parents[2]
 TREE = str(ROOT / "trees" / "husky_carry_wall_adaptive.xml")

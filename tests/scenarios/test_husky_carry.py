@@ -9,7 +9,7 @@ import pybullet as pb
 import pytest
 
 from bt_manip.episode import Episode, EpisodeSpec
-from bt_manip.faults import FaultInjector, FaultSpec, parse_fault
+from bt_manip.run.faults import FaultInjector, FaultSpec, parse_fault
 
 ROOT = Path(__file__).resolve().parents[2]
 TREE = str(ROOT / "trees" / "husky_carry_wall.xml")

@@ -11,7 +11,7 @@ import pytest
 
 from bt_manip.behaviours.regions import region_of
 from bt_manip.episode import Episode, EpisodeSpec
-from bt_manip.runner import Runner
+from bt_manip.run.runner import Runner
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -10,9 +10,9 @@ import pytest
 
 import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
 from bt_manip.bt import load_tree_string
-from bt_manip.faults import FaultInjector, FaultSpec
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.context import RunContext
+from bt_manip.run.faults import FaultInjector, FaultSpec
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.sim.world import World
 from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D

@@ -8,7 +8,7 @@ import py_trees
 from py_trees.common import Status
 
 from bt_manip.overlay import Overlay
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 
 HERE = __import__("pathlib").Path(__file__).resolve().parent
 ROOM = HERE / "viz_room.yaml"

@@ -16,7 +16,7 @@ import pytest
 from drive_tree import ROOM, DriveTree
 
 from bt_manip.cli import main
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 from bt_manip.viz.recorder import Recorder
@@ -120,7 +120,8 @@ def test_replay_page_plays_offline(browser: Any, tmp_path: Path) -> None:
 def test_live_page_follows_the_run(browser: Any) -> None:
     world = World(ROOM, seed=3)
     tree = DriveTree(world, drive_s=3.5)
-    live = LiveViewer(world, tree, LiveOptions(port=0), say=lambda s: None)
+    # kept serving after the run (as --keep-serving does): the page is read to the end
+    live = LiveViewer(world, tree, LiveOptions(port=0, keep_serving=True), say=lambda s: None)
     assert live.start()
     go = threading.Event()
     done = threading.Event()
@@ -161,7 +162,7 @@ def test_live_page_follows_the_run(browser: Any) -> None:
         go.set()
         thread.join(30)
         page.close()
-        live.close()
+        live.stop()
         world.close()
 
     assert first["mission"] == "IDLE"
@@ -272,7 +273,8 @@ def test_live_view_shows_spawned_blocks_moving_with_the_gripper(browser: Any) ->
     stops_wanted = 4
     episode = Episode(EpisodeSpec(tree=str(HERE / "viz_blocks.xml"), world=str(TABLE)))
     world = episode.world
-    live = LiveViewer(world, episode.tree, LiveOptions(port=0, max_fps=1e6), say=lambda s: None)
+    live = LiveViewer(world, episode.tree, LiveOptions(port=0, max_fps=1e6, keep_serving=True),
+                      say=lambda s: None)
     assert live.start()
     paused = threading.Event()
     resume = threading.Event()
@@ -341,7 +343,7 @@ def test_live_view_shows_spawned_blocks_moving_with_the_gripper(browser: Any) ->
         resume.set()
         thread.join(60)
         page.close()
-        live.close()
+        live.stop()
         episode.close()
     assert len(samples) == stops_wanted
     positions = np.array([p for p, _ in samples])

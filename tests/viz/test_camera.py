@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from drive_tree import ROOM, DriveTree
 
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.camera import (
     DEFAULT_OFFSET,

@@ -13,7 +13,7 @@ import pytest
 from drive_tree import ROOM, DriveTree
 
 from bt_manip.cli import main
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.viz.live import LiveOptions, LiveViewer
 from bt_manip.viz.replay_page import read_replay
@@ -44,7 +44,9 @@ def _run(viewer: bool, options: LiveOptions | None = None, hooks: list[Any] = ()
 
 
 def test_live_viewer_draws_and_serves_statuses() -> None:
-    (status, ticks, _), live, world = _run(True, LiveOptions(port=0, max_fps=1e6))
+    # kept serving after the run (as --keep-serving does), to be read here
+    options = LiveOptions(port=0, max_fps=1e6, keep_serving=True)
+    (status, ticks, _), live, world = _run(True, options)
     try:
         assert status == "SUCCESS" and live.page is not None and live.link is not None
         assert live.updates == ticks  # one scene update per tick when not throttled
@@ -66,7 +68,7 @@ def test_live_viewer_draws_and_serves_statuses() -> None:
         html = live.link._request(b"get_scene").decode()
         assert html.count("fetch(") >= len(live.scene.objects) if live.scene else False
     finally:
-        live.close()
+        live.stop()
         world.close()
     assert live.link is None and live.page is None
 
@@ -195,7 +197,8 @@ def test_a_body_that_comes_and_goes_within_one_tick_breaks_nothing(tmp_path: Pat
 
     world = World(ROOM, seed=3)
     tree = DriveTree(world)
-    live = LiveViewer(world, tree, LiveOptions(port=None, max_fps=1e6), say=lambda s: None)
+    live = LiveViewer(world, tree, LiveOptions(port=None, max_fps=1e6, keep_serving=True),
+                      say=lambda s: None)
     recorder = Recorder(tmp_path / "r.html", world, tree)
     try:
         assert live.start()
@@ -204,7 +207,7 @@ def test_a_body_that_comes_and_goes_within_one_tick_breaks_nothing(tmp_path: Pat
         assert "blink" not in live.scene.bodies  # type: ignore[union-attr]
     finally:
         recorder.close()
-        live.close()
+        live.stop()
         world.close()
     header, _ = read_replay(tmp_path / "r.html")
     assert "blink" not in {b["name"] for b in header["scene"]["bodies"]}  # never in a frame

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from drive_tree import ROOM, DriveTree
 
-from bt_manip.run_context import RunContext
-from bt_manip.runner import Runner, RunOptions
+from bt_manip.run.context import RunContext
+from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.events import Attached, Detached
 from bt_manip.sim.world import World
 from bt_manip.viz.recorder import Recorder, RecordOptions
@@ -180,7 +180,7 @@ def test_bodies_added_and_removed_during_the_run_keep_their_times(tmp_path: Path
 def test_a_block_fault_crate_is_in_the_replay(tmp_path: Path) -> None:
     import bt_manip.behaviours  # noqa: F401  (registers Navigate)
     from bt_manip.bt import load_tree_string
-    from bt_manip.faults import FaultInjector, FaultSpec
+    from bt_manip.run.faults import FaultInjector, FaultSpec
 
     with World(REPO / "worlds" / "tb3_house.yaml", seed=0) as world:
         faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)

@@ -107,7 +107,7 @@ def test_overlay_keeps_the_latest_item_per_name() -> None:
 def test_each_run_has_its_own_overlay_and_viewers_find_it(room: World) -> None:
     from bt_manip.bt import Tree, TreeContext
     from bt_manip.bt.leaves import AlwaysSuccess
-    from bt_manip.run_context import RunContext, run_overlay
+    from bt_manip.run.context import RunContext, run_overlay
 
     first, second = RunContext.for_world(room), RunContext.for_world(room)
     first.overlay.show_path("plan", [(0, 0), (1, 0)])

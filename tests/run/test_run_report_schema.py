@@ -11,9 +11,9 @@ import pytest
 from tree_files import write_tree
 
 from bt_manip.cli import main
-from bt_manip.runner import REPORT_SCHEMA_VERSION
+from bt_manip.run.report import REPORT_SCHEMA_VERSION
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SCHEMA = ROOT / "docs" / "schemas" / "run-report.schema.json"
 WORLD = str(ROOT / "worlds" / "sawyer_table.yaml")
 

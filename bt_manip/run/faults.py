@@ -43,12 +43,16 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from bt_manip.bt.status import NodeStatus
+from bt_manip.clock import Clock
 from bt_manip.errors import InputError, Problem
+from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 
 if TYPE_CHECKING:
     from bt_manip.bt.node import BtNode
-    from bt_manip.bt.status import NodeStatus
     from bt_manip.bt.tree import Tree
+    from bt_manip.sim.robot import Robot
+    from bt_manip.sim.world import World
 
 WORLD_FAULTS = ("slip", "block")
 POSE_NOISE = "pose_noise"
@@ -204,7 +208,7 @@ class FaultInjector:
 
     specs: list[FaultSpec]
     seed: int = 0
-    clock: Any = None
+    clock: Clock | None = None
     events: list[FaultEvent] = field(default_factory=list)
     pending_blocks: dict[str, PendingBlock] = field(default_factory=dict)
     """Per robot, a drawn ``block`` whose crate has not fallen yet (see :meth:`defer_block`)."""
@@ -311,8 +315,6 @@ class FailingStart:
     injector: FaultInjector
 
     def __call__(self) -> NodeStatus:
-        from bt_manip.bt.status import NodeStatus
-
         node = self.node
         if node.bt_status is NodeStatus.IDLE and self.injector.node_fails(
             node.name, node.NODE_ID
@@ -358,7 +360,7 @@ def plan_slip(injector: FaultInjector, object_name: str, started_at: float) -> P
     return PendingSlip(started_at + SLIP_AFTER, object_name)
 
 
-def slip_out(world: Any, robot: Any, slip: PendingSlip) -> None:
+def slip_out(world: World, robot: Robot, slip: PendingSlip) -> None:
     """The injected slip: the attach joint goes and the fingers open."""
     if world.attachments.is_attached(slip.object_name):
         world.attachments.detach(slip.object_name)
@@ -395,12 +397,10 @@ def plan_block(injector: FaultInjector, polyline: Any, route: str) -> PendingBlo
     return PendingBlock(float(x), float(y), route)
 
 
-def drop_crate(world: Any, injector: FaultInjector, block: PendingBlock) -> str | None:
+def drop_crate(world: World, injector: FaultInjector, block: PendingBlock) -> str | None:
     """Drop the crate of ``block``: it appears :data:`CRATE_DROP_HEIGHT` above the floor at its
     place and falls. Returns the crate's name, or None when it could not appear there (it would
     start inside a body; the fault's event says so)."""
-    from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
-
     n = sum(1 for name in world.movable if name.startswith("dropped_crate"))
     spec = BodySpec(
         name=f"dropped_crate_{n}",
@@ -426,7 +426,7 @@ def drop_crate(world: Any, injector: FaultInjector, block: PendingBlock) -> str 
     return spec.name
 
 
-def block_route(world: Any, injector: FaultInjector, polyline: Any, route: str) -> str | None:
+def block_route(world: World, injector: FaultInjector, polyline: Any, route: str) -> str | None:
     """The ``block`` fault for a navigation along ``polyline`` to ``route``, at once: drawn as
     :func:`plan_block` says, the crate falls now (:func:`drop_crate`). Returns the crate's name,
     or None when none fell."""
