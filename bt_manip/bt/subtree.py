@@ -14,9 +14,6 @@ from typing import Any
 
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.node import (
-    IGNORED_ATTRIBUTES,
-    POST_CONDITIONS,
-    PRE_CONDITIONS,
     AttributeCheck,
     BtNode,
     DecoratorNode,
@@ -42,7 +39,7 @@ class SubTree(DecoratorNode):
         check = AttributeCheck()
         parse_condition_scripts(attributes, check, "SubTree")
         for key, value in attributes.items():
-            if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+            if key.startswith("_") and key != "_autoremap":  # a script, or not a port
                 continue
             if key == "_autoremap":
                 if isinstance(value, bool):
@@ -82,7 +79,7 @@ class SubTree(DecoratorNode):
         bb = Blackboard(parent, remap=remap, autoremap=self.autoremap)
         for key, binding in self.bindings.items():
             if isinstance(binding, Literal) and key != "_autoremap":
-                bb.set(key, binding.value)
+                bb.set_own(key, binding.value)  # not remapped, even with _autoremap
         return bb
 
     def tick_node(self) -> NodeStatus:
