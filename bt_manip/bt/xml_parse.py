@@ -94,9 +94,10 @@ class _Tags:
 
 def _blank(match: re.Match[str]) -> str:
     text = match.group(1)
-    if text is None or not text.strip():
+    if text is None or not text.strip("\ufeff \t\r\n"):
         return match.group()
-    return "\n".join(" " * len(line) for line in text.split("\n"))
+    bom = "\ufeff" if text.startswith("\ufeff") else ""  # a byte order mark stays
+    return bom + "\n".join(" " * len(line) for line in text[len(bom):].split("\n"))
 
 
 def _lenient(text: str) -> str | None:

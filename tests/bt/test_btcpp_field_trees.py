@@ -172,6 +172,11 @@ def test_lenient_reading_keeps_lines_and_columns() -> None:
     assert (seq.line, seq.attrib["a"], seq.children[0].attrib["c"]) == (3, "x<y && z", "1<2")
 
 
+def test_a_byte_order_mark_and_declaration_stay_before_a_lenient_document() -> None:
+    text = '\ufeff<?xml version="1.0" encoding="UTF-8"?>\n<root a="x && y"><B/></root>'
+    assert parse_xml_text(text.encode("utf-8"), "t.xml").attrib["a"] == "x && y"
+
+
 def test_what_tinyxml2_refuses_too_stays_refused_with_its_line() -> None:
     cases = {
         '<root BTCPP_format="4">\n<A x="1<2">\n</B></root>': 3,  # mismatched tag
