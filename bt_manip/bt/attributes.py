@@ -40,6 +40,9 @@ if TYPE_CHECKING:
 PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
 POST_CONDITIONS = ("_onHalted", "_onFailure", "_onSuccess", "_post")
 IGNORED_ATTRIBUTES = ("_description", "_uid", "_fullpath")
+"""Some of the attributes that are neither ports nor scripts: as BT.CPP, a node keeps every
+attribute whose name starts with ``_`` and is no pre/post-condition (``_collapsed``, written by
+tree editors) as a non-port attribute, unchecked and unused."""
 
 IMMUTABLE_TYPES = frozenset({int, float, bool, str, bytes, type(None)})
 """Types whose values ``copy.deepcopy`` gives back as they are."""
@@ -136,7 +139,7 @@ def _checked_attributes(cls: type[BtNode], attributes: Mapping[str, Any]) -> Att
     parse_condition_scripts(attributes, check, where)
     ports = set(cls.INPUT_PORTS) | set(cls.OUTPUT_PORTS)
     for key, value in attributes.items():
-        if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+        if key.startswith("_"):  # a script, or not a port (IGNORED_ATTRIBUTES)
             continue
         info = cls.port_info(key)
         if info is None:

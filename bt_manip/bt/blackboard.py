@@ -147,6 +147,11 @@ class Blackboard:
         A new entry is strongly typed by the value (as BT.CPP's typed ``Blackboard::set``)."""
         self._write(key, value, True)
 
+    def set_own(self, key: str, value: Any) -> None:
+        """Write an entry of this blackboard itself, as :meth:`set` does but without following
+        remapping (a SubTree's literal port with ``_autoremap``, as BT.CPP sets it)."""
+        self._store(key, value, True)
+
     def assign(self, key: str, value: Any) -> None:
         """Write ``key`` from a script: a new entry is not strongly typed (BT.CPP's scripts
         create their entries untyped; the value they hold still has a type)."""
@@ -154,6 +159,11 @@ class Blackboard:
 
     def _write(self, key: str, value: Any, strong: bool) -> None:
         bb, name = self._owner(key)
+        bb._store(name, value, strong)
+
+    def _store(self, name: str, value: Any, strong: bool) -> None:
+        """Write the entry ``name`` of this blackboard itself (see :meth:`_write`)."""
+        bb = self
         types = bb._types
         declared = types.get(name)
         if declared is None:

@@ -42,9 +42,10 @@ class TreeContext:
     def start_timer(self, seconds: float, callback: Callable[[], None] | None = None) -> int:
         """A timer on the tree's clock, as BT.CPP's timer queue (which runs on its own thread).
 
-        When ``seconds`` have passed, ``callback`` runs and the wake-up signal is emitted. The
-        clock only moves between ticks, so timers fire at the start of the next ``Tree.tick()``
-        (or at once when ``seconds`` <= 0). Returns an id for :meth:`cancel_timer`.
+        When ``seconds`` have passed, ``callback`` runs and the wake-up signal is emitted.
+        Timers fire at the start of each ``Tree.tick()`` and before each re-tick of its wake-up
+        loop (or at once when ``seconds`` <= 0); the sim clock only moves between ticks, the
+        wall clock also within one. Returns an id for :meth:`cancel_timer`.
         """
         self._timer_ids += 1
         if seconds <= 0:

@@ -36,6 +36,7 @@ class Document:
     problems: list[Problem] = field(default_factory=list)
     warnings: list[Problem] = field(default_factory=list)
     included: dict[str, str] = field(default_factory=dict)  # real path -> where first included
+    unnamed: int = 0  # ID-less trees named so far (BehaviorTree_0, BehaviorTree_1...)
 
 
 def read_document(path: str, text: str | None = None) -> Document:
@@ -96,11 +97,12 @@ def _read_into(doc: Document, path: str, text: str | None, stack: tuple[str, ...
         doc.main_tree = root.get("main_tree_to_execute")
         doc.root_line = root.line
     here = os.path.realpath(path) if text is None else path
+    single = sum(child.tag == "BehaviorTree" for child in root.children) == 1
     for child in root.children:
         if child.tag == "include":
             _include(doc, path, child, (*stack, here))
         elif child.tag == "BehaviorTree":
-            _add_tree(doc, path, child)
+            _add_tree(doc, path, child, single)
         elif child.tag == "TreeNodesModel":
             _merge_models(doc, child, path)
         else:
@@ -154,11 +156,17 @@ def _include(doc: Document, path: str, element: Element, stack: tuple[str, ...])
     _read_into(doc, resolved, None, stack, top=False)
 
 
-def _add_tree(doc: Document, path: str, element: Element) -> None:
+def _add_tree(doc: Document, path: str, element: Element, single: bool) -> None:
+    """Add a ``<BehaviorTree>``; the only one of its file may have no ID: BT.CPP then names
+    it ``BehaviorTree_N`` (N counts such trees, from 0) and runs it as the main tree."""
     tree_id = element.get("ID")
+    if not tree_id and single:
+        tree_id = f"BehaviorTree_{doc.unnamed}"
+        doc.unnamed += 1
     if not tree_id:
         doc.problems.append(Problem(path, element.line,
-                                    "<BehaviorTree> needs an ID, e.g. <BehaviorTree ID=\"Main\">"))
+                                    "<BehaviorTree> needs an ID when a file has several, e.g. "
+                                    "<BehaviorTree ID=\"Main\">"))
         return
     if tree_id in doc.trees:
         other = doc.trees[tree_id]

@@ -10,8 +10,8 @@ tick:
 - queue empty, when no child is running: the status ``if_empty`` (SUCCESS by default).
 
 A queue given as text is copied each time the node starts; a queue on the blackboard (a list)
-is consumed in place, as BT.CPP pops its shared deque. An entry holding text is an error, as in
-BT.CPP 4.8.
+is consumed in place, as BT.CPP pops its shared deque. An entry holding text, or no value, is
+an error, as in BT.CPP 4.8.
 """
 
 from __future__ import annotations
@@ -45,7 +45,11 @@ class _Loop(DecoratorNode):
         binding = self.bindings.get("queue")
         if binding is None or isinstance(binding, Literal):
             return self._queue
-        value = self.blackboard.get_or(binding.key)
+        if not self.blackboard.has_value(binding.key):  # BT.CPP: "Any::cast failed ..."
+            raise PortError(
+                f"{self.describe()}: queue entry '{binding.key}' has no value; write a list "
+                "into it first, or give the items in the queue port (queue=\"1;2;3\")")
+        value = self.blackboard.get(binding.key)
         if value is None:
             return None
         if not isinstance(value, list):  # BT.CPP 4.8 does not convert text entries either

@@ -24,7 +24,8 @@ from bt_manip.bt.xml_parse import Element
 from bt_manip.errors import Problem
 
 KINDS = ("Action", "Condition", "Control", "Decorator", "SubTree")
-_PORT_TAGS = {"input_port": "input", "output_port": "output", "inout_port": "inout"}
+_PORT_TAGS = {"input_port": "input", "output_port": "output", "inout_port": "inout",
+              "bidirectional_port": "inout"}  # the older name, still in Nav2's model file
 _CHILDREN = {"Action": (0, 0), "Condition": (0, 0), "Control": (1, None), "Decorator": (1, 1),
              "SubTree": (0, 0)}
 

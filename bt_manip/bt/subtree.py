@@ -12,13 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from bt_manip.bt.attributes import (
-    IGNORED_ATTRIBUTES,
-    POST_CONDITIONS,
-    PRE_CONDITIONS,
-    AttributeCheck,
-    parse_condition_scripts,
-)
+from bt_manip.bt.attributes import AttributeCheck, parse_condition_scripts
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.node import BtNode, DecoratorNode
 from bt_manip.bt.ports import Literal, Ref, convert_literal, format_literal, parse_reference
@@ -41,7 +35,7 @@ class SubTree(DecoratorNode):
         check = AttributeCheck()
         parse_condition_scripts(attributes, check, "SubTree")
         for key, value in attributes.items():
-            if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+            if key.startswith("_") and key != "_autoremap":  # a script, or not a port
                 continue
             if key == "_autoremap":
                 if isinstance(value, bool):
@@ -81,7 +75,7 @@ class SubTree(DecoratorNode):
         bb = Blackboard(parent, remap=remap, autoremap=self.autoremap)
         for key, binding in self.bindings.items():
             if isinstance(binding, Literal) and key != "_autoremap":
-                bb.set(key, binding.value)
+                bb.set_own(key, binding.value)  # not remapped, even with _autoremap
         return bb
 
     def tick_node(self) -> NodeStatus:

@@ -18,6 +18,8 @@ from bt_manip.bt.walk import walk_nodes
 from bt_manip.errors import InputError, Problem
 
 INVALID = Status.INVALID
+MAX_WAKE_UPS = 1000
+"""Re-ticks one ``Tree.tick()`` makes for wake-up signals before it returns to its caller."""
 
 
 @dataclass
@@ -48,7 +50,17 @@ class Tree:
     FAILURE) is reset to IDLE afterwards, as in BT.CPP, so the next tick starts it again.
     ``halt()`` is ``haltTree()``: every RUNNING node's ``terminate(INVALID)`` runs once, and
     every node's ``_onHalted`` script runs.
+
+    A wake-up loop cannot hold ``tick()`` for ever: before each re-tick the timers whose time
+    has come fire (a Timeout over ``RetryUntilSuccessful num_attempts="-1"`` ends on the wall
+    clock as in BT.CPP, whose timers run on their own thread), and after
+    :attr:`max_wake_ups` re-ticks ``tick()`` returns RUNNING with the signal still pending, so
+    that its caller can check its budgets and move the sim clock (which only moves between
+    ticks); the next ``tick()`` goes on where the loop stopped.
     """
+
+    max_wake_ups: int = MAX_WAKE_UPS
+    """Re-ticks for wake-up signals within one ``tick()`` (see :data:`MAX_WAKE_UPS`)."""
 
     warnings: list[Problem]
     """The loader's warnings, set on trees loaded from a file (no attribute otherwise)."""
@@ -102,8 +114,12 @@ class Tree:
         if context.timers:
             context.fire_timers()
         status = root.execute_tick()
-        while status is NodeStatus.RUNNING and context.wake_up:
+        wake_ups = self.max_wake_ups
+        while status is NodeStatus.RUNNING and context.wake_up and wake_ups > 0:
+            wake_ups -= 1
             context.wake_up = False
+            if context.timers:  # the clock may have moved (the wall clock does)
+                context.fire_timers()
             status = root.execute_tick()
         return self._finish(status)
 

@@ -12,15 +12,13 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable
+from functools import cached_property
 from typing import Any, cast
 
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.attributes import (
-    IGNORED_ATTRIBUTES,
-    POST_CONDITIONS,
-    PRE_CONDITIONS,
     AttributeCheck,
     closest,
     parse_condition_scripts,
@@ -64,6 +62,7 @@ class _Checker:
         self.need_implementation = need_implementation
         self.problems: list[Problem] = []
         self.edges: dict[str, list[tuple[str, Element, str]]] = {}
+        self.shadow_hits: set[str] = set()  # shadowed IDs given a port only their model has
 
     def known_ids(self) -> set[str]:
         return set(self.reg.ids()) | set(self.doc.models) | {SUBTREE_ID}
@@ -88,6 +87,38 @@ class _Checker:
             for root in roots:
                 self.check_node(root, tree)
         self.check_recursion()
+        for node_id, lacking in sorted(self.shadowed.items()):
+            if node_id not in self.shadow_hits:
+                continue
+            model, cls = self.doc.models[node_id], self.reg.get(node_id)
+            assert cls is not None
+            self.doc.warnings.append(Problem(
+                model.file or self.doc.file, model.line,
+                f"warning: the TreeNodesModel entry '{node_id}' is not used: bt-manip's own "
+                f"node {node_id} ({cls.__module__}.{cls.__qualname__}) takes its place, and "
+                f"it has no port {', '.join(repr(p) for p in lacking)}"))
+
+    def shadow_note(self, node_id: str) -> str:
+        """For port errors of a node whose TreeNodesModel entry a bt-manip node shadows."""
+        model = self.doc.models.get(node_id)
+        if model is None or node_id not in self.shadowed:
+            return ""
+        return (f" (the TreeNodesModel entry at {model.file}:{model.line} declares another "
+                f"'{node_id}'; bt-manip's own node of that ID is used)")
+
+    @cached_property
+    def shadowed(self) -> dict[str, list[str]]:
+        """IDs declared in a TreeNodesModel with ports that the bt-manip node of the same ID,
+        used instead, does not have (those ports, by ID)."""
+        out = {}
+        for node_id, model in self.doc.models.items():
+            cls = self.reg.get(node_id)
+            if cls is not None and model.kind != SUBTREE_ID:
+                own = spec_of(cls).ports
+                lacking = [port for port in model.ports if port not in own]
+                if lacking:
+                    out[node_id] = lacking
+        return out
 
     def check_node(self, element: Element, tree: TreeDef) -> None:
         file = tree.file
@@ -129,7 +160,7 @@ class _Checker:
             check = AttributeCheck()
             parse_condition_scripts(attributes, check, spec.node_id)
             for key in attributes:
-                if key in PRE_CONDITIONS or key in POST_CONDITIONS or key in IGNORED_ATTRIBUTES:
+                if key.startswith("_"):  # a script, or not a port (IGNORED_ATTRIBUTES)
                     continue
                 if key not in spec.ports:
                     declared = ", ".join(sorted(spec.ports)) or "none"
@@ -146,9 +177,14 @@ class _Checker:
                     (f"node '{spec.node_id}' is declared in a TreeNodesModel but has no "
                      "implementation; import the Python module that registers it with "
                      "--import MODULE", None))
+        note = self.shadow_note(spec.node_id) if spec.cls is not None and check.errors else ""
+        if note and any(key in self.shadowed[spec.node_id] for key in attributes):
+            self.shadow_hits.add(spec.node_id)
         for message, column in check.errors:
             if column is not None:
                 message = f"{message} (column {column} of the script)"
+            if note and " is not a port of " in message:
+                message += note
             self.add(file, element, message)
 
     def check_children(self, element: Element, file: str, spec: NodeSpec) -> None:
@@ -178,6 +214,13 @@ class _Checker:
                      "<include>)")
         else:
             self.edges[tree.tree_id].append((target, element, file))
+        attributes, missing = subtree_model_defaults(self.doc, target, attributes)
+        for port in missing:
+            spec = self.doc.models[target or ""]
+            self.add(file, element,
+                     f"SubTree '{target}' does not remap port '{port}', which its model "
+                     f"({spec.file}:{spec.line}) declares without a default; add {port}=\"...\" "
+                     "or a default to the model")
         for message, column in SubTree.check_attributes(attributes).errors:
             if column is not None:
                 message = f"{message} (column {column} of the script)"
@@ -300,6 +343,28 @@ def _nesting(root: Element, nodes: dict[str, int]) -> int:
     return best
 
 
+def subtree_model_defaults(doc: Document, target: str | None, attributes: dict[str, str]
+                           ) -> tuple[dict[str, str], list[str]]:
+    """A SubTree's attributes with the defaults of its ``<TreeNodesModel><SubTree>`` entry
+    added for the ports it does not give, and the ports it should give (declared there
+    without a default), as BT.CPP's ``XMLParser`` remaps them; with ``_autoremap`` the model
+    is not used."""
+    spec = doc.models.get(target or "")
+    if spec is None or spec.kind != SUBTREE_ID:
+        return attributes, []
+    if attributes.get("_autoremap", "").strip().lower() in ("true", "1"):
+        return attributes, []
+    out = dict(attributes)
+    missing = []
+    for port in spec.ports.values():
+        if port.name not in out:
+            if port.default:
+                out[port.name] = port.default
+            else:
+                missing.append(port.name)
+    return out, missing
+
+
 def model_port_problem(port: PortSpec, value: str) -> str | None:
     """What is wrong with ``value`` for a port declared in a TreeNodesModel, or None."""
     if parse_reference(value) is not None:
@@ -404,6 +469,7 @@ class _Builder:
         if node_id == SUBTREE_ID:
             target = element.get("ID")
             assert target is not None
+            attributes = subtree_model_defaults(self.doc, target, attributes)[0]
             node = SubTree(target, self.tree_root(target), name=name, **attributes)
         else:
             cls = self.reg.get(node_id) or self._stand_in(node_id)

@@ -3,10 +3,19 @@
 XML files are untrusted input. This reader uses expat directly and refuses any document type
 declaration (so no entity can be declared, expanded or fetched), bounds the file size, the
 nesting depth and the number of elements, and records the line and column of every element.
+
+BehaviorTree.CPP reads its files with tinyxml2, which takes what strict XML refuses and real
+trees contain: a raw ``<`` or ``&&`` in an attribute value (``if="A<2 && B>0"``), a ``&`` that
+starts no character reference, text before the first element (``// clang-format off``). A
+document that expat refuses is read again through :func:`_lenient`, which stands a placeholder
+character in for each of those ``<`` and ``&`` and blanks the text before the first element;
+every replacement keeps the length of what it replaces, so lines and columns stay those of the
+file, and the placeholders are turned back when attribute values and text are read.
 """
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from xml.parsers import expat
 
@@ -45,12 +54,94 @@ class _Refused(Exception):
     pass
 
 
+LT, AMP = "\ufdd0", "\ufdd1"
+"""Stand-ins for a raw ``<`` in an attribute value and a ``&`` that starts no reference:
+Unicode noncharacters, which no tree file holds (one that does is read strictly)."""
+_REFERENCE = re.compile(AMP + r"(?=(?:amp|lt|gt|quot|apos|#[0-9]+|#x[0-9a-fA-F]+);)")
+_SKIP = (  # markup that needs no change; possessive, so nothing is scanned twice
+    r"<!--.*?(?:-->|\Z)|<!\[CDATA\[.*?(?:\]\]>|\Z)|<\?.*?(?:\?>|\Z)"
+    r"|<[^<>\"']*+(?:(?:\"[^\"<]*+\"|'[^'<]*+')[^<>\"']*+)*+(?:>|(?=<))|[^<]++")
+_MARKUP = re.compile(
+    rf"(?:{_SKIP})++"  # a run of it, handed back whole
+    r"|(<[^<>\"'!?]*+(?:(?:\"[^\"<]*+\"|'[^'<]*+')[^<>\"']*+)*+"  # a tag with a raw < in a
+    r"(?:\"[^\"<]*+<[^\"]*+(?:\"|\Z)|'[^'<]*+<[^']*+(?:'|\Z))"  # value: to that value's end,
+    r"(?:[^<>\"']++|\"[^\"]*+(?:\"|\Z)|'[^']*+(?:'|\Z))*+(?:>|(?=<)|\Z))",  # then the tag's
+    re.S)
+_PROLOG = re.compile(r"(?:[^<]++|<!--.*?(?:-->|\Z)|<\?.*?(?:\?>|\Z))*+", re.S)
+_PROLOG_TEXT = re.compile(r"<!--.*?(?:-->|\Z)|<\?.*?(?:\?>|\Z)|([^<]+)", re.S)
+
+
+class _TooMany(Exception):
+    pass
+
+
+class _Tags:
+    """The replacement of :data:`_MARKUP`'s matches; stops after :data:`MAX_ELEMENTS` changed
+    tags (a document with more is refused anyway)."""
+
+    def __init__(self) -> None:
+        self.changed = 0
+
+    def __call__(self, match: re.Match[str]) -> str:
+        tag = match.group(1)
+        if tag is None:
+            return match.group()
+        self.changed += 1
+        if self.changed > MAX_ELEMENTS:
+            raise _TooMany
+        return "<" + tag[1:].replace("<", LT)  # every < after the first is in a quoted value
+
+
+def _blank(match: re.Match[str]) -> str:
+    text = match.group(1)
+    if text is None or not text.strip("\ufeff \t\r\n"):
+        return match.group()
+    bom = "\ufeff" if text.startswith("\ufeff") else ""  # a byte order mark stays
+    return bom + "\n".join(" " * len(line) for line in text[len(bom):].split("\n"))
+
+
+def _lenient(text: str) -> str | None:
+    """``text`` as strict XML takes it, or None when there is nothing to change (see the
+    module docstring). Linear in the length of the text: no expression rescans what it
+    passed, and Python code runs only for each tag it changes (and each piece of the text
+    before the first element)."""
+    if LT in text or AMP in text:
+        return None
+    out = _REFERENCE.sub("&", text.replace("&", AMP))  # the references are & again
+    prolog = _PROLOG.match(out)
+    end = prolog.end() if prolog is not None else 0
+    try:
+        out = _PROLOG_TEXT.sub(_blank, out[:end]) + _MARKUP.sub(_Tags(), out[end:])
+    except _TooMany:
+        return None
+    return None if out == text else out
+
+
 def parse_xml_text(text: str | bytes, file: str) -> Element:
-    """Parse XML text into :class:`Element` objects; raises :class:`XmlError`."""
+    """Parse XML text into :class:`Element` objects; raises :class:`XmlError`.
+
+    A document that expat refuses is read again as BehaviorTree.CPP's parser reads it (see
+    :func:`_lenient`); if that fails too, the error is the second reading's."""
     data = text.encode("utf-8") if isinstance(text, str) else text
     if len(data) > MAX_BYTES:
         raise XmlError(Problem(file, None,
                                f"file is larger than the limit of {size_text(MAX_BYTES)}"))
+    try:
+        return _parse(data, file, False)
+    except XmlError as strict:
+        if not strict.problem.message.startswith("malformed XML"):
+            raise
+        try:
+            lenient = _lenient(data.decode("utf-8"))
+        except UnicodeDecodeError:
+            lenient = None
+        if lenient is None:
+            raise
+    return _parse(lenient.encode("utf-8"), file, True)
+
+
+def _parse(data: bytes, file: str, placeholders: bool) -> Element:
+    """expat on ``data``; with ``placeholders``, :data:`LT` and :data:`AMP` are turned back."""
     parser = expat.ParserCreate()
     stack: list[Element] = []
     roots: list[Element] = []
@@ -66,6 +157,8 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
             refuse(f"more than {MAX_ELEMENTS} elements")
         if len(stack) >= MAX_DEPTH:
             refuse(f"elements nested deeper than {MAX_DEPTH} levels")
+        if placeholders:
+            attrs = {k: v.replace(LT, "<").replace(AMP, "&") for k, v in attrs.items()}
         element = Element(tag, dict(attrs), parser.CurrentLineNumber,
                           parser.CurrentColumnNumber + 1)
         if stack:
@@ -79,7 +172,7 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
 
     def chars(data: str) -> None:
         if stack:
-            stack[-1].text += data
+            stack[-1].text += data.replace(AMP, "&") if placeholders else data
 
     def doctype(*args: object) -> None:
         refuse("document type declarations (DOCTYPE) are not allowed")
