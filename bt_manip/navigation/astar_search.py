@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 from llvmlite import ir
-from numba.core import types
+from numba.core import cgutils, types
 from numba.extending import intrinsic
 
 KEEP = 1.0 - 1e-13
@@ -73,6 +73,40 @@ def _float_to_bits(typingctx, value):  # type: ignore[no-untyped-def]  # numba i
         return builder.bitcast(args[0], ir.IntType(64))
 
     return sig, codegen
+
+
+@intrinsic
+def _prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """Ask the processor to bring ``arr[idx]`` into cache (a hint: never faults)."""
+    sig = types.void(arr, idx)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty = signature.args[0]
+        ary = context.make_array(arrty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [args[1]], wraparound=False)
+        i8p = ir.IntType(8).as_pointer()
+        i32 = ir.IntType(32)
+        fnty = ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
+        # read, keep in all cache levels, data cache
+        builder.call(fn, [builder.bitcast(ptr, i8p), i32(0), i32(3), i32(1)])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@numba.njit(cache=True, inline="always")
+def _prefetch_around(
+    g: np.ndarray, flat: np.ndarray, parent: np.ndarray, q: int, cols: int
+) -> None:
+    """Prefetch the g, cost and parent rows that expanding cell ``q`` will read or write."""
+    _prefetch(g, q - cols)  # type: ignore[call-arg]  # numba body, as for _load_g
+    _prefetch(g, q)  # type: ignore[call-arg]
+    _prefetch(g, q + cols)  # type: ignore[call-arg]
+    _prefetch(flat, q - cols)  # type: ignore[call-arg]
+    _prefetch(flat, q)  # type: ignore[call-arg]
+    _prefetch(flat, q + cols)  # type: ignore[call-arg]
+    _prefetch(parent, q)  # type: ignore[call-arg]
 
 
 @numba.njit(cache=True, inline="always")
@@ -251,26 +285,35 @@ def _move_costs(
     return 8
 
 
+# Indices into the bucket search's state vectors (it runs in rounds between pool growths).
+_CUR, _USED, _FREE, _OPEN, _EXPANDED = 0, 1, 2, 3, 4
+_G_GOAL, _BOUND = 0, 1
+
+
 @numba.njit(cache=True)
-def search_buckets(
+def _bucket_rounds(
     cost: np.ndarray,
     start: int,
     goal: int,
     diagonal: bool,
     hmin: float,
     delta: float,
-    span: int,
+    mask: int,
     g: np.ndarray,
     parent: np.ndarray,
     lo: np.ndarray,
     hi: np.ndarray,
-    zero: bool,
-) -> tuple[float, int]:
-    """A* with f-buckets of width ``delta`` in a circular array of at least ``span`` buckets.
+    heads: np.ndarray,
+    pn: np.ndarray,
+    pg: np.ndarray,
+    pnext: np.ndarray,
+    ints: np.ndarray,
+    floats: np.ndarray,
+) -> bool:
+    """Run the bucket search until it ends (True) or its pool may run out of slots (False).
 
-    ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
-    ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
-    entry; with ``zero`` the written part of ``g`` is zero again on return.
+    The pool (``pn``, ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the
+    state vectors are the caller's, so that no array changes hands inside the loop.
     """
     rows, cols = cost.shape
     flat = cost.ravel()
@@ -278,36 +321,24 @@ def search_buckets(
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
     inv_delta = 1.0 / delta
-    size = 1
-    while size < span:  # a power of two: the bucket of a key is key & mask
-        size *= 2
-    mask = size - 1
     inf = np.inf
-
-    heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
-    pn = np.empty(4096, np.int32)  # pool: cell, g at push time, next slot in the bucket
-    pg = np.empty(4096, np.float64)
-    pnext = np.empty(4096, np.int32)
     off = DR * cols + DC
     w8 = np.empty(8, np.float64)
     cand_k = np.empty(8, np.int64)
     cand_g = np.empty(8, np.float64)
-
-    _store_g(g, start, 0.0)
-    _mark(lo, hi, start // cols, start % cols)
-    cur = np.int64(math.floor(_h(start // cols, start % cols, gr, gc, diagonal, hmin) * inv_delta))
-    pn[0] = start
-    pg[0] = 0.0
-    pnext[0] = -1
-    heads[cur & mask] = 0
-    used = 1
-    free = -1
-    n_open = 1
-    expanded = 0
-    g_goal = inf
-    bound = inf  # g_goal x KEEP: what a path through an entry must beat
-
+    room = pn.shape[0] - 8  # an expansion pushes at most 8 entries
+    cur = ints[_CUR]
+    used = ints[_USED]
+    free = ints[_FREE]
+    n_open = ints[_OPEN]
+    expanded = ints[_EXPANDED]
+    g_goal = floats[_G_GOAL]
+    bound = floats[_BOUND]  # g_goal x KEEP: what a path through an entry must beat
+    done = True
     while n_open > 0:
+        if used > room:
+            done = False
+            break
         b = cur & mask
         while heads[b] == -1:
             cur += 1
@@ -321,6 +352,13 @@ def search_buckets(
         gn = pg[slot]
         pnext[slot] = free
         free = slot
+        # the next two entries of this bucket are likely the next pops: start their loads
+        nxt = heads[b]
+        if nxt != -1:
+            _prefetch_around(g, flat, parent, pn[nxt], cols)
+            nxt = pnext[nxt]
+            if nxt != -1:
+                _prefetch_around(g, flat, parent, pn[nxt], cols)
         if gn > _load_g(g, node):
             continue  # stale entry
         r = node // cols
@@ -353,23 +391,81 @@ def search_buckets(
             f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
             if f >= bound:
                 continue
-            kb = max(np.int64(math.floor(f * inv_delta)), cur)
+            kb = max(np.int64(math.floor(f * inv_delta)), cur) & mask
             if free != -1:
                 s = free
                 free = pnext[s]
             else:
-                if used == pn.shape[0]:
-                    pn, pg, pnext = _doubled(pn), _doubled(pg), _doubled(pnext)
                 s = used
                 used += 1
-            kb = kb & mask
             pn[s] = nb
             pg[s] = ng_
             pnext[s] = heads[kb]
             heads[kb] = s
             n_open += 1
-    _clean(g, lo, hi, rows, cols, zero)
-    return g_goal, expanded
+    ints[_CUR] = cur
+    ints[_USED] = used
+    ints[_FREE] = free
+    ints[_OPEN] = n_open
+    ints[_EXPANDED] = expanded
+    floats[_G_GOAL] = g_goal
+    floats[_BOUND] = bound
+    return done
+
+
+@numba.njit(cache=True)
+def _grown(a: np.ndarray, used: int) -> np.ndarray:
+    """A copy of ``a`` with twice the room, its first ``used`` entries kept."""
+    out = np.empty(a.shape[0] * 2, a.dtype)
+    out[:used] = a[:used]
+    return out
+
+
+@numba.njit(cache=True)
+def search_buckets(
+    cost: np.ndarray,
+    start: int,
+    goal: int,
+    diagonal: bool,
+    hmin: float,
+    delta: float,
+    span: int,
+    g: np.ndarray,
+    parent: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    zero: bool,
+) -> tuple[float, int]:
+    """A* with f-buckets of width ``delta`` in a circular array of at least ``span`` buckets.
+
+    ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
+    ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
+    entry; with ``zero`` the written part of ``g`` is zero again on return.
+    """
+    cols = cost.shape[1]
+    size = 1
+    while size < span:  # a power of two: the bucket of a key is key & mask
+        size *= 2
+    heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
+    pn = np.empty(4096, np.int32)
+    pg = np.empty(4096, np.float64)
+    pnext = np.empty(4096, np.int32)
+    _store_g(g, start, 0.0)
+    _mark(lo, hi, start // cols, start % cols)
+    h0 = _h(start // cols, start % cols, goal // cols, goal % cols, diagonal, hmin)
+    cur = np.int64(math.floor(h0 * (1.0 / delta)))
+    pn[0] = start
+    pg[0] = 0.0
+    pnext[0] = -1
+    heads[cur & (size - 1)] = 0
+    ints = np.array([cur, 1, -1, 1, 0], np.int64)
+    floats = np.array([np.inf, np.inf])
+    while not _bucket_rounds(cost, start, goal, diagonal, hmin, delta, size - 1, g, parent, lo,
+                             hi, heads, pn, pg, pnext, ints, floats):
+        used = ints[_USED]
+        pn, pg, pnext = _grown(pn, used), _grown(pg, used), _grown(pnext, used)
+    _clean(g, lo, hi, cost.shape[0], cols, zero)
+    return floats[_G_GOAL], ints[_EXPANDED]
 
 
 @numba.njit(cache=True, inline="always")
