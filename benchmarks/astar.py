@@ -1,6 +1,7 @@
 """Grid A* side by side: bt-manip's planner, pyastar2d (C++) and tcod.path, in one run.
 
-Run: ``.venv/bin/python benchmarks/astar.py [--repeat 5] [--queries 10] [--no-house]``
+Run: ``.venv/bin/python benchmarks/astar.py [--repeat 5] [--queries 10] [--calls 3] [--no-house]
+[--corners-only]``
 
 Grids (1000 x 1000 unless named otherwise):
 
@@ -10,7 +11,15 @@ Grids (1000 x 1000 unless named otherwise):
 - ``house``: the inflated cost grid of ``worlds/tb3_house.yaml`` for the Husky (323 x 223
   cells of 5 cm), with the cost gradient near obstacles (costs 1 to 7).
 
-Each grid gets the same seeded start/goal pairs for every planner (free cells, joined by a
+Corner to corner first: on ``open``, ``random20`` (seed 1) and ``maze``, one query from the free
+cell nearest the top-left corner to the one nearest the bottom-right corner, bt-manip and
+pyastar2d (tcod takes seconds a call there) each called
+once to warm up and then ``--calls`` times, the calls of the planners taking turns; one line per
+grid and planner with the median wall time (and CPU time: on a shared machine the process's own
+CPU time says more), and on bt-manip's line its time over pyastar2d's (``time_vs_pyastar2d``,
+``cpu_vs_pyastar2d``).
+
+Then each grid gets the same seeded start/goal pairs for every planner (free cells, joined by a
 path under bt-manip's rules). Every line printed is one JSON object: grid, planner, median
 time per query (ms), and the mean path cost recomputed with bt-manip's cost definition
 (``step_length x cost[entered cell]``, step_length 1 or sqrt 2), plus how many diagonal steps of
@@ -183,11 +192,72 @@ def measure(
     }
 
 
+def corner_cells(grid: np.ndarray) -> tuple[Cell, Cell]:
+    """The free cells nearest the top-left and the bottom-right corner."""
+    free = np.argwhere(np.isfinite(grid))
+    a, b = free[np.argmin(free.sum(axis=1))], free[np.argmax(free.sum(axis=1))]
+    return (int(a[0]), int(a[1])), (int(b[0]), int(b[1]))
+
+
+def corner_to_corner(
+    name: str,
+    grid: np.ndarray,
+    planners: dict[str, Callable[[np.ndarray, Cell, Cell], np.ndarray | None]],
+    calls: int,
+) -> list[dict[str, object]]:
+    """One corner-to-corner query per planner: a warm-up call, then ``calls`` timed calls."""
+    s, t = corner_cells(grid)
+    times: dict[str, list[float]] = {p: [] for p in planners}
+    cpu: dict[str, list[float]] = {p: [] for p in planners}
+    paths: dict[str, np.ndarray | None] = {}
+    for p, fn in planners.items():
+        paths[p] = fn(grid, s, t)
+    for _ in range(calls):
+        for p, fn in planners.items():
+            c0 = time.process_time()
+            t0 = time.perf_counter()
+            fn(grid, s, t)
+            times[p].append(time.perf_counter() - t0)
+            cpu[p].append(time.process_time() - c0)
+    rows: list[dict[str, object]] = []
+    for p in planners:
+        path = paths[p]
+        rows.append(
+            {
+                "case": "corner_to_corner",
+                "grid": name,
+                "shape": list(grid.shape),
+                "planner": p,
+                "start": list(s),
+                "goal": list(t),
+                "calls": calls,
+                "median_ms": round(statistics.median(times[p]) * 1e3, 3),
+                "min_ms": round(min(times[p]) * 1e3, 3),
+                "max_ms": round(max(times[p]) * 1e3, 3),
+                "median_cpu_ms": round(statistics.median(cpu[p]) * 1e3, 3),
+                "cost": None if path is None else round(astar.path_cost(grid, path), 4),
+                "corner_cuts": None if path is None else astar.corner_cuts(grid, path),
+            }
+        )
+    ours = float(rows[0]["median_ms"])  # type: ignore[arg-type]
+    for row in rows:
+        row["time_vs_bt_manip"] = round(float(row["median_ms"]) / ours, 3)  # type: ignore[arg-type]
+    if "pyastar2d" in planners:
+        peer = float(rows[list(planners).index("pyastar2d")]["median_ms"])  # type: ignore[arg-type]
+        rows[0]["time_vs_pyastar2d"] = round(ours / peer, 3)
+        ours_cpu = float(rows[0]["median_cpu_ms"])  # type: ignore[arg-type]
+        peer_cpu = float(rows[list(planners).index("pyastar2d")]["median_cpu_ms"])  # type: ignore[arg-type]
+        rows[0]["cpu_vs_pyastar2d"] = round(ours_cpu / peer_cpu, 3)
+    return rows
+
+
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3, help="runs per query (best is kept)")
     ap.add_argument("--queries", type=int, default=10, help="start/goal pairs per grid")
+    ap.add_argument("--calls", type=int, default=3, help="timed corner-to-corner calls")
     ap.add_argument("--no-house", action="store_true")
+    ap.add_argument("--corners-only", action="store_true", help="skip the random queries")
     args = ap.parse_args(argv)
 
     t0 = time.perf_counter()
@@ -199,7 +269,7 @@ def main(argv: list[str] | None = None) -> None:
         "random20": random_grid(),
         "maze": maze_grid(),
     }
-    if not args.no_house:
+    if not args.no_house and not args.corners_only:
         house = house_grid()
         if house is not None:
             grids["house"] = house
@@ -208,6 +278,12 @@ def main(argv: list[str] | None = None) -> None:
         fn = maker()
         if fn is not None:
             planners[label] = fn
+    corner_planners = {p: fn for p, fn in planners.items() if p != "tcod"}  # seconds a call
+    for name in ("open", "random20", "maze"):
+        for row in corner_to_corner(name, grids[name], corner_planners, args.calls):
+            print(json.dumps(row), flush=True)
+    if args.corners_only:
+        return
     for name, grid in grids.items():
         pairs = queries(grid, args.queries)
         rows = [measure(name, grid, pairs, p, fn, args.repeat) for p, fn in planners.items()]

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from bt_manip.navigation.astar_search import (
+    Scratch,
     cost_range,
-    scratch,
     search_buckets,
     search_heap,
     trace,
@@ -74,6 +74,27 @@ MAX_BUCKET_COST_RATIO = 64.0
 """Grids whose largest/smallest finite cost exceeds this use the heap search."""
 HEAP_QUANTUM = 1e-11
 """Priority rounding of the heap search, relative to the start's heuristic."""
+KEPT_CELLS = 1 << 22
+"""Grids up to this many cells search in scratch memory kept for the next search (at most
+9 bytes a cell, resident where searches went); larger ones get fresh zero pages each time, given
+back when the search ends."""
+
+_kept: list[Scratch] = []
+"""The scratch kept between searches (none, or one), taken out while a search uses it."""
+
+
+def _take_scratch(cells: int, rows: int) -> tuple[Scratch, bool]:
+    """Scratch for a search, and whether it is to be kept (so cleaned up by the search)."""
+    if cells > KEPT_CELLS:
+        return Scratch.new(cells, rows), False
+    try:
+        kept = _kept.pop()
+    except IndexError:  # none yet, or another thread holds it
+        kept = None
+    if kept is not None and kept.fits(cells, rows):
+        return kept, True
+    size = max(cells, kept.cells if kept is not None else 0)
+    return Scratch.new(size, max(rows, kept.rows if kept is not None else 0), huge=True), True
 
 
 def _check_grid(cost: np.ndarray) -> np.ndarray:
@@ -116,23 +137,25 @@ def plan_verbose(
     ti = t[0] * cols + t[1]
     if si == ti:
         return PlanResult(PlanStatus.FOUND, np.array([s], dtype=np.int64), 0.0, 0)
+    work, keep = _take_scratch(grid.size, grid.shape[0])
+    arrays = (work.g, work.parent, work.lo, work.hi, keep)
     if hmax <= MAX_BUCKET_COST_RATIO * hmin:
         delta = BUCKET_WIDTH * hmin
         # largest f increase along one move: step x (cost + hmin), step <= sqrt 2
         span = math.ceil(SQRT2 * (hmax + hmin) / delta) + 3
-        parent, g_goal, expanded = search_buckets(
-            grid, si, ti, bool(diagonal), float(hmin), delta, span, *scratch(grid.size)
+        g_goal, expanded = search_buckets(
+            grid, si, ti, bool(diagonal), float(hmin), delta, span, *arrays
         )
     else:
         dr, dc = abs(s[0] - t[0]), abs(s[1] - t[1])
         h0 = (max(dr, dc) + (SQRT2 - 1.0) * min(dr, dc)) if diagonal else float(dr + dc)
         quantum = HEAP_QUANTUM * h0 * float(hmin)
-        parent, g_goal, expanded = search_heap(
-            grid, si, ti, bool(diagonal), float(hmin), quantum, *scratch(grid.size)
-        )
-    if not math.isfinite(g_goal):
+        g_goal, expanded = search_heap(grid, si, ti, bool(diagonal), float(hmin), quantum, *arrays)
+    path = trace(work.parent, si, ti, cols) if math.isfinite(g_goal) else None
+    if keep and not _kept:  # the search left it clean (one that raised is left to the collector)
+        _kept.append(work)
+    if path is None:
         return PlanResult(PlanStatus.NO_PATH, None, math.inf, int(expanded))
-    path = trace(parent, si, ti, cols)
     return PlanResult(PlanStatus.FOUND, path, float(g_goal), int(expanded))
 
 

@@ -1,10 +1,9 @@
 """The compiled A* searches behind :mod:`bt_manip.navigation.astar`.
 
 Two open lists, one contract. Both take a C-contiguous float32 grid (``inf`` = blocked, finite
-costs > 0), flat start and goal indices, and return ``(parent, g_goal, expanded)``:
-``parent[i]`` is the predecessor of cell ``i`` on its best known path (valid only for reached
-cells; -1 for the start), ``g_goal`` the cost of the cheapest path (``inf`` if none),
-``expanded`` the number of cell expansions.
+costs > 0), flat start and goal indices and a :class:`Scratch`, and return
+``(g_goal, expanded)``: the cost of the cheapest path (``inf`` if none) and the number of cell
+expansions; :func:`trace` then reads the path from the scratch's ``parent`` moves.
 
 - :func:`search_buckets` (used when the costs span a modest range, as on occupancy grids):
   the open list is a circular array of f-buckets of fixed width, each a last-in first-out
@@ -19,15 +18,27 @@ Both use the octile distance (Manhattan without diagonals) times the smallest co
 heuristic: admissible and consistent for these moves. An improvement of g smaller than
 ``KEEP`` (1e-13 relative) is treated as a tie, so rounding noise between equal-cost paths does
 not trigger re-expansions.
+
+Scratch memory. ``g`` is stored as the bits of the float64 value XOR those of ``+inf``, so a
+zero word reads as ``+inf``, "not reached" (the start, g = 0, is stored as the bits of inf):
+zero pages are an empty search, and a blocked neighbour (step cost inf) can never improve on
+it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cell was last
+improved, one byte per cell. Each search records, per row, the columns of ``g`` it wrote, and
+a search asked to clean up sets them back to zero before it returns, so the next search can
+reuse the same memory without touching the rest of the grid.
 """
 
 from __future__ import annotations
 
 import math
 import mmap
+from dataclasses import dataclass
 
 import numba
 import numpy as np
+from llvmlite import ir
+from numba.core import cgutils, types
+from numba.extending import intrinsic
 
 KEEP = 1.0 - 1e-13
 """A new g must be below ``KEEP x`` the known g to count as an improvement."""
@@ -35,6 +46,79 @@ KEEP = 1.0 - 1e-13
 # Neighbour order: four sides first, then the four diagonals.
 DR = np.array([-1, 1, 0, 0, -1, -1, 1, 1], dtype=np.int64)
 DC = np.array([0, 0, -1, 1, -1, 1, -1, 1], dtype=np.int64)
+# the two sides a diagonal move passes: (up or down, left or right) for moves 4-7
+SIDE_ROW = np.array([0, 0, 1, 1], dtype=np.int64)
+SIDE_COL = np.array([2, 3, 2, 3], dtype=np.int64)
+INF_BITS = np.int64(0x7FF0000000000000)
+"""Bits of float64 ``+inf``: stored g words are the value's bits XOR these."""
+
+
+@intrinsic
+def _bits_to_float(typingctx, bits):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """The float64 whose bits are the int64 ``bits``."""
+    sig = types.float64(types.int64)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        return builder.bitcast(args[0], ir.DoubleType())
+
+    return sig, codegen
+
+
+@intrinsic
+def _float_to_bits(typingctx, value):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """The bits of the float64 ``value`` as an int64."""
+    sig = types.int64(types.float64)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        return builder.bitcast(args[0], ir.IntType(64))
+
+    return sig, codegen
+
+
+@intrinsic
+def _prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """Ask the processor to bring ``arr[idx]`` into cache (a hint: never faults)."""
+    sig = types.void(arr, idx)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty = signature.args[0]
+        ary = context.make_array(arrty)(context, builder, args[0])
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [args[1]], wraparound=False)
+        i8p = ir.IntType(8).as_pointer()
+        i32 = ir.IntType(32)
+        fnty = ir.FunctionType(ir.VoidType(), [i8p, i32, i32, i32])
+        fn = cgutils.get_or_insert_function(builder.module, fnty, "llvm.prefetch.p0")
+        # read, keep in all cache levels, data cache
+        builder.call(fn, [builder.bitcast(ptr, i8p), i32(0), i32(3), i32(1)])
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@numba.njit(cache=True, inline="always")
+def _prefetch_around(
+    g: np.ndarray, flat: np.ndarray, parent: np.ndarray, q: int, cols: int
+) -> None:
+    """Prefetch the g, cost and parent rows that expanding cell ``q`` will read or write."""
+    _prefetch(g, q - cols)  # type: ignore[call-arg]  # numba body, as for _load_g
+    _prefetch(g, q)  # type: ignore[call-arg]
+    _prefetch(g, q + cols)  # type: ignore[call-arg]
+    _prefetch(flat, q - cols)  # type: ignore[call-arg]
+    _prefetch(flat, q)  # type: ignore[call-arg]
+    _prefetch(flat, q + cols)  # type: ignore[call-arg]
+    _prefetch(parent, q)  # type: ignore[call-arg]
+
+
+@numba.njit(cache=True, inline="always")
+def _load_g(g: np.ndarray, i: int) -> float:
+    """g of cell ``i`` (``inf`` when not reached)."""
+    # numba body: mypy reads the intrinsic as taking the typing context too
+    return _bits_to_float(g[i] ^ INF_BITS)  # type: ignore[call-arg, no-any-return]
+
+
+@numba.njit(cache=True, inline="always")
+def _store_g(g: np.ndarray, i: int, value: float) -> None:
+    g[i] = _float_to_bits(value) ^ INF_BITS  # type: ignore[call-arg]  # numba body, as above
 
 
 @numba.njit(cache=True, inline="always")
@@ -43,9 +127,9 @@ def _h(r: int, c: int, gr: int, gc: int, diagonal: bool, hmin: float) -> float:
     ac = abs(c - gc)
     if not diagonal:
         return (ar + ac) * hmin
-    if ar > ac:
-        return (ar - ac + math.sqrt(2.0) * ac) * hmin
-    return (ac - ar + math.sqrt(2.0) * ar) * hmin
+    hi = max(ar, ac)
+    lo = min(ar, ac)
+    return (hi - lo + math.sqrt(2.0) * lo) * hmin
 
 
 @numba.njit(cache=True)
@@ -75,42 +159,82 @@ def cost_range(grid: np.ndarray) -> tuple[float, float]:
     return lo, float(hi)
 
 
-def scratch(cells: int) -> tuple[np.ndarray, np.ndarray]:
-    """Fresh ``g`` and ``parent`` arrays for a search over ``cells`` cells.
+def _zero_pages(nbytes: int, huge: bool) -> mmap.mmap:
+    """An anonymous map of ``nbytes`` zero bytes (resident only where touched)."""
+    area = mmap.mmap(-1, max(1, nbytes))
+    if huge and hasattr(mmap, "MADV_HUGEPAGE"):
+        area.madvise(mmap.MADV_HUGEPAGE)
+    return area
 
-    ``g`` is all zeros, read as "not reached" (every reached cell but the start has g > 0), so
-    both can live in an anonymous memory map: the system hands out zero pages on first touch,
-    in small pages (numpy would ask for huge pages on arrays this large), and a search that
-    explores a small part of a large grid keeps only that part resident. ``parent`` is read
-    only for reached cells.
+
+@dataclass
+class Scratch:
+    """Per-cell memory of a search over up to ``cells`` cells and ``rows`` rows.
+
+    ``g`` (int64 words, see the module notes) and ``parent`` (uint8 moves) live in anonymous
+    memory maps: the system hands out zero pages on first touch, so a search that explores a
+    small part of a large grid keeps only that part resident. ``lo``/``hi`` are, per row, the
+    first and last column whose ``g`` the current search wrote (``lo > hi``: none).
     """
-    g = np.frombuffer(mmap.mmap(-1, max(1, cells) * 8), np.float64)
-    parent = np.frombuffer(mmap.mmap(-1, max(1, cells) * 4), np.int32)
-    return g[:cells], parent[:cells]
+
+    cells: int
+    rows: int
+    g: np.ndarray
+    parent: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+
+    @classmethod
+    def new(cls, cells: int, rows: int, huge: bool = False) -> Scratch:
+        """Fresh scratch; ``huge`` asks for huge pages (fewer, larger pages for a kept one)."""
+        g = np.frombuffer(_zero_pages(cells * 8, huge), np.int64)[:cells]
+        parent = np.frombuffer(_zero_pages(cells, huge), np.uint8)[:cells]
+        lo = np.full(max(1, rows), np.iinfo(np.int32).max, np.int32)
+        hi = np.full(max(1, rows), -1, np.int32)
+        return cls(cells, rows, g, parent, lo, hi)
+
+    def fits(self, cells: int, rows: int) -> bool:
+        return self.cells >= cells and self.rows >= rows
 
 
 @numba.njit(cache=True, inline="always")
-def _improves(new_g: float, known: float, is_start: bool) -> bool:
-    """Whether ``new_g`` beats a cell's stored g (0 = not reached, except at the start)."""
-    if known == 0.0:
-        return not is_start
-    return new_g < known * KEEP
+def _mark(lo: np.ndarray, hi: np.ndarray, r: int, c: int) -> None:
+    """Remember that the search wrote g at (r, c)."""
+    if c < lo[r]:
+        lo[r] = c
+    if c > hi[r]:
+        hi[r] = c
+
+
+@numba.njit(cache=True)
+def _clean(g: np.ndarray, lo: np.ndarray, hi: np.ndarray, rows: int, cols: int, zero: bool) -> None:
+    """Forget the written columns; with ``zero``, also set their g words back to 0."""
+    top = np.iinfo(np.int32).max
+    for r in range(rows):
+        if hi[r] >= lo[r]:
+            if zero:
+                g[r * cols + lo[r] : r * cols + hi[r] + 1] = 0
+            lo[r] = top
+            hi[r] = -1
 
 
 @numba.njit(cache=True)
 def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
-    """The (row, col) cells from ``start`` to ``goal`` following ``parent`` links."""
+    """The (row, col) cells from ``start`` to ``goal`` following the ``parent`` moves."""
     n = 1
     node = goal
     while node != start:
-        node = parent[node]
+        k = parent[node]
+        node -= DR[k] * cols + DC[k]
         n += 1
     out = np.empty((n, 2), np.int64)
     node = goal
     for i in range(n - 1, -1, -1):
         out[i, 0] = node // cols
         out[i, 1] = node % cols
-        node = parent[node]
+        if i > 0:
+            k = parent[node]
+            node -= DR[k] * cols + DC[k]
     return out
 
 
@@ -119,6 +243,181 @@ def _doubled(a: np.ndarray) -> np.ndarray:
     """A copy of ``a`` with twice the room (the new half is left uninitialised)."""
     out = np.empty(a.shape[0] * 2, a.dtype)
     out[: a.shape[0]] = a
+    return out
+
+
+@numba.njit(cache=True, inline="always")
+def _move_costs(
+    flat: np.ndarray,
+    node: int,
+    r: int,
+    c: int,
+    rows: int,
+    cols: int,
+    diagonal: bool,
+    off: np.ndarray,
+    w8: np.ndarray,
+) -> int:
+    """Fill ``w8[k]`` with the cost of the cell entered by move k (inf if not allowed).
+
+    A diagonal move is allowed only when both side cells beside it are free. Returns the
+    number of moves looked at (4 or 8).
+    """
+    inf = np.inf
+    if r == 0 or r == rows - 1 or c == 0 or c == cols - 1:
+        for k in range(4):
+            nr = r + DR[k]
+            nc = c + DC[k]
+            if nr < 0 or nr >= rows or nc < 0 or nc >= cols:
+                w8[k] = inf
+            else:
+                w8[k] = flat[node + off[k]]
+    else:
+        for k in range(4):
+            w8[k] = flat[node + off[k]]
+    if not diagonal:
+        return 4
+    for k in range(4, 8):
+        if w8[SIDE_ROW[k - 4]] == inf or w8[SIDE_COL[k - 4]] == inf:
+            w8[k] = inf
+        else:
+            w8[k] = flat[node + off[k]]
+    return 8
+
+
+# Indices into the bucket search's state vectors (it runs in rounds between pool growths).
+_CUR, _USED, _FREE, _OPEN, _EXPANDED = 0, 1, 2, 3, 4
+_G_GOAL, _BOUND = 0, 1
+
+
+@numba.njit(cache=True)
+def _bucket_rounds(
+    cost: np.ndarray,
+    start: int,
+    goal: int,
+    diagonal: bool,
+    hmin: float,
+    delta: float,
+    mask: int,
+    g: np.ndarray,
+    parent: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    heads: np.ndarray,
+    pn: np.ndarray,
+    pg: np.ndarray,
+    pnext: np.ndarray,
+    ints: np.ndarray,
+    floats: np.ndarray,
+) -> bool:
+    """Run the bucket search until it ends (True) or its pool may run out of slots (False).
+
+    The pool (``pn``, ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the
+    state vectors are the caller's, so that no array changes hands inside the loop.
+    """
+    rows, cols = cost.shape
+    flat = cost.ravel()
+    gr = goal // cols
+    gc = goal % cols
+    sqrt2 = math.sqrt(2.0)
+    inv_delta = 1.0 / delta
+    inf = np.inf
+    off = DR * cols + DC
+    w8 = np.empty(8, np.float64)
+    cand_k = np.empty(8, np.int64)
+    cand_g = np.empty(8, np.float64)
+    room = pn.shape[0] - 8  # an expansion pushes at most 8 entries
+    cur = ints[_CUR]
+    used = ints[_USED]
+    free = ints[_FREE]
+    n_open = ints[_OPEN]
+    expanded = ints[_EXPANDED]
+    g_goal = floats[_G_GOAL]
+    bound = floats[_BOUND]  # g_goal x KEEP: what a path through an entry must beat
+    done = True
+    while n_open > 0:
+        if used > room:
+            done = False
+            break
+        b = cur & mask
+        while heads[b] == -1:
+            cur += 1
+            b = cur & mask
+        if cur * delta >= g_goal:
+            break  # every open entry has f >= g_goal
+        slot = heads[b]
+        heads[b] = pnext[slot]
+        n_open -= 1
+        node = pn[slot]
+        gn = pg[slot]
+        pnext[slot] = free
+        free = slot
+        # the next two entries of this bucket are likely the next pops: start their loads
+        nxt = heads[b]
+        if nxt != -1:
+            _prefetch_around(g, flat, parent, pn[nxt], cols)
+            nxt = pnext[nxt]
+            if nxt != -1:
+                _prefetch_around(g, flat, parent, pn[nxt], cols)
+        if gn > _load_g(g, node):
+            continue  # stale entry
+        r = node // cols
+        c = node - r * cols
+        if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
+            continue  # cannot lead to a cheaper path to the goal
+        expanded += 1
+        nmoves = _move_costs(flat, node, r, c, rows, cols, diagonal, off, w8)
+        n_cand = 0
+        for k in range(nmoves):
+            ng_ = gn + w8[k] if k < 4 else gn + sqrt2 * w8[k]
+            # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
+            if ng_ < _load_g(g, node + off[k]) * KEEP:
+                cand_k[n_cand] = k
+                cand_g[n_cand] = ng_
+                n_cand += 1
+        for j in range(n_cand):
+            k = cand_k[j]
+            ng_ = cand_g[j]
+            nb = node + off[k]
+            nr = r + DR[k]
+            nc = c + DC[k]
+            _store_g(g, nb, ng_)
+            parent[nb] = k
+            _mark(lo, hi, nr, nc)
+            if nb == goal:
+                g_goal = ng_
+                bound = ng_ * KEEP
+                continue
+            f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
+            if f >= bound:
+                continue
+            kb = max(np.int64(math.floor(f * inv_delta)), cur) & mask
+            if free != -1:
+                s = free
+                free = pnext[s]
+            else:
+                s = used
+                used += 1
+            pn[s] = nb
+            pg[s] = ng_
+            pnext[s] = heads[kb]
+            heads[kb] = s
+            n_open += 1
+    ints[_CUR] = cur
+    ints[_USED] = used
+    ints[_FREE] = free
+    ints[_OPEN] = n_open
+    ints[_EXPANDED] = expanded
+    floats[_G_GOAL] = g_goal
+    floats[_BOUND] = bound
+    return done
+
+
+@numba.njit(cache=True)
+def _grown(a: np.ndarray, used: int) -> np.ndarray:
+    """A copy of ``a`` with twice the room, its first ``used`` entries kept."""
+    out = np.empty(a.shape[0] * 2, a.dtype)
+    out[:used] = a[:used]
     return out
 
 
@@ -133,103 +432,40 @@ def search_buckets(
     span: int,
     g: np.ndarray,
     parent: np.ndarray,
-) -> tuple[np.ndarray, float, int]:
-    """A* with f-buckets of width ``delta`` in a circular array of ``span`` buckets.
+    lo: np.ndarray,
+    hi: np.ndarray,
+    zero: bool,
+) -> tuple[float, int]:
+    """A* with f-buckets of width ``delta`` in a circular array of at least ``span`` buckets.
 
     ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
-    ``g`` and ``parent`` are the caller's scratch arrays (see :func:`scratch`).
+    ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
+    entry; with ``zero`` the written part of ``g`` is zero again on return.
     """
-    rows, cols = cost.shape
-    flat = cost.ravel()
-    gr = goal // cols
-    gc = goal % cols
-    sqrt2 = math.sqrt(2.0)
-    nmoves = 8 if diagonal else 4
-    inv_delta = 1.0 / delta
-
-    heads = np.full(span, -1, np.int32)  # first pool slot of each bucket
-    pn = np.empty(4096, np.int32)  # pool: cell, g at push time, next slot in the bucket
+    cols = cost.shape[1]
+    size = 1
+    while size < span:  # a power of two: the bucket of a key is key & mask
+        size *= 2
+    heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
+    pn = np.empty(4096, np.int32)
     pg = np.empty(4096, np.float64)
     pnext = np.empty(4096, np.int32)
-
-    g[start] = 0.0
-    parent[start] = -1
-    cur = np.int64(math.floor(_h(start // cols, start % cols, gr, gc, diagonal, hmin) * inv_delta))
+    _store_g(g, start, 0.0)
+    _mark(lo, hi, start // cols, start % cols)
+    h0 = _h(start // cols, start % cols, goal // cols, goal % cols, diagonal, hmin)
+    cur = np.int64(math.floor(h0 * (1.0 / delta)))
     pn[0] = start
     pg[0] = 0.0
     pnext[0] = -1
-    heads[cur % span] = 0
-    used = 1
-    free = -1
-    n_open = 1
-    expanded = 0
-    g_goal = np.inf
-
-    while n_open > 0:
-        b = cur % span
-        while heads[b] == -1:
-            cur += 1
-            b += 1
-            if b == span:
-                b = 0  # type: ignore[assignment]  # numba body: numba unifies int64 and int
-        if cur * delta >= g_goal:
-            break  # every open entry has f >= g_goal
-        slot = heads[b]
-        heads[b] = pnext[slot]
-        n_open -= 1
-        node = pn[slot]
-        gn = pg[slot]
-        pnext[slot] = free
-        free = slot
-        if gn > g[node]:
-            continue  # stale entry
-        r = node // cols
-        c = node % cols
-        if g_goal < np.inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= g_goal * KEEP:
-            continue  # cannot lead to a cheaper path to the goal
-        expanded += 1
-        for k in range(nmoves):
-            nr = r + DR[k]
-            nc = c + DC[k]
-            if nr < 0 or nr >= rows or nc < 0 or nc >= cols:
-                continue
-            nb = nr * cols + nc
-            w = flat[nb]
-            if w == np.inf:
-                continue
-            if k >= 4:
-                if flat[nr * cols + c] == np.inf or flat[r * cols + nc] == np.inf:
-                    continue  # diagonal past a blocked corner
-                ng_ = gn + sqrt2 * w
-            else:
-                ng_ = gn + w
-            if not _improves(ng_, g[nb], nb == start):
-                continue
-            g[nb] = ng_
-            parent[nb] = node
-            if nb == goal:
-                g_goal = ng_
-                continue
-            f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
-            if f >= g_goal * KEEP:
-                continue
-            kb = np.int64(math.floor(f * inv_delta))
-            kb = max(kb, cur)
-            if free != -1:
-                s = free
-                free = pnext[s]
-            else:
-                if used == pn.shape[0]:
-                    pn, pg, pnext = _doubled(pn), _doubled(pg), _doubled(pnext)
-                s = used
-                used += 1
-            kb = kb % span
-            pn[s] = nb
-            pg[s] = ng_
-            pnext[s] = heads[kb]
-            heads[kb] = s
-            n_open += 1
-    return parent, g_goal, expanded
+    heads[cur & (size - 1)] = 0
+    ints = np.array([cur, 1, -1, 1, 0], np.int64)
+    floats = np.array([np.inf, np.inf])
+    while not _bucket_rounds(cost, start, goal, diagonal, hmin, delta, size - 1, g, parent, lo,
+                             hi, heads, pn, pg, pnext, ints, floats):
+        used = ints[_USED]
+        pn, pg, pnext = _grown(pn, used), _grown(pg, used), _grown(pnext, used)
+    _clean(g, lo, hi, cost.shape[0], cols, zero)
+    return floats[_G_GOAL], ints[_EXPANDED]
 
 
 @numba.njit(cache=True, inline="always")
@@ -248,30 +484,35 @@ def search_heap(
     quantum: float,
     g: np.ndarray,
     parent: np.ndarray,
-) -> tuple[np.ndarray, float, int]:
+    lo: np.ndarray,
+    hi: np.ndarray,
+    zero: bool,
+) -> tuple[float, int]:
     """A* with a binary heap on (f rounded down to ``quantum``, larger g first).
 
-    The returned cost exceeds the optimum by less than ``quantum``. ``g`` and ``parent`` are
-    the caller's scratch arrays (see :func:`scratch`).
+    The returned cost exceeds the optimum by less than ``quantum``. The scratch arrays are as
+    for :func:`search_buckets`.
     """
     rows, cols = cost.shape
     flat = cost.ravel()
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
-    nmoves = 8 if diagonal else 4
     inv_q = 1.0 / quantum
+    off = DR * cols + DC
+    w8 = np.empty(8, np.float64)
 
     hf = np.empty(1024, np.float64)
     hg = np.empty(1024, np.float64)
     hn = np.empty(1024, np.int32)
-    g[start] = 0.0
-    parent[start] = -1
+    _store_g(g, start, 0.0)
+    _mark(lo, hi, start // cols, start % cols)
     hf[0] = math.floor(_h(start // cols, start % cols, gr, gc, diagonal, hmin) * inv_q)
     hg[0] = 0.0
     hn[0] = start
     size = 1
     expanded = 0
+    g_goal = np.inf
 
     while size > 0:
         g_top = hg[0]
@@ -297,32 +538,25 @@ def search_heap(
             hf[i] = lf
             hg[i] = lg
             hn[i] = ln
-        if g_top > g[node]:
+        if g_top > _load_g(g, node):
             continue  # stale entry
         if node == goal:
-            return parent, g_top, expanded
+            g_goal = g_top
+            break
         expanded += 1
         r = node // cols
-        c = node % cols
+        c = node - r * cols
+        nmoves = _move_costs(flat, node, r, c, rows, cols, diagonal, off, w8)
         for k in range(nmoves):
+            ng_ = g_top + w8[k] if k < 4 else g_top + sqrt2 * w8[k]
+            nb = node + off[k]
+            if not ng_ < _load_g(g, nb) * KEEP:
+                continue
             nr = r + DR[k]
             nc = c + DC[k]
-            if nr < 0 or nr >= rows or nc < 0 or nc >= cols:
-                continue
-            nb = nr * cols + nc
-            w = flat[nb]
-            if w == np.inf:
-                continue
-            if k >= 4:
-                if flat[nr * cols + c] == np.inf or flat[r * cols + nc] == np.inf:
-                    continue
-                ng_ = g_top + sqrt2 * w
-            else:
-                ng_ = g_top + w
-            if not _improves(ng_, g[nb], nb == start):
-                continue
-            g[nb] = ng_
-            parent[nb] = node
+            _store_g(g, nb, ng_)
+            parent[nb] = k
+            _mark(lo, hi, nr, nc)
             nf_ = math.floor((ng_ + _h(nr, nc, gr, gc, diagonal, hmin)) * inv_q)
             if size == hf.shape[0]:
                 hf, hg, hn = _doubled(hf), _doubled(hg), _doubled(hn)
@@ -339,4 +573,5 @@ def search_heap(
             hf[i] = nf_
             hg[i] = ng_
             hn[i] = nb
-    return parent, np.inf, expanded
+    _clean(g, lo, hi, rows, cols, zero)
+    return g_goal, expanded

@@ -163,3 +163,23 @@ def test_open_grid_search_stays_on_the_optimal_band() -> None:
     res = plan_verbose(cost, (390, 150), (10, 210))
     assert res.cost == pytest.approx(320 + 60 * math.sqrt(2.0), rel=1e-12)
     assert res.expanded < 2 * len(res.path)
+
+
+def test_kept_scratch_gives_the_results_of_fresh_memory(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Searches in the memory kept between searches (grids of all sizes, one after another)
+    find what searches in fresh zero pages find, and leave the kept memory clean."""
+    rng = np.random.default_rng(7)
+    cases = [random_case(rng) for _ in range(60)]
+    kept = [plan_verbose(cost, s, t, diagonal=bool(i % 2)) for i, (cost, s, t) in enumerate(cases)]
+    assert astar._kept and not astar._kept[0].g.any()
+    monkeypatch.setattr(astar, "KEPT_CELLS", 0)
+    for i, (cost, s, t) in enumerate(cases):
+        fresh = plan_verbose(cost, s, t, diagonal=bool(i % 2))
+        assert (fresh.status, fresh.cost, fresh.expanded) == (
+            kept[i].status,
+            kept[i].cost,
+            kept[i].expanded,
+        )
+        if fresh.path is not None:
+            assert kept[i].path is not None
+            assert np.array_equal(fresh.path, kept[i].path)
