@@ -203,6 +203,8 @@ class WorldSpec:
     pose_lines: dict[str, int] = field(default_factory=dict)
     groups: list[Any] = field(default_factory=list)
     """:class:`~bt_manip.sim.groups.GroupSpec` entries: members moved together."""
+    route_graph: Path | None = None
+    """A route graph in Nav2's GeoJSON format for ComputeRoute (None: one is generated)."""
 
 
 WORLD_SCHEMA_VERSION = 1
@@ -220,6 +222,7 @@ TOP_KEYS = {
     "robots",
     "poses",
     "groups",
+    "route_graph",
 }
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "solver_tolerance", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
@@ -683,6 +686,11 @@ def _parse_world(path: Path, raw: bytes) -> WorldSpec:
     from bt_manip.sim.groups import parse_groups
 
     spec.groups = parse_groups(rd, data, spec)
+    if "route_graph" in data:
+        graph = base / rd.text(data, "route_graph", "the world")
+        if not graph.is_file():
+            rd.fail(data.line_of("route_graph"), f"route_graph: no file {graph}")
+        spec.route_graph = graph
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)
