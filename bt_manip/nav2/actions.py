@@ -257,6 +257,8 @@ class FollowPath(Nav2Action):
             str, False, "Mapped name of the progress checker", ""
         ),
         "path_handler_id": PortInformation(str, False, "Mapped name of the path handler", ""),
+        "server_name": PortInformation(str, False, "Action server name", "follow_path"),
+        "server_timeout": PortInformation(float, False, "Action server timeout (ms)", 20.0),
     }
     OUTPUT_PORTS: ClassVar[dict[str, PortInformation]] = {  # type: ignore[misc]  # py_trees stub: not ClassVar
         "tracking_feedback": PortInformation(
