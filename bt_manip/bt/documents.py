@@ -12,8 +12,10 @@ import os
 from dataclasses import dataclass, field
 
 from bt_manip.bt.models import NodeSpec, read_models
-from bt_manip.bt.xml_parse import Element, XmlError, parse_xml_file, parse_xml_text
-from bt_manip.errors import Problem
+from bt_manip.bt.v3_convert import ConvertError, convert_v3
+from bt_manip.bt.xml_parse import MAX_BYTES, Element, XmlError, parse_xml_file, parse_xml_text
+from bt_manip.errors import InputError, Problem
+from bt_manip.input_files import read_bounded
 
 MAX_INCLUDE_DEPTH = 256
 """Files including files including files...: at most this many levels (like XML nesting)."""
@@ -85,10 +87,11 @@ def _read_into(doc: Document, path: str, text: str | None, stack: tuple[str, ...
                                     f"found <{root.tag}>"))
         return
     fmt = root.get("BTCPP_format")
-    if fmt is None:
-        doc.warnings.append(Problem(path, root.line,
-                                    "warning: <root> has no BTCPP_format attribute; reading it "
-                                    "as BTCPP_format=\"4\""))
+    if fmt is None or fmt.strip() == "3":
+        upgraded = _upgrade_v3(doc, path, text, fmt)
+        if upgraded is None:
+            return
+        root = upgraded
     elif fmt.strip() != "4":
         doc.problems.append(Problem(path, root.line,
                                     f"BTCPP_format=\"{fmt}\" is not supported; this loader reads "
@@ -109,6 +112,29 @@ def _read_into(doc: Document, path: str, text: str | None, stack: tuple[str, ...
             doc.problems.append(Problem(path, child.line,
                                         f"unexpected element <{child.tag}> under <root>; "
                                         "expected <BehaviorTree>, <include> or <TreeNodesModel>"))
+
+
+def _upgrade_v3(doc: Document, path: str, text: str | None, fmt: str | None) -> Element | None:
+    """The root of a BehaviorTree.CPP v3 file (``BTCPP_format`` "3" or none) converted to v4
+    (:mod:`bt_manip.bt.v3_convert`), each rewrite a warning with its line; None (and the
+    problem) when it cannot be read."""
+    what = "has no BTCPP_format attribute" if fmt is None else 'has BTCPP_format="3"'
+    try:
+        raw = text if text is not None else read_bounded(path, MAX_BYTES, "file").decode("utf-8")
+        v4, rewrites = convert_v3(raw)
+        root = parse_xml_text(v4, path)
+    except InputError as e:
+        doc.problems.extend(e.problems)
+        return None
+    except (ConvertError, XmlError, UnicodeDecodeError) as e:
+        doc.problems.append(e.problem if isinstance(e, XmlError)
+                            else Problem(path, getattr(e, "line", None), str(e)))
+        return None
+    doc.warnings.append(Problem(path, root.line, f"warning: <root> {what}; reading it as "
+                                "BehaviorTree.CPP v3, converted to BTCPP_format=\"4\""))
+    doc.warnings.extend(Problem(path, line, f"warning: v3 form: {change}")
+                        for line, change in rewrites if "BTCPP_format" not in change)
+    return root
 
 
 def _include(doc: Document, path: str, element: Element, stack: tuple[str, ...]) -> None:

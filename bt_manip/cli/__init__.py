@@ -9,6 +9,7 @@ Verbs:
   bim-report REPORT --png P  the floor plan of an installation run, as built
   robot init|check           write a robot descriptor from a URDF, or check one
   validate TREE.xml          check a tree without running it, listing every problem
+  convert V3.xml [-o OUT]    a BehaviorTree.CPP v3 tree in its v4 form
   show TREE.xml              print a tree as text (or Graphviz with --dot)
   nodes [--groot]            list registered nodes (TreeNodesModel XML with --groot)
   demo [--out DIR]           Scenario A headless: summary, run report, replay page
@@ -64,6 +65,7 @@ VERBS = (
     Verb("examples", "examples", "list the shipped trees, worlds and robots, or copy them"),
     Verb("schema", "schema", "list the JSON Schemas of bt-manip's output files, or print one"),
     Verb("validate", "tree", "check tree files without running them"),
+    Verb("convert", "convert", "write a BehaviorTree.CPP v3 tree file in its v4 form"),
     Verb("show", "tree", "print a tree as text (and Graphviz with --dot)"),
     Verb("nodes", "tree", "list registered nodes, or export a TreeNodesModel"),
 )

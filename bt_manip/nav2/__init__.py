@@ -18,7 +18,13 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
   TruncatePathLocal (:mod:`.path_local`); CancelControl, CancelBackUp, CancelSpin,
   CancelWait, CancelDriveOnHeading (:mod:`.cancel`);
 - IsBatteryLow on the robot's simulated battery (:mod:`.battery`); the decorator GoalUpdater
-  (:mod:`.goal_updater`).
+  (:mod:`.goal_updater`);
+- current Nav2's ValidatePath, IsGoalNearby, PathExpiringTimer, IsWithinPathTrackingBounds
+  (:mod:`.path_checks`), ProgressCheckerSelector, PathHandlerSelector (:mod:`.selectors`);
+  GetCurrentPose, GetPoseFromPath, ArePosesNear, ConcatenatePaths, GetNextFewGoals,
+  AppendGoalPoseToGoals (:mod:`.pose_nodes`); the route server's ComputeRoute,
+  ExtractRouteNodesAsGoals and WouldARouteRecoveryHelp (:mod:`.route`) on the world's route
+  graph (:mod:`.route_graph`).
 
 The TreeNodesModel names the ports' types as Nav2 does (:mod:`.model_types`).
 
@@ -38,9 +44,12 @@ from bt_manip.nav2 import (
     decorators,
     frames,
     goal_updater,
+    path_checks,
     path_local,
     path_nodes,
+    pose_nodes,
     progress,
+    route,
     selectors,
     smoothing,
     through_poses,
@@ -51,6 +60,6 @@ apply_model_types(registry)
 
 __all__ = [
     "actions", "battery", "cancel", "clearing", "conditions", "controls", "decorators",
-    "frames", "goal_updater", "path_local", "path_nodes", "progress", "selectors", "smoothing",
-    "through_poses",
+    "frames", "goal_updater", "path_checks", "path_local", "path_nodes", "pose_nodes", "progress",
+    "route", "selectors", "smoothing", "through_poses",
 ]

@@ -29,6 +29,7 @@ from bt_manip.nav2.blocking import drop_if_due, maybe_block
 from bt_manip.nav2.collision_ahead import AheadWatch, blocked_ahead
 from bt_manip.nav2.errors import BehaviorError, ControllerError, PlannerError
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
+from bt_manip.nav2.tracking import TrackingFeedback, tracking_feedback
 from bt_manip.navigation.controller import FollowState, PathFollower
 from bt_manip.navigation.planner import PlanOutcome
 
@@ -233,6 +234,9 @@ class FollowPath(Nav2Action):
       is followed from where the robot is, without stopping;
     - SUCCESS when the base is within Nav2's default goal tolerances (0.25 m, 0.25 rad) of the
       path's last pose;
+    - ``tracking_feedback`` is written at each tick it drives (:mod:`bt_manip.nav2.tracking`:
+      the signed distance of the base's pivot point from the path, the heading error, the
+      path length left);
     - FAILURE with 103 INVALID_PATH (no path or an empty one), 105 FAILED_TO_MAKE_PROGRESS
       (the base stopped getting closer) or 106 NO_VALID_CONTROL: a movable object lies on the
       next 0.8 m of the path (checked at 5 Hz, :mod:`bt_manip.nav2.collision_ahead`),
@@ -252,8 +256,17 @@ class FollowPath(Nav2Action):
         "progress_checker_id": PortInformation(
             str, False, "Mapped name of the progress checker", ""
         ),
+        "path_handler_id": PortInformation(str, False, "Mapped name of the path handler", ""),
+        "server_name": PortInformation(str, False, "Action server name", "follow_path"),
+        "server_timeout": PortInformation(float, False, "Action server timeout (ms)", 20.0),
     }
-    OUTPUT_PORTS: dict[str, PortInformation] = error_ports("The follow path")
+    OUTPUT_PORTS: dict[str, PortInformation] = {
+        "tracking_feedback": PortInformation(
+            TrackingFeedback, False, "Tracking feedback of the controller: cross track error, "
+            "current path index, remaining path length"
+        ),
+        **error_ports("The follow path"),
+    }
 
     def _path(self) -> Nav2Path:
         try:
@@ -308,6 +321,8 @@ class FollowPath(Nav2Action):
                     f"collision ahead: '{blocked.name}' lies on the path "
                     f"{blocked.distance:.2f} m ahead",
                 )
+        points = path.shifted(self.nav.pivot)
+        self.set_output("tracking_feedback", tracking_feedback(points, path.goal, pivot, pose))
         status = self.follower.update(pose, self.now())
         if status.state is FollowState.SUCCEEDED:
             robot.stop_base()

@@ -47,12 +47,11 @@ class AreErrorCodesPresent(ConditionNode):
 
 
 class _WouldARecoveryHelp(AreErrorCodesPresent):
-    """SUCCESS when ``error_code`` is one of the fixed codes ``CODES``, FAILURE otherwise."""
+    """SUCCESS when ``error_code`` is one of the fixed codes ``CODES``, FAILURE otherwise.
+    ``error_codes_to_check`` is accepted (current Nav2 declares it) but, as in Nav2, the fixed
+    codes are the ones checked."""
 
     CODES: ClassVar[frozenset[Any]] = frozenset()
-    INPUT_PORTS: dict[str, PortInformation] = {
-        "error_code": PortInformation(int, False, "The active error code to compare against", 0),
-    }
 
     def codes(self) -> frozenset[int]:
         return frozenset(int(c) for c in self.CODES)

@@ -36,12 +36,27 @@ PORT_TYPES: dict[str, str] = {
     "error_code": ERROR_CODE,
     "error_codes_to_check": "std::vector<int>",
     "server_timeout": MILLISECONDS,
+    "input_path1": PATH,
+    "input_path2": PATH,
+    "route_path": PATH,
+    "ref_pose": POSE,
+    "target_pose": POSE,
+    "current_pose": POSE,
+    "goal_pose": POSE,
+    "collision_poses": POSES,
+    "route": "nav2_msgs::msg::Route",
+    "tracking_feedback": "nav2_msgs::msg::TrackingFeedback",
+    "input_waypoint_statuses": "std::vector<nav2_msgs::msg::WaypointStatus>",
+    "output_waypoint_statuses": "std::vector<nav2_msgs::msg::WaypointStatus>",
+    "planning_time": "builtin_interfaces::msg::Duration",
 }
 """Nav2's type of a port, by the port's name (the same name has the same type in every node
 of Nav2's library)."""
 
 NODE_PORT_TYPES: dict[str, dict[str, str]] = {
     "IsPathValid": {"max_cost": "unsigned int"},
+    "ValidatePath": {"max_cost": "unsigned int"},
+    "ComputeRoute": {"start_id": "unsigned int", "goal_id": "unsigned int"},
 }
 """Types that only one node gives a port."""
 

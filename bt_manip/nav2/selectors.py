@@ -1,6 +1,7 @@
-"""Nav2's selector nodes: which planner, controller, goal checker or smoother the next
-actions use. Nav2 takes a selection published on ``topic_name``; bt-manip has no topics, so
-the selection is the default given in the tree (a later tick keeps it)."""
+"""Nav2's selector nodes: which planner, controller, goal checker, progress checker, path
+handler or smoother the next actions use. Nav2 takes a selection published on ``topic_name``;
+bt-manip has no topics, so the selection is the default given in the tree (a later tick keeps
+it)."""
 
 from __future__ import annotations
 
@@ -74,3 +75,25 @@ class SmootherSelector(_Selector):
     WHAT = "smoother"
     INPUT_PORTS: dict[str, PortInformation] = _ports("smoother", "smoother_selector")
     OUTPUT_PORTS: dict[str, PortInformation] = _out("smoother")
+
+
+@registry.register
+class ProgressCheckerSelector(_Selector):
+    """Selects the progress checker for FollowPath (``selected_progress_checker``)."""
+
+    WHAT = "progress_checker"
+    INPUT_PORTS: dict[str, PortInformation] = _ports(
+        "progress_checker", "progress_checker_selector"
+    )
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("progress_checker")
+
+
+@registry.register
+class PathHandlerSelector(_Selector):
+    """Selects the path handler for FollowPath (``selected_path_handler``)."""
+
+    WHAT = "path_handler"
+    INPUT_PORTS: dict[str, PortInformation] = _ports(
+        "path_handler", "path_handler_selector"
+    )
+    OUTPUT_PORTS: dict[str, PortInformation] = _out("path_handler")

@@ -24,6 +24,12 @@ from bt_manip.bt.registry import registry
 from bt_manip.nav2.actions import PLAN_PORTS, PlanAction, ahead_of, error_ports, plan_error
 from bt_manip.nav2.blocking import maybe_block
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
+from bt_manip.nav2.waypoints import (
+    WaypointStatus,
+    mark_completed,
+    pending_statuses,
+    statuses_of,
+)
 
 
 class ThroughPosesError(enum.IntEnum):
@@ -118,12 +124,18 @@ class ComputePathThroughPoses(PlanAction):
 @registry.register
 class RemovePassedGoals(WorldAccess, SyncActionNode):
     """Drops the goals at the front of ``input_goals`` that the robot is within ``radius`` of
-    (always keeping the last) and writes the rest to ``output_goals``. SUCCESS (FAILURE without
-    a world or with goals it cannot read)."""
+    (always keeping the last) and writes the rest to ``output_goals``; each goal dropped is
+    marked COMPLETED in ``output_waypoint_statuses`` (:mod:`bt_manip.nav2.waypoints`). When
+    ``input_waypoint_statuses`` holds no statuses yet, they start as PENDING for the goals of
+    this first tick (Nav2's navigator writes them when the navigation starts). SUCCESS
+    (FAILURE without a world or with goals it cannot read)."""
 
     INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "input_goals": PortInformation(object, True, "Original goals to remove viapoints from"),
+        "input_waypoint_statuses": PortInformation(
+            list, False, "Original waypoint_statuses to mark waypoint status from"
+        ),
         "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
                        POSITIVE),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
@@ -131,17 +143,31 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_goals": PortInformation(object, False, "Goals with passed viapoints removed"),
+        "output_waypoint_statuses": PortInformation(
+            list, False, "Waypoint_statuses with passed waypoints marked"
+        ),
     }
+
+    def __init__(self, name: str | None = None, **attributes: Any) -> None:
+        super().__init__(name, **attributes)
+        self.started: list[WaypointStatus] | None = None
 
     def update(self) -> Status:
         try:
             goals = goals_list(self.world, self.get_input("input_goals"))
             x, y, _ = self.robot().base_pose2d()
+            statuses = statuses_of(self.get_input("input_waypoint_statuses", None))
         except (ActionFailed, PortError) as exc:
             self.feedback_message = str(exc)
             return Status.FAILURE
+        if statuses is None:
+            if self.started is None:
+                self.started = pending_statuses(goals)
+            statuses = self.started
         radius = float(self.get_input("radius"))
         while len(goals) > 1 and math.hypot(goals[0][0] - x, goals[0][1] - y) <= radius:
-            goals.pop(0)
+            statuses = mark_completed(statuses, goals.pop(0))
+        self.started = statuses
         self.set_output("output_goals", goals)
+        self.set_output("output_waypoint_statuses", statuses)
         return Status.SUCCESS

@@ -70,6 +70,7 @@ TOP_KEYS = {
     "robots",
     "poses",
     "groups",
+    "route_graph",
 }
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "solver_tolerance", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
@@ -520,6 +521,11 @@ def _parse_world(path: Path, raw: bytes) -> WorldSpec:
                 spec.poses[name] = p
                 spec.pose_lines[name] = poses.line_of(name)  # type: ignore[union-attr]
     spec.groups = parse_groups(rd, data, spec)
+    if "route_graph" in data:
+        graph = base / rd.text(data, "route_graph", "the world")
+        if not graph.is_file():
+            rd.fail(data.line_of("route_graph"), f"route_graph: no file {graph}")
+        spec.route_graph = graph
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)

@@ -193,6 +193,8 @@ class WorldSpec:
     pose_lines: dict[str, int] = field(default_factory=dict)
     groups: list[GroupSpec] = field(default_factory=list)
     """Entities moved together by one rigid motion (``groups:``)."""
+    route_graph: Path | None = None
+    """A route graph in Nav2's GeoJSON format for ComputeRoute (None: one is generated)."""
 
 
 WORLD_SCHEMA_VERSION = 1

@@ -156,9 +156,15 @@ def test_main_tree_selection_errors() -> None:
         load_tree_string(two, tree_id="C")
 
 
-def test_version_3_rejected_and_missing_format_warns() -> None:
-    with pytest.raises(InputError, match='BTCPP_format="3" is not supported'):
-        load_tree_string('<root BTCPP_format="3"><BehaviorTree ID="A"><AlwaysSuccess/>'
+def test_version_3_converted_other_versions_rejected_and_missing_format_warns() -> None:
+    # BehaviorTree.CPP v3 files are read through the v3 -> v4 conversion (bt/v3_convert.py)
+    v3 = load_tree_string('<root BTCPP_format="3"><BehaviorTree ID="A"><SequenceStar>'
+                          "<AlwaysSuccess/></SequenceStar></BehaviorTree></root>")
+    assert v3.tick().name == "SUCCESS"
+    assert any("SequenceStar -> SequenceWithMemory" in str(w)
+               for w in v3.warnings)  # type: ignore[attr-defined]
+    with pytest.raises(InputError, match='BTCPP_format="2" is not supported'):
+        load_tree_string('<root BTCPP_format="2"><BehaviorTree ID="A"><AlwaysSuccess/>'
                          "</BehaviorTree></root>")
     tree = load_tree_string('<root><BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree></root>')
     assert "no BTCPP_format" in str(tree.warnings[0])  # type: ignore[attr-defined]
