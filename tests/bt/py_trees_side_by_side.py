@@ -196,7 +196,7 @@ def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
             tree.root.setup_with_descendants()
         blackboard = tree.blackboard
         return _ticks(tree.tick, tree.root, log,
-                      lambda: {k: plain(blackboard.get(k)) for k in blackboard.keys()},
+                      lambda: {k: plain(blackboard.get(k)) for k in blackboard.keys()},  # noqa: SIM118
                       ticks, clock, seed)
 
 
@@ -214,18 +214,19 @@ def differences(expected: Run, got: Run, strict_calls: bool, bt_view: bool = Fal
         yield f"raised {expected.error or 'nothing'} / {got.error or 'nothing'}"
     views = (expected.bt_statuses, got.bt_statuses) if bt_view else \
         (expected.statuses, got.statuses)
-    for tick, (a, b) in enumerate(zip(*views), start=1):
+    for tick, (a, b) in enumerate(zip(*views, strict=False), start=1):
         if a != b:
-            diff = [(x, y) for x, y in zip(a, b) if x != y] or [(a, b)]
+            diff = [(x, y) for x, y in zip(a, b, strict=False) if x != y] or [(a, b)]
             yield f"tick {tick}: statuses {diff[:3]}"
             return
-    for tick, (a, b) in enumerate(zip(expected.calls, got.calls), start=1):
+    for tick, (a, b) in enumerate(zip(expected.calls, got.calls, strict=False), start=1):
         if not strict_calls:
             a, b = comparable(a), comparable(b)
         if a != b:
             yield f"tick {tick}: calls {a} / {b}"
             return
-    for tick, (a, b) in enumerate(zip(expected.blackboards, got.blackboards), start=1):
+    pairs = zip(expected.blackboards, got.blackboards, strict=False)
+    for tick, (a, b) in enumerate(pairs, start=1):
         if a != b:
             yield f"tick {tick}: blackboard {a} / {b}"
             return

@@ -21,8 +21,6 @@ the next tick as a :class:`~bt_manip.bt.tree.Tree` does.
 
 from __future__ import annotations
 
-from typing import cast
-
 from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
@@ -40,13 +38,13 @@ def invalidate(node: Behaviour) -> None:
         below.status = INVALID
 
 
-class _HaltedView:
-    """Halting the node makes its whole subtree INVALID in py_trees' view."""
+class _HaltedView(BtNode):
+    """Halting the node makes its whole subtree INVALID in py_trees' view (mixed in before
+    a built-in control or decorator)."""
 
     def halt(self) -> None:
-        node = cast(BtNode, self)
-        super().halt()  # type: ignore[misc]  # a BtNode method (mixed before BtNode classes)
-        for child in node.children:
+        super().halt()
+        for child in self.children:
             invalidate(child)
 
 
@@ -58,7 +56,7 @@ class _CompositeView(_HaltedView):
     _chosen = 0  # py_trees' ``current_child`` of a selector, as an index
 
     def tick_node(self) -> NodeStatus:
-        node = cast(BtNode, self)
+        node = self
         children = node.children
         if node.bt_status is not NodeStatus.RUNNING:  # py_trees (re)starts the composite
             if not self.SELECTOR:
@@ -70,7 +68,7 @@ class _CompositeView(_HaltedView):
                 invalidate(child)
         visited = node.context.visited
         mark = len(visited) if visited is not None else 0
-        result = cast(NodeStatus, super().tick_node())  # type: ignore[misc]  # the built-in's
+        result = super().tick_node()  # the built-in's
         ticked = [n for n in (visited or [])[mark:] if n.parent is node]
         if ticked:
             index = children.index(ticked[-1])
@@ -78,7 +76,7 @@ class _CompositeView(_HaltedView):
         return result
 
     def _after_child(self, index: int, status: Status) -> None:
-        children = cast(BtNode, self).children
+        children = self.children
         if self.SELECTOR:
             if status in (Status.RUNNING, Status.SUCCESS):
                 if index != self._chosen:
