@@ -52,6 +52,18 @@ _CHECKS_PER_CLASS = 256
 """The most attribute checks kept per node class (the oldest goes first)."""
 
 
+class UnwritableText(str):
+    """The text of an attribute that XML cannot hold (a Python object, a callable): ``to_xml``
+    refuses to write it, naming the node and the attribute, and gives ``reason``."""
+
+    reason: str
+
+    def __new__(cls, value: Any, reason: str) -> UnwritableText:
+        text = super().__new__(cls, f"<{type(value).__name__}>")
+        text.reason = reason
+        return text
+
+
 @dataclass
 class AttributeCheck:
     """Result of checking a node's attributes against its class."""

@@ -3,8 +3,14 @@
 A py_trees behaviour registered as a bt-manip leaf takes its XML attributes as keyword
 arguments of its constructor, converted by the constructor's annotations: numbers,
 ``true``/``false``, statuses by name (``SUCCESS``), enums by member name, ``null`` for an
-optional value, JSON for lists and dicts (``queue='["SUCCESS", "RUNNING"]'``). Each argument is
+optional value, JSON for lists and dicts (``queue='["SUCCESS", "RUNNING"]'``), py_trees'
+``ComparisonExpression`` as a JSON object (``{"variable": "a", "value": 3, "operator": "ge"}``)
+and a function of the ``operator`` module by its name (``operator="xor"``). Each argument is
 declared as an input port (:func:`port_info`) in the TreeNodesModel.
+
+A value none of these can hold (an object of another class, a lambda) is kept as
+:class:`UnwritableText`: ``to_xml`` refuses to write it rather than write a file that loads
+with another meaning.
 """
 
 from __future__ import annotations
@@ -12,14 +18,18 @@ from __future__ import annotations
 import enum
 import inspect
 import json
+import operator
 import typing
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, get_args, get_origin
+from typing import Any, cast, get_args, get_origin
 
+import py_trees
 from py_trees.behaviour import Behaviour
-from py_trees.common import Status
+from py_trees.common import ComparisonExpression, Status
 from py_trees.ports import PortInformation
 
+from bt_manip.bt.attributes import UnwritableText
 from bt_manip.bt.ports import convert_literal
 
 _NONE_TEXT = ("", "null", "none")
@@ -97,6 +107,13 @@ def _convert_one(text: str, annotation: Any) -> Any:
         except json.JSONDecodeError as e:
             raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
         return _from_json(value, annotation)
+    if annotation is ComparisonExpression:
+        try:
+            return _comparison(json.loads(text))
+        except json.JSONDecodeError as e:
+            raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
+    if origin is Callable or annotation is Callable:
+        return _operator(text)
     if annotation in (int, float, bool, str):
         return convert_literal(text, annotation)
     if annotation is Any or annotation is object or annotation is inspect.Parameter.empty:
@@ -106,6 +123,22 @@ def _convert_one(text: str, annotation: Any) -> Any:
             return text
     name = getattr(annotation, "__name__", str(annotation))
     raise ValueError(f"a {name} cannot be written in XML; build this node in Python")
+
+
+def _operator(name: Any) -> Callable[..., Any]:
+    function = getattr(operator, str(name).strip(), None)
+    if not callable(function) or str(name).startswith("_"):
+        raise ValueError(f"expected the name of a function of the operator module (eq, ge, "
+                         f"xor...), got '{name}'")
+    return cast(Callable[..., Any], function)
+
+
+def _comparison(value: Any) -> ComparisonExpression:
+    if not isinstance(value, dict) or set(value) != {"variable", "value", "operator"}:
+        raise ValueError('expected a JSON object {"variable": ..., "value": ..., "operator": '
+                         f'...}}, got {json.dumps(value)}')
+    return ComparisonExpression(str(value["variable"]), value["value"],
+                                _operator(value["operator"]))
 
 
 def _status(text: Any) -> Status:
@@ -147,6 +180,8 @@ def _json_item(value: Any, annotation: Any) -> Any:
     if value is None and optional:
         return None
     option = options[0] if options else Any
+    if option is ComparisonExpression:
+        return _comparison(value)
     if option is Status or (isinstance(option, type) and issubclass(option, enum.Enum)):
         return _status(value) if option is Status else _enum(str(value), option)
     if option is float and isinstance(value, int) and not isinstance(value, bool):
@@ -157,26 +192,51 @@ def _json_item(value: Any, annotation: Any) -> Any:
 
 
 def format_param(value: Any) -> str:
-    """XML text of a constructor argument (read back by :func:`convert_param`)."""
+    """XML text of a constructor argument (read back by :func:`convert_param`), or an
+    :class:`UnwritableText` saying why XML cannot hold it."""
     if value is None:
         return "null"
     if isinstance(value, bool):
         return "true" if value else "false"
     if isinstance(value, enum.Enum):
         return value.name
-    if isinstance(value, (list, tuple, set, dict)):
-        return json.dumps(_jsonable(value))
-    return str(value)
+    try:
+        if isinstance(value, (list, tuple, set, dict, ComparisonExpression)):
+            return json.dumps(_jsonable(value))
+        if isinstance(value, (int, float, str)):
+            return str(value)
+        if callable(value):
+            return _operator_name(value)
+    except (TypeError, ValueError) as e:
+        return UnwritableText(value, str(e))
+    return UnwritableText(value, f"a {type(value).__name__} cannot be written in XML")
+
+
+def _operator_name(function: Any) -> str:
+    name = getattr(function, "__name__", "")
+    if getattr(operator, name, None) is not function:
+        raise ValueError(f"{getattr(function, '__qualname__', repr(function))} is not a "
+                         "function of the operator module")
+    return str(name)
 
 
 def _jsonable(value: Any) -> Any:
     if isinstance(value, enum.Enum):
         return value.name
+    if isinstance(value, ComparisonExpression):
+        generator = value.value_generator
+        if "ComparisonExpression.__init__" not in getattr(generator, "__qualname__", ""):
+            raise ValueError("a ComparisonExpression whose value is a callable cannot be "
+                             "written in XML")
+        return {"variable": value.variable, "value": _jsonable(generator()),
+                "operator": _operator_name(value.operator)}
     if isinstance(value, dict):
         return {str(k): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, set)):
         return [_jsonable(v) for v in value]
-    return value
+    if isinstance(value, (str, int, float, bool, type(None))):
+        return value
+    raise ValueError(f"a {type(value).__name__} cannot be written in XML")
 
 
 # Where py_trees' own behaviours keep their constructor arguments (for saving a wrapped
@@ -191,6 +251,9 @@ def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[st
     if "variable_value" in params and callable(generator) and \
             "SetBlackboardVariable.__init__" in getattr(generator, "__qualname__", ""):
         found["variable_value"] = generator()  # py_trees' wrapper around a plain value
+    results = vars(behaviour).get("blackboard_results")  # CheckBlackboardVariableValues
+    if "namespace" in params and isinstance(results, py_trees.blackboard.Client):
+        found["namespace"] = results.namespace
     for name in params:
         if name in found:
             continue

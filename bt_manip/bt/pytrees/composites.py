@@ -28,7 +28,7 @@ import py_trees
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.bt.attributes import AttributeCheck
+from bt_manip.bt.attributes import AttributeCheck, UnwritableText
 from bt_manip.bt.node import BtNode, ControlNode, DecoratorNode, TreeRuntimeError, _truth
 from bt_manip.bt.pytrees.storage import EntryView, py_trees_storage, raised_as_tree_error
 from bt_manip.bt.registry import registry
@@ -421,7 +421,9 @@ class PyTreesEternalGuard(_ClientDecorator):
             else:
                 self.condition = value
             function = getattr(value, "func", value)
-            self.attribute_texts["condition"] = getattr(function, "__qualname__", str(value))
+            self.attribute_texts["condition"] = UnwritableText(
+                value, f"the Python callable {getattr(function, '__qualname__', value)!s} "
+                "cannot be written in XML (give a script instead)")
         else:
             raise ValueError(f"{self.NODE_ID}: condition must be a script or a Python "
                              "callable, got a blackboard reference or a value")

@@ -43,11 +43,11 @@ from typing import Any, cast
 import py_trees
 from py_trees.behaviour import Behaviour
 
-from bt_manip.bt import controls, decorators
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
 from bt_manip.bt.pytrees import composites as ptc
+from bt_manip.bt.pytrees import view
 from bt_manip.bt.pytrees.leaf import wrap
 from bt_manip.bt.registry import registry
 from bt_manip.bt.subtree import SubTree
@@ -67,9 +67,9 @@ _SIMPLE_DECORATORS: dict[type, type[BtNode]] = {
     D.Count: ptc.PyTreesCount,
 }
 _BUILTIN_DECORATORS: dict[type, type[BtNode]] = {
-    D.Inverter: decorators.Inverter,
-    D.FailureIsSuccess: decorators.ForceSuccess,
-    D.SuccessIsFailure: decorators.ForceFailure,
+    D.Inverter: view.Inverter,
+    D.FailureIsSuccess: view.ForceSuccess,
+    D.SuccessIsFailure: view.ForceFailure,
 }
 
 
@@ -87,7 +87,7 @@ def from_py_trees(
     client in ``self.blackboard`` (bt-manip nodes use that name for their blackboard).
     """
     node = convert_node(root, builtins=builtins)
-    tree = Tree(node, context=context, blackboard=blackboard, tree_id=tree_id)
+    tree = view.PyTreesViewTree(node, context=context, blackboard=blackboard, tree_id=tree_id)
     _register_leaves(node)
     return tree
 
@@ -127,9 +127,9 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
     children = _children(node, builtins)
     if builtins and children:
         if kind is py_trees.composites.Sequence:
-            cls: type[BtNode] = controls.Sequence if memory else controls.ReactiveSequence
+            cls: type[BtNode] = view.Sequence if memory else view.ReactiveSequence
         else:
-            cls = controls.Fallback if memory else controls.ReactiveFallback
+            cls = view.Fallback if memory else view.ReactiveFallback
         return cls(name, children=children)
     pt_cls = ptc.PyTreesSequence if kind is py_trees.composites.Sequence else ptc.PyTreesSelector
     return pt_cls(name, children, memory=memory)

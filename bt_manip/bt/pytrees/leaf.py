@@ -28,6 +28,8 @@ arguments :mod:`bt_manip.bt.pytrees.arguments`.
 
 from __future__ import annotations
 
+import inspect
+import json
 import typing
 from collections.abc import Callable
 from typing import Any, ClassVar, cast
@@ -37,7 +39,7 @@ from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 from py_trees.ports import PortInformation, PortsMixin
 
-from bt_manip.bt.attributes import AttributeCheck
+from bt_manip.bt.attributes import AttributeCheck, UnwritableText
 from bt_manip.bt.node import LeafNode, TreeRuntimeError
 from bt_manip.bt.ports import Literal, Ref
 from bt_manip.bt.pytrees.arguments import (
@@ -58,6 +60,26 @@ from bt_manip.bt.registry import registry
 from bt_manip.bt.status import RESULT_OF_PY_TREES, NodeStatus
 
 _UNKNOWN = object()  # a constructor argument of a wrapped object that its attributes hide
+
+
+def _is_reference(text: str) -> bool:
+    """``{key}`` names a blackboard entry; a JSON object (``{"a": "b"}``) is a value."""
+    if not text.strip().startswith("{"):
+        return False
+    try:
+        return not isinstance(json.loads(text), dict)
+    except json.JSONDecodeError:
+        return True
+
+
+def takes_name(cls: Callable[..., Behaviour]) -> bool:
+    """Whether ``cls``'s constructor takes a ``name`` (or any keyword); a class that names
+    itself is built without one and then given the node's name."""
+    try:
+        parameters = inspect.signature(cls).parameters.values()
+    except (TypeError, ValueError):
+        return True
+    return any(p.name == "name" or p.kind is p.VAR_KEYWORD for p in parameters)
 
 
 # ---------------------------------------------------------------------- the wrapper
@@ -85,13 +107,21 @@ class PyTreesLeaf(LeafNode):
             if isinstance(binding, Literal) and binding.value is _UNKNOWN:
                 del self.bindings[port]
                 self.attribute_texts.pop(port, None)
+                if self.PARAMS[port].required:  # XML without it would not load
+                    self.attribute_texts[port] = UnwritableText(
+                        None, "the behaviour does not keep this constructor argument in an "
+                        "attribute of the same name, so its value is unknown")
         if behaviour is None:
             kwargs = {p: b.value for p, b in self.bindings.items()
                       if p in self.PARAMS and isinstance(b, Literal)}
+            named = takes_name(self.BEHAVIOUR)
             try:
-                behaviour = self.BEHAVIOUR(name=self.name, **kwargs)
+                behaviour = self.BEHAVIOUR(name=self.name, **kwargs) if named \
+                    else self.BEHAVIOUR(**kwargs)
             except Exception as e:  # the constructor refused its arguments
                 raise ValueError(f"{self.NODE_ID}: {type(e).__name__}: {e}") from None
+            if not named:
+                behaviour.name = self.name
         self.behaviour = behaviour
         self.blackboards = behaviour.blackboards
         self._local: dict[str, Any] = {}
@@ -108,8 +138,7 @@ class PyTreesLeaf(LeafNode):
             if param is None:
                 converted[key] = value
                 continue
-            if isinstance(value, Ref) or (isinstance(value, str) and value.strip().startswith("{")
-                                          and value.strip().endswith("}")):
+            if isinstance(value, Ref) or (isinstance(value, str) and _is_reference(value)):
                 errors.append((f"parameter '{key}' of {cls.NODE_ID} is a constructor argument "
                                "and cannot be a blackboard reference; give its value", None))
                 converted[key] = Literal(None)
