@@ -213,7 +213,7 @@ class MoveJointsSequentially(JointMove):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
+        "targets": PortInformation(list[float], True, "joint targets, one per arm joint (deg or rad, see units)"),
         "order": Port(
             list[int], False, "joint indices in the order to move them (empty: 0, 1, ...)", [],
             NON_NEGATIVE,
@@ -248,9 +248,10 @@ class MoveJoints(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("targets", "state"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], False, "joint targets (or use state)", []),
+        "targets": PortInformation(list[float], False, "joint targets (deg or rad, see units), or use state", []),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
     }
 
@@ -290,9 +291,10 @@ class Lift(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("deltas", "height"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "deltas": PortInformation(list[float], False, "change of each arm joint", []),
+        "deltas": PortInformation(list[float], False, "change of each arm joint (deg or rad, see units)", []),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
         "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
         "via_tolerance": VIA,
@@ -353,16 +355,17 @@ class MoveToPose(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("position", "object"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
+        "position": Port(list[float], False, "target x;y;z (m, world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),
         "grasp": Port(
             str, False, "target this grasp of object instead of its centre: top (see grasps)", "",
             Accepts(choices=("", "top")),
         ),
         "offset": Port(
-            list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0], count_of(3)
+            list[float], False, "added to the target x;y;z (m, world)", [0.0, 0.0, 0.0], count_of(3)
         ),
         "orientation": Port(
             list[float], False, "quaternion x;y;z;w (world)", [0.0, 1.0, 0.0, 0.0], count_of(4)

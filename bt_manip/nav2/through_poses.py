@@ -124,7 +124,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
     INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
         "input_goals": PortInformation(object, True, "Original goals to remove viapoints from"),
-        "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
+        "radius": Port(float, False, "Radius to goal for it to be considered for removal (m)", 0.5,
                        POSITIVE),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),

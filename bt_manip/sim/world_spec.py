@@ -194,6 +194,17 @@ class WorldSpec:
     groups: list[GroupSpec] = field(default_factory=list)
     """Entities moved together by one rigid motion (``groups:``)."""
 
+    def names_by_kind(self) -> dict[str, set[str]]:
+        """What a tree may name in this world, by kind: ``object`` (movable objects and
+        models), ``body`` (those, furniture and walls), ``pose`` (named poses), ``robot``."""
+        movable = {b.name for b in [*self.objects, *self.models]}
+        return {
+            "object": movable,
+            "body": movable | {b.name for b in self.furniture} | {w.name for w in self.walls},
+            "pose": set(self.poses),
+            "robot": {r.name for r in self.robots},
+        }
+
 
 WORLD_SCHEMA_VERSION = 1
 """The world format this bt-manip reads (``schema_version`` of a world file; absent means 1)."""
