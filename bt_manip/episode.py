@@ -80,6 +80,8 @@ class Episode:
                 # entries given by the user (--bb) are typed as a script would type them
                 blackboard=Blackboard.from_dict(dict(spec.blackboard), typed=False),
             )
+            if self.world is None:
+                refuse_world_nodes(self.tree, spec.tree)
             inject_node_failures(self.tree, self.faults)
         except BaseException:
             self.close()
@@ -146,6 +148,18 @@ class Episode:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def refuse_world_nodes(tree: Tree, source: str) -> None:
+    """InputError naming the first node of ``tree`` that acts on a world (``NEEDS_WORLD``),
+    for a run given none: it would fail at its first tick."""
+    for node in tree.nodes():
+        if getattr(type(node), "NEEDS_WORLD", False):
+            named = f" '{node.name}'" if node.name != node.NODE_ID else ""
+            raise InputError.single(
+                node.xml_file or source, node.xml_line,
+                f"{node.NODE_ID}{named} acts on a simulated world, and no world is given; run "
+                "with --world W.yaml (`bt-manip examples` lists the shipped worlds)")
 
 
 def _load_behaviours(imports: Sequence[str] = ()) -> None:
