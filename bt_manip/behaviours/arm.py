@@ -213,7 +213,9 @@ class MoveJointsSequentially(JointMove):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], True, "joint targets, one per arm joint (deg or rad, see units)"),
+        "targets": PortInformation(
+            list[float], True, "joint targets, one per arm joint (deg or rad, see units)"
+        ),
         "order": Port(
             list[int], False, "joint indices in the order to move them (empty: 0, 1, ...)", [],
             NON_NEGATIVE,
@@ -251,7 +253,9 @@ class MoveJoints(JointMove):
     REQUIRED_ONE_OF = (("targets", "state"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], False, "joint targets (deg or rad, see units), or use state", []),
+        "targets": PortInformation(
+            list[float], False, "joint targets (deg or rad, see units), or use state", []
+        ),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
     }
 
@@ -294,7 +298,9 @@ class Lift(JointMove):
     REQUIRED_ONE_OF = (("deltas", "height"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "deltas": PortInformation(list[float], False, "change of each arm joint (deg or rad, see units)", []),
+        "deltas": PortInformation(
+            list[float], False, "change of each arm joint (deg or rad, see units)", []
+        ),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
         "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
         "via_tolerance": VIA,
