@@ -22,10 +22,12 @@ from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix
+from bt_manip.kinematics.reasons import BEYOND_REACH, JOINT_LIMITS, NOT_CONVERGED, SOLVER_KNOBS
 from bt_manip.manipulation import cartesian
 from bt_manip.manipulation.base_search import object_grasp
 
 if TYPE_CHECKING:
+    from bt_manip.run.context import RobotServices
     from bt_manip.sim.robot import Robot
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
@@ -424,11 +426,21 @@ class MoveToPose(JointMove):
         self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on
         services = self.services()
         free = bool(self.get_input("free_yaw"))
-        n = len(q_now)
         approach = float(self.get_input("approach"))
         retreat = float(self.get_input("retreat"))
         if approach < 0 or retreat < 0:
             raise ActionFailed("approach and retreat are distances: they cannot be negative")
+        try:
+            return self._stages(robot, tip, target, q_now, services, free, approach, retreat)
+        except cartesian.CartesianError as exc:
+            raise cartesian.CartesianError(_with_knobs(str(exc), free, approach,
+                                                       self.get_input("path"))) from None
+
+    def _stages(self, robot: Robot, tip: str, target: np.ndarray, q_now: np.ndarray,
+                services: RobotServices, free: bool, approach: float, retreat: float
+                ) -> list[Stage]:
+        """The joint waypoints to ``target``: back out, go there, approach."""
+        n = len(q_now)
         here = robot.link_transform(tip)
         stages: list[Stage] = []
         if retreat > 0:
@@ -468,6 +480,26 @@ class MoveToPose(JointMove):
             if turn < best_angle:
                 best, best_angle = cand, turn
         return best
+
+
+def _with_knobs(reason: str, free_yaw: bool, approach: float, path: str) -> str:
+    """An IK failure's ``reason`` with the ports of MoveToPose that may get round it in place
+    of the solver's options (which a tree does not set)."""
+    if not (NOT_CONVERGED in reason or JOINT_LIMITS in reason or BEYOND_REACH in reason):
+        return reason
+    knobs = []
+    if BEYOND_REACH not in reason and not free_yaw:
+        knobs.append('free_yaw="true" (the rotation about the tool axis left to the solver)')
+    knobs.append("another orientation or offset")
+    if path == "line":
+        knobs.append('path="joint" (no straight line from where the tool is)')
+    if approach > 0:
+        knobs.append("a shorter approach")
+    knobs.append("the base moved (Navigate, PlanBaseForGrasp)")
+    text = "try " + ", ".join(knobs)
+    if SOLVER_KNOBS in reason:
+        return reason.replace(SOLVER_KNOBS, text)
+    return f"{reason}; {text}"
 
 
 def _through(path: list[np.ndarray], n: int) -> list[Stage]:
