@@ -85,7 +85,7 @@ def test_run_tree_takes_blackboard_entries_and_faults() -> None:
 def test_run_tree_refuses_an_unknown_option() -> None:
     import bt_manip
 
-    with pytest.raises(TypeError, match="unknown option.*max_tick.*options are"):
+    with pytest.raises(TypeError, match=r"unknown option.*max_tick.*options are"):
         bt_manip.run_tree(ROOT / "trees" / "builtins_demo.xml", max_tick=5)
 
 

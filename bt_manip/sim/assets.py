@@ -41,7 +41,6 @@ def data_root() -> Path:
     return REPO_ROOT
 
 
-@functools.cache
 def shipped_or_given(text: str) -> str:
     """A tree or world path as the file to read: ``text`` itself when that file exists (paths
     are relative to the current folder, as always) or when it does not name a shipped file;
@@ -57,6 +56,7 @@ def shipped_or_given(text: str) -> str:
     return str(shipped) if shipped.is_file() else text
 
 
+@functools.cache
 def example_robot_data_share() -> Path:
     """The ``share`` folder that holds ``example-robot-data/robots/...``."""
     dist = metadata.distribution("example-robot-data")

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-import bt_manip.behaviours  # noqa: F401  (registers the robot nodes)
+import bt_manip.behaviours  # registers the robot nodes
 import bt_manip.nav2  # noqa: F401  (and Nav2's)
 from bt_manip.bt.reference import NO_UNIT, carries_number, node_reference, unit_of
 from bt_manip.bt.registry import registry
