@@ -15,6 +15,7 @@ from pathlib import Path
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_folder, make_folder
 from bt_manip.sim.assets import DATA_FOLDERS, data_root
+from bt_manip.sim.assets import shipped_or_given as shipped_path
 
 __all__ = [
     "DEMO_TREE",
@@ -109,13 +110,7 @@ def shipped_or_given(text: str) -> str:
     ``text`` itself when that file exists (paths are relative to the current folder, as
     always) or when it does not name a shipped file; else, for a relative path into the shipped
     folders (``trees/husky_carry_wall.xml``, ``worlds/tb3_house.yaml``), the shipped file. So
-    the README's commands run from any folder once bt-manip is installed.
+    the README's commands run from any folder once bt-manip is installed. (The lookup is
+    :func:`bt_manip.sim.assets.shipped_or_given`; ``World`` uses it too.)
     """
-    given = Path(text)
-    if given.exists() or given.is_absolute():
-        return text
-    parts = given.parts
-    if len(parts) < 2 or parts[0] not in DATA_FOLDERS or ".." in parts:
-        return text
-    shipped = data_root() / given
-    return str(shipped) if shipped.is_file() else text
+    return shipped_path(text)

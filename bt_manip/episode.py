@@ -10,8 +10,9 @@ injected faults, the as-built table of a world written by ``bt-manip bim``).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass, field
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field, fields
+from pathlib import Path
 from typing import Any
 
 import bt_manip.behaviours  # importing it registers the robot behaviours
@@ -25,10 +26,11 @@ from bt_manip.errors import InputError
 from bt_manip.groot import BtlogWriter, TreeMonitor
 from bt_manip.plugins import import_modules
 from bt_manip.run.context import RunContext
-from bt_manip.run.faults import FaultInjector, FaultSpec, inject_node_failures
+from bt_manip.run.faults import FaultInjector, FaultSpec, inject_node_failures, parse_fault
 from bt_manip.run.hooks import RunHook, TickCallback, close_hooks
 from bt_manip.run.report import RunReport
 from bt_manip.run.runner import Runner, RunOptions
+from bt_manip.sim.assets import shipped_or_given
 from bt_manip.sim.world import World
 
 
@@ -80,6 +82,8 @@ class Episode:
                 # entries given by the user (--bb) are typed as a script would type them
                 blackboard=Blackboard.from_dict(dict(spec.blackboard), typed=False),
             )
+            if self.world is None:
+                refuse_world_nodes(self.tree, spec.tree)
             inject_node_failures(self.tree, self.faults)
         except BaseException:
             self.close()
@@ -148,6 +152,18 @@ class Episode:
         self.close()
 
 
+def refuse_world_nodes(tree: Tree, source: str) -> None:
+    """InputError naming the first node of ``tree`` that acts on a world (``NEEDS_WORLD``),
+    for a run given none: it would fail at its first tick."""
+    for node in tree.nodes():
+        if getattr(type(node), "NEEDS_WORLD", False):
+            named = f" '{node.name}'" if node.name != node.NODE_ID else ""
+            raise InputError.single(
+                node.xml_file or source, node.xml_line,
+                f"{node.NODE_ID}{named} acts on a simulated world, and no world is given; run "
+                "with --world W.yaml (`bt-manip examples` lists the shipped worlds)")
+
+
 def _load_behaviours(imports: Sequence[str] = ()) -> None:
     """Register the user's modules' nodes with the node registry (importing them does it;
     the robot behaviours and Nav2's nodes are registered by this module's imports);
@@ -155,3 +171,74 @@ def _load_behaviours(imports: Sequence[str] = ()) -> None:
     problems = import_modules(imports)
     if problems:
         raise InputError(problems)
+
+
+def load_tree_with_nodes(path: str | Path, **kwargs: Any) -> Tree:
+    """Load a tree file with every shipped node registered: ``bt_manip.load_tree``.
+
+    The robot behaviours (:mod:`bt_manip.behaviours`) and Nav2's nodes (:mod:`bt_manip.nav2`)
+    are registered by this module's imports. ``path`` is found as ``bt-manip run`` finds it: a
+    relative path that names no file here but a shipped tree (``trees/sawyer_stack_two.xml``)
+    is that tree. ``kwargs`` are those of :func:`bt_manip.bt.load_tree` (``tree_id``,
+    ``models``, ``context``, ``blackboard``). A tree whose nodes act on a world ticks against
+    one when given ``context=RunContext.for_world(world)``; :func:`run_tree` does all that.
+    """
+    return load_tree(shipped_or_given(str(path)), **kwargs)
+
+
+def run_tree(
+    tree: str | Path,
+    world: str | Path | None = None,
+    seed: int = 0,
+    *,
+    tree_id: str | None = None,
+    blackboard: Mapping[str, Any] | None = None,
+    inject: Sequence[str | FaultSpec] = (),
+    imports: Sequence[str] = (),
+    models: Sequence[str] = (),
+    hooks: Sequence[RunHook | TickCallback] = (),
+    **options: Any,
+) -> RunReport:
+    """Run a tree file on a world to its end, as ``bt-manip run`` does; the run report.
+
+    Args:
+        tree: the tree file (a shipped one by its relative path, ``trees/...``).
+        world: the world file (``worlds/sawyer_table.yaml``), or None for a tree of built-in
+            nodes only (run on the wall clock).
+        seed: picks the world's random starts and the injected faults.
+        tree_id: the tree to run (default: the file's main tree).
+        blackboard: root blackboard entries set before the first tick (``--bb``).
+        inject: faults, as ``--inject`` takes them (``"Attach:failure:0.3"``).
+        imports: modules of your own that register nodes (``--import``).
+        models: TreeNodesModel files.
+        hooks: called after each tick with the runner (and closed at the end): look at the
+            world (``runner.world``) or the tree while it runs.
+        options: fields of :class:`~bt_manip.run.runner.RunOptions`: ``tick_hz``,
+            ``max_sim_time``, ``max_ticks``, ``realtime``.
+
+    Returns the :class:`~bt_manip.run.report.RunReport`: ``status`` (a
+    :class:`~bt_manip.run.status.RunStatus`), ``reason``, ``cause``, sim and wall time, every
+    node's final status; ``report.exit_code`` is what ``bt-manip run`` would exit with.
+
+    Raises :class:`~bt_manip.errors.InputError` (every problem, as ``file:line: message``) for
+    a bad tree or world, and TypeError for an unknown option.
+    """
+    known = {f.name for f in fields(RunOptions)}
+    unknown = sorted(set(options) - known)
+    if unknown:
+        raise TypeError(f"run_tree() got unknown option(s) {', '.join(unknown)}; options are "
+                        + ", ".join(sorted(known)))
+    faults = [parse_fault(f) if isinstance(f, str) else f for f in inject]
+    spec = EpisodeSpec(
+        tree=shipped_or_given(str(tree)),
+        world=shipped_or_given(str(world)) if world is not None else None,
+        seed=int(seed),
+        tree_id=tree_id,
+        models=list(models),
+        blackboard=dict(blackboard or {}),
+        inject=faults,
+        options=RunOptions(**options),
+        imports=list(imports),
+    )
+    with Episode(spec) as episode:
+        return episode.run(hooks)

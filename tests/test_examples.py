@@ -44,3 +44,15 @@ def test_python_example_equals_the_xml_tree(name: str) -> None:
     assert shape(built.root) == shape(from_file.root)
     # and its XML loads back to the same tree
     assert shape(load_tree_string(to_xml(built)).root) == shape(from_file.root)
+
+
+def test_run_a_tree_stacks_block_1_on_block_0() -> None:
+    """examples/run_a_tree.py runs trees/sawyer_stack_two.xml through bt_manip.run_tree: the
+    tree succeeds and block_1 ends resting on block_0 (centred within 1 cm, one block height
+    above it)."""
+    report, positions = _example("run_a_tree").stack(seed=3)
+    assert report.status.value == "SUCCESS", report.reason
+    (x0, y0, z0), (x1, y1, z1) = positions["block_0"], positions["block_1"]
+    assert abs(x1 - x0) < 0.01 and abs(y1 - y0) < 0.01
+    assert abs((z1 - z0) - 0.05) < 0.005
+    assert abs(z0 - 0.7725) < 0.005  # block_0 still on the table

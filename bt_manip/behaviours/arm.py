@@ -22,10 +22,12 @@ from bt_manip.behaviours.collisions import arm_collisions
 from bt_manip.bt import registry
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix
+from bt_manip.kinematics.reasons import BEYOND_REACH, JOINT_LIMITS, NOT_CONVERGED, SOLVER_KNOBS
 from bt_manip.manipulation import cartesian
 from bt_manip.manipulation.base_search import object_grasp
 
 if TYPE_CHECKING:
+    from bt_manip.run.context import RobotServices
     from bt_manip.sim.robot import Robot
 
 UNITS = Port(str, False, "unit of targets: deg or rad", "deg", Accepts(choices=("deg", "rad")))
@@ -213,7 +215,9 @@ class MoveJointsSequentially(JointMove):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], True, "joint targets, one per arm joint"),
+        "targets": PortInformation(
+            list[float], True, "joint targets, one per arm joint (deg or rad, see units)"
+        ),
         "order": Port(
             list[int], False, "joint indices in the order to move them (empty: 0, 1, ...)", [],
             NON_NEGATIVE,
@@ -248,9 +252,12 @@ class MoveJoints(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("targets", "state"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "targets": PortInformation(list[float], False, "joint targets (or use state)", []),
+        "targets": PortInformation(
+            list[float], False, "joint targets (deg or rad, see units), or use state", []
+        ),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
     }
 
@@ -290,9 +297,12 @@ class Lift(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("deltas", "height"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "deltas": PortInformation(list[float], False, "change of each arm joint", []),
+        "deltas": PortInformation(
+            list[float], False, "change of each arm joint (deg or rad, see units)", []
+        ),
         "order": Port(list[int], False, "joints in the order to move them", [], NON_NEGATIVE),
         "height": PortInformation(float, False, "lift straight up by this much (m)", 0.0),
         "via_tolerance": VIA,
@@ -353,16 +363,17 @@ class MoveToPose(JointMove):
     Halted: the arm holds where it is.
     """
 
+    REQUIRED_ONE_OF = (("position", "object"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
-        "position": Port(list[float], False, "target x;y;z (world)", [], count_of(0, 3)),
+        "position": Port(list[float], False, "target x;y;z (m, world)", [], count_of(0, 3)),
         "object": PortInformation(str, False, "target the centre of this object", ""),
         "grasp": Port(
             str, False, "target this grasp of object instead of its centre: top (see grasps)", "",
             Accepts(choices=("", "top")),
         ),
         "offset": Port(
-            list[float], False, "added to the target x;y;z", [0.0, 0.0, 0.0], count_of(3)
+            list[float], False, "added to the target x;y;z (m, world)", [0.0, 0.0, 0.0], count_of(3)
         ),
         "orientation": Port(
             list[float], False, "quaternion x;y;z;w (world)", [0.0, 1.0, 0.0, 0.0], count_of(4)
@@ -415,11 +426,21 @@ class MoveToPose(JointMove):
         self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on
         services = self.services()
         free = bool(self.get_input("free_yaw"))
-        n = len(q_now)
         approach = float(self.get_input("approach"))
         retreat = float(self.get_input("retreat"))
         if approach < 0 or retreat < 0:
             raise ActionFailed("approach and retreat are distances: they cannot be negative")
+        try:
+            return self._stages(robot, tip, target, q_now, services, free, approach, retreat)
+        except cartesian.CartesianError as exc:
+            raise cartesian.CartesianError(_with_knobs(str(exc), free, approach,
+                                                       self.get_input("path"))) from None
+
+    def _stages(self, robot: Robot, tip: str, target: np.ndarray, q_now: np.ndarray,
+                services: RobotServices, free: bool, approach: float, retreat: float
+                ) -> list[Stage]:
+        """The joint waypoints to ``target``: back out, go there, approach."""
+        n = len(q_now)
         here = robot.link_transform(tip)
         stages: list[Stage] = []
         if retreat > 0:
@@ -459,6 +480,26 @@ class MoveToPose(JointMove):
             if turn < best_angle:
                 best, best_angle = cand, turn
         return best
+
+
+def _with_knobs(reason: str, free_yaw: bool, approach: float, path: str) -> str:
+    """An IK failure's ``reason`` with the ports of MoveToPose that may get round it in place
+    of the solver's options (which a tree does not set)."""
+    if not (NOT_CONVERGED in reason or JOINT_LIMITS in reason or BEYOND_REACH in reason):
+        return reason
+    knobs = []
+    if BEYOND_REACH not in reason and not free_yaw:
+        knobs.append('free_yaw="true" (the rotation about the tool axis left to the solver)')
+    knobs.append("another orientation or offset")
+    if path == "line":
+        knobs.append('path="joint" (no straight line from where the tool is)')
+    if approach > 0:
+        knobs.append("a shorter approach")
+    knobs.append("the base moved (Navigate, PlanBaseForGrasp)")
+    text = "try " + ", ".join(knobs)
+    if SOLVER_KNOBS in reason:
+        return reason.replace(SOLVER_KNOBS, text)
+    return f"{reason}; {text}"
 
 
 def _through(path: list[np.ndarray], n: int) -> list[Stage]:

@@ -69,6 +69,13 @@ class _Node(Protocol):
 class WorldAccess:
     """Mixin: the world and robot a node acts on, resolved from its ports and context."""
 
+    NEEDS_WORLD: ClassVar[bool] = True
+    WORLD_NAMES: ClassVar[dict[str, str]] = {
+        "robot": "robot", "object": "body", "inside": "body", "region": "body", "goal": "pose",
+    }
+    """The ports of these names, where a node has them, name things of the world (see
+    :attr:`bt_manip.bt.node.BtNode.WORLD_NAMES`)."""
+
     feedback_message: str
 
     @property

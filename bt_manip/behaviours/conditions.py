@@ -67,11 +67,12 @@ class ObjectInRegion(WorldCondition):
     as ``x;y;z``.
     """
 
+    REQUIRED_ANY_OF = (("inside", "min+max"),)
     INPUT_PORTS: dict[str, PortInformation] = {
         "object": OBJECT,
         "inside": PortInformation(str, False, "body whose box is the region", ""),
-        "min": Port(list[float], False, "lower corner x;y;z", [], count_of(0, 3)),
-        "max": Port(list[float], False, "upper corner x;y;z", [], count_of(0, 3)),
+        "min": Port(list[float], False, "lower corner x;y;z (m, world)", [], count_of(0, 3)),
+        "max": Port(list[float], False, "upper corner x;y;z (m, world)", [], count_of(0, 3)),
     }
 
     def check(self) -> tuple[bool, str]:

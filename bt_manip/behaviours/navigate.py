@@ -103,7 +103,8 @@ class Navigate(RobotAction):
     CARRIES = True
     INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
-        "goal": Port(str, True, "named world pose, or x;y;yaw", accepts=Accepts(check=_goal_text)),
+        "goal": Port(str, True, "named world pose, or x;y;yaw (m, rad; world)",
+                     accepts=Accepts(check=_goal_text)),
         "xy_tolerance": Port(
             float, False, "distance to the goal that counts (m)", 0.1, POSITIVE
         ),

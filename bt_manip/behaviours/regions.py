@@ -187,7 +187,7 @@ class DropPoint(WorldAccess, SyncActionNode):
                           Accepts(0, MAX_CLEARANCE)),
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
-        "point": PortInformation(list[float], False, "the drop point x;y;z (world)"),
+        "point": PortInformation(list[float], False, "the drop point x;y;z (m, world)"),
     }
 
     def update(self) -> Status:

@@ -49,9 +49,10 @@ class SpawnModel(RobotAction):
         "model": PortInformation(str, True, "a model of the world file, or a new name"),
         "shape": Port(str, False, "box, cylinder or sphere", "box",
                       Accepts(choices=tuple(SHAPE_SIZES))),
-        "size": Port(list[float], False, "box x;y;z, cylinder radius;height, sphere radius", [],
+        "size": Port(list[float], False, "box x;y;z, cylinder radius;height, sphere radius (m)", [],
                      POSITIVE),
-        "pose": Port(list[float], False, "x;y;z;yaw of its centre", [], count_of(0, 4)),
+        "pose": Port(list[float], False, "x;y;z;yaw of its centre (m, rad; world)", [],
+                     count_of(0, 4)),
         "mass": Port(float, False, "kg; 0 for a static model", 0.1, NON_NEGATIVE),
         "colour": Port(
             str, False, "colour name", "orange", Accepts(choices=tuple(sorted(COLOURS)))

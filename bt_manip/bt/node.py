@@ -94,6 +94,24 @@ class BtNode(PortsMixin):
     INPUT_PORTS: dict[str, PortInformation] = {}
     OUTPUT_PORTS: dict[str, PortInformation] = {}
     SCRIPT_PORTS: ClassVar[tuple[str, ...]] = ()  # ports whose literal is a script
+    REQUIRED_ONE_OF: ClassVar[tuple[tuple[str, ...], ...]] = ()
+    """Groups of alternative ports of which a tree must give exactly one, checked when a tree
+    file is loaded: ``(("position", "object"),)``. An alternative written ``"min+max"`` is two
+    ports given together."""
+    REQUIRED_ANY_OF: ClassVar[tuple[tuple[str, ...], ...]] = ()
+    """Groups of alternative ports of which a tree must give at least one (the node uses the
+    first one given)."""
+    WORLD_NAMES: ClassVar[dict[str, str]] = {}
+    """Ports whose literal names something of the world, by port: ``"object"`` (a movable
+    object or model), ``"body"`` (any body: furniture, object, model), ``"model"`` (a model to
+    spawn), ``"pose"`` (a named pose; numbers ``x;y;yaw`` pass) or ``"robot"``. ``bt-manip
+    validate --world W`` checks them against W."""
+    DEFAULT_KEYS: ClassVar[tuple[str, ...]] = ()
+    """Blackboard entries the node reads by their own name when a port is not given (Nav2's
+    ``getInputOrBlackboard``): a SubTree port of that name is used by it."""
+    NEEDS_WORLD: ClassVar[bool] = False
+    """Whether the node acts on a simulated world (a tree holding one cannot run without
+    ``--world``)."""
     started_order: int = 0
     failure_order: int = 0
     """When the node last started (was ticked while IDLE) and last returned FAILURE, as ranks

@@ -35,7 +35,8 @@ class Accepts:
     port must be finite unless ``also`` holds ``math.inf`` (or ``-math.inf``): such a port
     takes that infinity, written ``inf`` or ``infinity`` in any case, with a sign or not, as
     BT.CPP's ``convertFromString<double>`` (``std::stod``) reads them. ``check`` is a further
-    test of the whole value for rules a range cannot say: it returns what is wrong, or None.
+    test of the whole value for rules a range cannot say: it returns what is wrong, or None;
+    ``what`` says in words what ``check`` accepts (for the node reference).
     """
 
     low: float | None = None
@@ -45,6 +46,7 @@ class Accepts:
     choices: tuple[Any, ...] = ()
     also: tuple[Any, ...] = ()
     check: Callable[[Any], str | None] | None = None
+    what: str = ""
 
     def text(self) -> str:
         """What is allowed, as the end of 'must be ...'."""
@@ -107,7 +109,7 @@ def count_of(*counts: int) -> Accepts:
             return f"must hold {allowed} values, got {len(value)}"
         return None
 
-    return Accepts(check=check)
+    return Accepts(check=check, what=f"{allowed} values")
 
 
 def takes_infinity(info: PortInformation) -> bool:

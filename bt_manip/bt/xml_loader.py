@@ -11,7 +11,7 @@ then instantiates the main tree, each ``<SubTree>`` instance getting its own cop
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from functools import cached_property
 from typing import Any, cast
 
@@ -36,6 +36,7 @@ from bt_manip.bt.node import (
     TreeRuntimeError,
     children_rule,
 )
+from bt_manip.bt.port_rules import keys_used, one_of_problem, world_name_problem
 from bt_manip.bt.ports import convert_literal, parse_reference, type_from_name
 from bt_manip.bt.registry import SUBTREE_ID, NodeRegistry, registry
 from bt_manip.bt.status import NodeStatus
@@ -55,14 +56,27 @@ EXPLICIT_TAGS = ("Action", "Condition", "Control", "Decorator")
 NAME_ATTRIBUTES = ("name", "ID")
 
 
+class WorldNames:
+    """What a world has by kind (``object``, ``body``, ``pose``, ``robot``: see
+    :attr:`bt_manip.bt.node.BtNode.WORLD_NAMES`), for checking the names a tree's literals give;
+    ``label`` names the world in messages."""
+
+    def __init__(self, label: str, names: Mapping[str, set[str]]) -> None:
+        self.label = label
+        self.names = names
+
+
 class _Checker:
-    def __init__(self, doc: Document, reg: NodeRegistry, need_implementation: bool) -> None:
+    def __init__(self, doc: Document, reg: NodeRegistry, need_implementation: bool,
+                 world: WorldNames | None = None) -> None:
         self.doc = doc
         self.reg = reg
         self.need_implementation = need_implementation
+        self.world = world
         self.problems: list[Problem] = []
         self.edges: dict[str, list[tuple[str, Element, str]]] = {}
         self.shadow_hits: set[str] = set()  # shadowed IDs given a port only their model has
+        self._keys: dict[str, set[str] | None] = {}
 
     def known_ids(self) -> set[str]:
         return set(self.reg.ids()) | set(self.doc.models) | {SUBTREE_ID}
@@ -156,6 +170,13 @@ class _Checker:
                          attributes: dict[str, str]) -> None:
         if spec.cls is not None:
             check = spec.cls.check_attributes(attributes)
+            if not check.errors:
+                for message in one_of_problem(spec.cls, attributes):
+                    check.errors.append((message, None))
+                if self.world is not None:
+                    for message in world_name_problem(spec.cls, attributes, self.world.names,
+                                                      self.world.label):
+                        check.errors.append((message, None))
         else:
             check = AttributeCheck()
             parse_condition_scripts(attributes, check, spec.node_id)
@@ -214,6 +235,7 @@ class _Checker:
                      "<include>)")
         else:
             self.edges[tree.tree_id].append((target, element, file))
+            self.check_subtree_ports(element, file, target, attributes)
         attributes, missing = subtree_model_defaults(self.doc, target, attributes)
         for port in missing:
             spec = self.doc.models[target or ""]
@@ -230,6 +252,24 @@ class _Checker:
                                     "its content is the <BehaviorTree> it names")
             for child in element.children:
                 self.check_node(child, tree)
+
+    def check_subtree_ports(self, element: Element, file: str, target: str,
+                            attributes: dict[str, str]) -> None:
+        """Warn of each port of a ``<SubTree>`` that its tree never reads or writes."""
+        if target not in self._keys:
+            defaults = {cls.NODE_ID: set(cls.DEFAULT_KEYS) for cls in self.reg.classes()
+                        if cls.DEFAULT_KEYS}
+            self._keys[target] = keys_used(self.doc.trees[target].element, defaults)
+        used = self._keys[target]
+        if used is None:
+            return
+        for port in attributes:
+            if port.startswith("_") or port in used:
+                continue
+            self.doc.warnings.append(Problem(
+                file, element.line,
+                f"warning: SubTree '{target}' port '{port}' is never read or written by tree "
+                f"'{target}'{closest(port, used)}; its value goes nowhere"))
 
     def check_recursion(self) -> None:
         """Report SubTree cycles, and chains of SubTrees nested deeper than the limit.
@@ -413,12 +453,12 @@ def _main_tree(doc: Document, tree_id: str | None) -> tuple[str | None, Problem 
 
 
 def _prepare(path: str, text: str | None, models: Iterable[str] | None, tree_id: str | None,
-             reg: NodeRegistry, need_implementation: bool) -> tuple[Document, str | None,
-                                                                   list[Problem]]:
+             reg: NodeRegistry, need_implementation: bool, world: WorldNames | None = None
+             ) -> tuple[Document, str | None, list[Problem]]:
     doc = read_document(path, text)
     for model_file in models or []:
         read_model_file(model_file, doc)
-    checker = _Checker(doc, reg, need_implementation)
+    checker = _Checker(doc, reg, need_implementation, world)
     checker.check_all()
     problems = doc.problems + checker.problems
     main, problem = _main_tree(doc, tree_id)
@@ -429,11 +469,12 @@ def _prepare(path: str, text: str | None, models: Iterable[str] | None, tree_id:
 
 
 def validate(path: str, models: Iterable[str] | None = None, tree_id: str | None = None,
-             text: str | None = None, reg: NodeRegistry | None = None
-             ) -> tuple[list[Problem], list[Problem]]:
-    """(problems, warnings) of a tree file: everything loading checks, without running."""
+             text: str | None = None, reg: NodeRegistry | None = None,
+             world: WorldNames | None = None) -> tuple[list[Problem], list[Problem]]:
+    """(problems, warnings) of a tree file: everything loading checks, without running; with
+    ``world``, also the names of objects, bodies, poses and robots the world lacks."""
     reg = reg or registry
-    doc, main, problems = _prepare(path, text, models, tree_id, reg, False)
+    doc, main, problems = _prepare(path, text, models, tree_id, reg, False, world)
     if not problems and main is not None:
         allow_depth(_Builder.depth_of(doc, main))
         try:  # building the tree checks the types of the entries that ports share

@@ -13,12 +13,14 @@ from collections.abc import Iterable
 
 from bt_manip.bt.display import render_dot, render_tree
 from bt_manip.bt.models import write_models
+from bt_manip.bt.reference import find_node, node_reference, reference_markdown, reference_text
 from bt_manip.bt.registry import registry
-from bt_manip.bt.xml_loader import load_tree, validate
+from bt_manip.bt.xml_loader import WorldNames, load_tree, validate
 from bt_manip.bundled import shipped_or_given
 from bt_manip.errors import InputError, Problem
 from bt_manip.outputs import check_output_file, write_text
 from bt_manip.plugins import add_import_flag, import_modules
+from bt_manip.sim.world_reader import parse_world
 
 PLUGIN_PACKAGES = ("bt_manip.behaviours", "bt_manip.nav2")
 
@@ -54,6 +56,9 @@ def add_validate_arguments(p: argparse.ArgumentParser) -> None:
                      "file:line: message.")
     p.add_argument("trees", nargs="+", type=shipped_or_given, metavar="TREE.xml")
     p.add_argument("--tree-id", default=None, help="main tree to check (default: the file's)")
+    p.add_argument("--world", type=shipped_or_given, default=None, metavar="W.yaml",
+                   help="also check the objects, bodies, poses and robots the tree names "
+                        "against this world")
     _common(p)
     p.set_defaults(func=validate_command)
 
@@ -69,6 +74,12 @@ def add_show_arguments(p: argparse.ArgumentParser) -> None:
 
 def add_nodes_arguments(p: argparse.ArgumentParser) -> None:
     """The arguments of ``bt-manip nodes``."""
+    p.description = ("List the registered nodes, or print one node's reference: what it does "
+                     "on each status, its ports with type, unit, default and accepted values.")
+    p.add_argument("name", nargs="?", default=None, metavar="NAME",
+                   help="print this node's reference")
+    p.add_argument("--markdown", action="store_true",
+                   help="print the reference of every node as Markdown (docs/nodes.md)")
     p.add_argument("--groot", action="store_true",
                    help="print a TreeNodesModel of every registered non-built-in node (Groot2)")
     p.add_argument("--builtins", action="store_true",
@@ -87,9 +98,16 @@ def validate_command(args: argparse.Namespace) -> int:
     if failures:
         _print_problems(failures)
         return 2
+    world = None
+    if args.world:
+        try:
+            world = WorldNames(args.world, parse_world(args.world).names_by_kind())
+        except InputError as e:
+            _print_problems(e.problems)
+            return 2
     status = 0
     for path in args.trees:
-        problems, warnings = validate(path, args.models, args.tree_id)
+        problems, warnings = validate(path, args.models, args.tree_id, world=world)
         _print_problems(warnings)
         if problems:
             _print_problems(problems)
@@ -134,6 +152,18 @@ def nodes_command(args: argparse.Namespace) -> int:
     if args.groot:
         classes = registry.classes(None if args.builtins else False)
         sys.stdout.write(write_models(classes))
+        return 0
+    if args.name is not None:
+        cls, suggestions = find_node(args.name, registry)
+        if cls is None:
+            _print_problems([Problem("nodes", None, f"unknown node '{args.name}'{suggestions}; "
+                                     "`bt-manip nodes` lists them all")])
+            return 2
+        sys.stdout.write(reference_text(node_reference(cls, registry)))
+        return 0
+    if args.markdown:
+        refs = [node_reference(cls, registry) for cls in registry.classes()]
+        sys.stdout.write(reference_markdown(refs))
         return 0
     for cls in registry.classes():
         tag = "built-in" if registry.is_builtin(cls.NODE_ID) else "custom"

@@ -15,6 +15,13 @@ from bt_manip.kinematics.arm_model import ArmModel
 BEYOND_REACH = "beyond reach"
 JOINT_LIMITS = "joint limits"
 NOT_CONVERGED = "not converged in the budget"
+SOLVER_KNOBS = (
+    "try another seed (IKOptions.seed), a larger budget (IKOptions.max_restarts, time_budget) "
+    "or a partial target (IKOptions.free_axis: the rotation about that tool axis left free; "
+    "position_only)"
+)
+"""The end of a :func:`not_converged` reason: the solver's options that could change the
+outcome (a node that calls the solver replaces it with its own ports)."""
 
 
 def beyond_reach(distance: float, reach: float) -> str:
@@ -73,7 +80,8 @@ def not_converged(
     elapsed: float,
     time_budget: float | None,
 ) -> str:
-    """No attempt reached the tolerance; give the best error and what was spent."""
+    """No attempt reached the tolerance; give the best error, what was spent, and the
+    :class:`~bt_manip.kinematics.ik.IKOptions` that could change the outcome."""
     spent = (
         f"time budget of {time_budget * 1e3:.1f} ms spent"
         if time_budget is not None
@@ -82,6 +90,5 @@ def not_converged(
     return (
         f"{NOT_CONVERGED} ({spent}, {iterations} iterations, {elapsed * 1e3:.1f} ms): best "
         f"error {position_error * 1e3:.2f} mm / {math.degrees(rotation_error):.2f} deg; the "
-        "pose may be at the edge of the workspace or blocked by joint limits: try another "
-        "seed, a larger budget or a partial target"
+        f"pose may be at the edge of the workspace or blocked by joint limits: {SOLVER_KNOBS}"
     )

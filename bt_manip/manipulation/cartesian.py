@@ -115,9 +115,18 @@ def line(
             [r20, r21, r22, az + dz * s],
             [0.0, 0.0, 0.0, 1.0],
         ])
-        q = _solved(solver, to_base @ pose, pose, q)
+        try:
+            q = _solved(solver, to_base @ pose, pose, q)
+        except CartesianError as exc:
+            raise CartesianError(
+                f"on the straight line from ({_xyz(a)}) to ({_xyz(b)}), waypoint {i} of {n} "
+                f"({100.0 * s:.0f} % of the way): {exc}") from None
         out.append(q)
     return out
+
+
+def _xyz(p: np.ndarray) -> str:
+    return ", ".join(f"{v:.3f}" for v in p.tolist())
 
 
 def _angle(ra: np.ndarray, rb: np.ndarray) -> float:

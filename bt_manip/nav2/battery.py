@@ -84,7 +84,8 @@ class IsBatteryLow(WorldCondition):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
-        "min_battery": Port(float, False, "Min battery percentage or voltage before triggering",
+        "min_battery": Port(float, False, "Min battery percentage or voltage before triggering "
+                            "(fraction or V, see is_voltage)",
                             0.0, NON_NEGATIVE),
         "battery_topic": PortInformation(str, False, "Topic for battery info",
                                          "/battery_status"),

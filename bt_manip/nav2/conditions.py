@@ -99,6 +99,8 @@ class GoalsReader:
     """Mixin: the goals now, from the ports ``goal`` and ``goals`` or, when a port is not
     given, from the blackboard entries of the same names (Nav2's ``getInputOrBlackboard``)."""
 
+    DEFAULT_KEYS: ClassVar[tuple[str, ...]] = ("goal", "goals")
+
     bindings: dict[str, Any]
     blackboard: Any
 

@@ -36,7 +36,7 @@ class RateController(DecoratorNode):
     """
 
     INPUT_PORTS: dict[str, PortInformation] = {
-        "hz": Port(float, False, "Rate", 10.0, POSITIVE),
+        "hz": Port(float, False, "Rate (Hz)", 10.0, POSITIVE),
     }
 
     def __init__(self, name: str | None = None, child: BtNode | None = None,
@@ -75,7 +75,7 @@ class DistanceController(WorldAccess, DecoratorNode):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         "robot": ROBOT_PORT,
-        "distance": Port(float, False, "Distance", 1.0, POSITIVE),
+        "distance": Port(float, False, "Distance (m)", 1.0, POSITIVE),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),
     }

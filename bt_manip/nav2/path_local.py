@@ -86,7 +86,7 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
         "max_robot_pose_search_dist": Port(float, False, "Maximum forward integrated distance "
                                            "along the path (starting from the last detected "
                                            "pose) to bound the search for the closest pose to "
-                                           "the robot", math.inf, NON_NEGATIVE_OR_INF),
+                                           "the robot (m)", math.inf, NON_NEGATIVE_OR_INF),
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "output_path": PortInformation(Nav2Path, False, "Truncated Path"),

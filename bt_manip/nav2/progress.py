@@ -94,7 +94,7 @@ class DistanceTraveled(_Every):
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **FRAME_PORTS,
-        "distance": Port(float, False, "The distance that must travel before returning success",
+        "distance": Port(float, False, "The distance that must travel before returning success (m)",
                          1.0, POSITIVE),
     }
 
@@ -112,7 +112,7 @@ class TimeExpired(_Every):
     FAILURE otherwise and on its first tick (which starts the clock)."""
 
     INPUT_PORTS: dict[str, PortInformation] = {
-        "seconds": Port(float, False, "Time to check if expired", 1.0, NON_NEGATIVE),
+        "seconds": Port(float, False, "Time to check if expired (s)", 1.0, NON_NEGATIVE),
     }
 
     def mark(self) -> float:

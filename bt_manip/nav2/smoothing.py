@@ -123,7 +123,7 @@ class SmoothPath(Nav2Action):
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "smoothed_path": PortInformation(Nav2Path, False, "Path smoothed by SmootherServer"),
-        "smoothing_duration": PortInformation(float, False, "Time taken to smooth path"),
+        "smoothing_duration": PortInformation(float, False, "Time taken to smooth path (s)"),
         "was_completed": PortInformation(bool, False,
                                          "True if smoothing was not interrupted by time limit"),
         **error_ports("The smooth path"),

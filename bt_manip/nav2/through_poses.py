@@ -136,7 +136,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
         "input_waypoint_statuses": PortInformation(
             list, False, "Original waypoint_statuses to mark waypoint status from"
         ),
-        "radius": Port(float, False, "Radius to goal for it to be considered for removal", 0.5,
+        "radius": Port(float, False, "Radius to goal for it to be considered for removal (m)", 0.5,
                        POSITIVE),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),

@@ -41,6 +41,21 @@ def data_root() -> Path:
     return REPO_ROOT
 
 
+def shipped_or_given(text: str) -> str:
+    """A tree or world path as the file to read: ``text`` itself when that file exists (paths
+    are relative to the current folder, as always) or when it does not name a shipped file;
+    else, for a relative path into the shipped folders (``trees/husky_carry_wall.xml``,
+    ``worlds/tb3_house.yaml``), the shipped file."""
+    given = Path(text)
+    if given.exists() or given.is_absolute():
+        return text
+    parts = given.parts
+    if len(parts) < 2 or parts[0] not in DATA_FOLDERS or ".." in parts:
+        return text
+    shipped = data_root() / given
+    return str(shipped) if shipped.is_file() else text
+
+
 @functools.cache
 def example_robot_data_share() -> Path:
     """The ``share`` folder that holds ``example-robot-data/robots/...``."""

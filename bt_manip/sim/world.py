@@ -31,6 +31,7 @@ from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError, Problem
 from bt_manip.geometry import euler_from_quat, quat_from_euler, quat_from_yaw, rotation_matrix
 from bt_manip.sim import pybullet_queries as pbq
+from bt_manip.sim.assets import shipped_or_given
 from bt_manip.sim.attach import Attachments
 from bt_manip.sim.events import BodyAdded, BodyRemoved, WorldEvents
 from bt_manip.sim.randomize import Rigid2D, entity_rng, place_groups, sample_offset
@@ -100,6 +101,9 @@ class World:
         self.spec: WorldSpec
         self.group_moves: dict[str, Rigid2D]
         """Each group's rigid motion for this seed (the spec's members are already moved)."""
+        # a relative path that names no file here but a shipped world is that world, as on
+        # the command line
+        path = shipped_or_given(str(path))
         self.spec, self.group_moves = place_groups(parse_world(path), int(seed))
         self.path = Path(path)
         self.seed = int(seed)

@@ -196,6 +196,17 @@ class WorldSpec:
     route_graph: Path | None = None
     """A route graph in Nav2's GeoJSON format for ComputeRoute (None: one is generated)."""
 
+    def names_by_kind(self) -> dict[str, set[str]]:
+        """What a tree may name in this world, by kind: ``object`` (movable objects and
+        models), ``body`` (those, furniture and walls), ``pose`` (named poses), ``robot``."""
+        movable = {b.name for b in [*self.objects, *self.models]}
+        return {
+            "object": movable,
+            "body": movable | {b.name for b in self.furniture} | {w.name for w in self.walls},
+            "pose": set(self.poses),
+            "robot": {r.name for r in self.robots},
+        }
+
 
 WORLD_SCHEMA_VERSION = 1
 """The world format this bt-manip reads (``schema_version`` of a world file; absent means 1)."""

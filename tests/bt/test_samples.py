@@ -7,7 +7,8 @@ from pathlib import Path
 from bt_manip.bt import load_tree, registry, validate, validate_file
 from bt_manip.bt.registry import NodeRegistry
 
-SAMPLES = Path("/work/shared/samples")
+SAMPLES = Path(__file__).resolve().parents[2].parent / "shared" / "samples"
+"""The shared sample files, beside the project's root (``../shared/samples``)."""
 BTCPP = SAMPLES / "btcpp"
 NAV2_TREE = SAMPLES / "nav2" / "navigate_to_pose_w_replanning_and_recovery.xml"
 NAV2_MODEL = SAMPLES / "nav2" / "nav2_tree_nodes.xml"

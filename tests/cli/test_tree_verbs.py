@@ -18,7 +18,8 @@ from bt_manip.cli import build_parser
 from bt_manip.clock import ManualClock
 
 DEMO = Path(__file__).resolve().parents[2] / "trees" / "builtins_demo.xml"
-SAMPLES = Path("/work/shared/samples")
+SAMPLES = Path(__file__).resolve().parents[2].parent / "shared" / "samples"
+"""The shared sample files, beside the project's root (``../shared/samples``)."""
 
 
 Ports = dict[str, PortInformation]
