@@ -144,8 +144,11 @@ def test_live_page_follows_the_run(browser: Any) -> None:
         first = _statuses(page)
         go.set()
         seen = [first]
-        page.wait_for_timeout(1200)
-        seen.append(_statuses(page))  # before the screenshot, which is slow on a busy machine
+        # read the page until it shows the drive running, before the screenshot (slow on a busy
+        # machine: taken first, it could last longer than the drive)
+        while not done.is_set() and seen[-1]["drive"] != "RUNNING":
+            page.wait_for_timeout(100)
+            seen.append(_statuses(page))
         middle = _image(page.screenshot())
         while not done.is_set():
             page.wait_for_timeout(250)
