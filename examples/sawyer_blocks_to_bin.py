@@ -20,7 +20,7 @@ from bt_manip.bt import SubTree, Tree, TreeContext, to_xml
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import ForceSuccess, RetryUntilSuccessful
 from bt_manip.bt.leaves import Script, ScriptCondition
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -104,7 +104,7 @@ def main() -> int:
     if args.xml:
         print(to_xml(build()))
         return 0
-    from bt_manip.runner import Runner
+    from bt_manip.run.runner import Runner
     from bt_manip.sim.world import World
 
     with World(args.world, seed=args.seed) as world:

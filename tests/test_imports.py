@@ -201,3 +201,23 @@ def test_few_misc_type_ignores() -> None:
     total = sum(counts.values())
     worst = sorted(((n, m) for m, n in counts.items() if n), reverse=True)[:10]
     assert total <= MAX_MISC_IGNORES, f"{total} 'type: ignore[misc]'; most in {worst}"
+
+
+def test_public_names_stay_reachable_from_their_former_modules() -> None:
+    """What the README, docs and user code import from before the layout still works."""
+    import bt_manip.bt as bt
+    import bt_manip.cli
+    import bt_manip.clock
+    import bt_manip.run.context
+    import bt_manip.run.runner
+    import bt_manip.run_context
+    import bt_manip.runner
+    from bt_manip.bt.registry import registry
+
+    assert bt_manip.runner.Runner is bt_manip.run.runner.Runner
+    assert bt_manip.runner.RunOptions is bt_manip.run.runner.RunOptions
+    assert bt_manip.run_context.RunContext is bt_manip.run.context.RunContext
+    assert callable(bt_manip.cli.main)
+    assert callable(bt_manip.clock.ManualClock)
+    assert callable(bt.from_py_trees) and callable(bt.load_tree)
+    assert callable(registry.register)

@@ -23,7 +23,7 @@ from bt_manip.nav2.route import ROUTE_RECOVERABLE, RouteError, route_goals
 from bt_manip.nav2.route_graph import GraphError, Route, RouteGraph, RouteNode, read_geojson
 from bt_manip.nav2.tracking import TrackingFeedback, tracking_feedback
 from bt_manip.nav2.waypoints import WaypointState
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 from bt_manip.sim.world import World
 
 HERE = Path(__file__).resolve().parent

@@ -16,7 +16,7 @@ import pytest
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import load_tree
 from bt_manip.bt.status import NodeStatus
-from bt_manip.run_context import RunContext
+from bt_manip.run.context import RunContext
 from bt_manip.sim.world import World
 
 ROOT = Path(__file__).resolve().parents[2]
