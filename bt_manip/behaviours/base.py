@@ -17,6 +17,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
+from bt_manip.kinematics.reasons import SOLVER_KNOBS
 from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.manipulation.grasps import grasped_object
 from bt_manip.manipulation.perception import PerceptionError, movable_body, perceived_pose
@@ -43,6 +44,20 @@ class ActionFailed(Exception):
 FAILS = (ActionFailed, PortError, ManipulationError)
 """What ends a behaviour with FAILURE, its message the reason: the node's own failures, a port
 value it cannot take, and what the manipulation helpers it calls cannot do."""
+
+TREE_IK_KNOBS = (
+    "try another target (an offset, a height or an orientation the node's ports set), or the "
+    "base moved closer (Navigate, PlanBaseForGrasp)"
+)
+"""What a tree can change when the IK solver gives up inside a node that does not name its own
+ports instead (the solver's own advice names options a tree cannot set)."""
+
+
+def failure_reason(exc: BaseException) -> str:
+    """The reason a node reports for ``exc``: its message, with the IK solver's advice (options
+    of the Python API) replaced by what a tree can change."""
+    text = str(exc)
+    return text.replace(SOLVER_KNOBS, TREE_IK_KNOBS) if SOLVER_KNOBS in text else text
 
 
 def skid_steer_refusal(robot: Robot, node_id: str) -> str | None:
@@ -184,7 +199,7 @@ class RobotAction(WorldAccess, ActionNode):
             if self.CARRIES:
                 self._draw_slip()
         except FAILS as exc:
-            self._start_error = str(exc)
+            self._start_error = failure_reason(exc)
         if self._start_error is None:
             self._list_running()
 
@@ -235,7 +250,7 @@ class RobotAction(WorldAccess, ActionNode):
                 slip_out(self.world, self.robot(), slip)
             return self.step()
         except FAILS as exc:
-            self.feedback_message = str(exc)
+            self.feedback_message = failure_reason(exc)
             self._make_safe()
             return Status.FAILURE
 
@@ -275,7 +290,7 @@ class WorldCondition(WorldAccess, ConditionNode):
         try:
             ok, reason = self.check()
         except FAILS as exc:
-            ok, reason = False, str(exc)
+            ok, reason = False, failure_reason(exc)
         self.feedback_message = "" if ok else reason
         return Status.SUCCESS if ok else Status.FAILURE
 

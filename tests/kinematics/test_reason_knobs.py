@@ -65,3 +65,16 @@ def test_a_straight_line_names_its_failing_waypoint(tmp_path: Path) -> None:
     x = float(match[4])
     assert abs(x - (0.9 - 0.4 * i / n)) < 1e-3  # the point named is that waypoint
     assert 'try free_yaw="true"' in report.reason and "IKOptions" not in report.reason
+
+
+def test_other_arm_nodes_name_what_a_tree_can_change() -> None:
+    """Lift, MoveToolBy, Place...: the solver's advice (Python options) becomes a tree's."""
+    from bt_manip.behaviours.base import TREE_IK_KNOBS, ActionFailed, failure_reason
+    from bt_manip.manipulation.cartesian import CartesianError
+
+    reason = not_converged(0.02, 0.03, 200, 8000, 0.02, None)
+    for exc in (ActionFailed(reason), CartesianError(f"lift: {reason}")):
+        text = failure_reason(exc)
+        assert "IKOptions" not in text and text.endswith(TREE_IK_KNOBS)
+        assert text.startswith(str(exc)[: str(exc).index(SOLVER_KNOBS)])
+    assert failure_reason(ActionFailed("gripper is empty")) == "gripper is empty"
