@@ -52,7 +52,7 @@ class ValidatePath(WorldAccess, SyncActionNode):
             bool, False, "Whether to stop validation at the first collision", True
         ),
         "max_lookahead_distance": Port(float, False, "Maximum distance ahead of the robot "
-                                       "along the path to validate (-1: the full path)", -1.0),
+                                       "along the path to validate (m; -1: the full path)", -1.0),
         "service_name": PortInformation(str, False, "Costmap service name", "is_path_valid"),
         "server_timeout": PortInformation(float, False, "Service server timeout (ms)", 20.0),
     }
@@ -120,7 +120,7 @@ class IsGoalNearby(WorldCondition):
                                     "as nearby", 1.0),
         "max_robot_pose_search_dist": Port(float, False, "Maximum forward integrated distance "
                                            "along the path to bound the search for the "
-                                           "closest pose to the robot (negative: the whole "
+                                           "closest pose to the robot (m; negative: the whole "
                                            "path)", -1.0),
         "global_frame": PortInformation(str, False, "The global reference frame", "map"),
         "robot_base_frame": PortInformation(str, False, "Robot base frame", "base_link"),

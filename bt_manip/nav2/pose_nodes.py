@@ -101,7 +101,7 @@ class ArePosesNear(WorldCondition):
         "ref_pose": PortInformation(object, True, "The initial pose to check"),
         "target_pose": PortInformation(object, True, "The other pose to check against"),
         "global_frame": PortInformation(str, False, "Global frame", "map"),
-        "tolerance": Port(float, False, "Tolerance to check poses if nearby with respect to",
+        "tolerance": Port(float, False, "Tolerance to check poses if nearby with respect to (m)",
                           0.5),
     }
 
