@@ -186,7 +186,9 @@ class ComputePathToPose(PlanAction):
     UNKNOWN = PlannerError.UNKNOWN
     INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
-        "goal": PortInformation(object, True, "Destination to plan to (x;y;yaw or a pose name)"),
+        "goal": PortInformation(
+            object, True, "Destination to plan to (x;y;yaw in m, rad, or a pose name)"
+        ),
         **PLAN_PORTS,
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
