@@ -31,6 +31,7 @@ from py_trees.common import Status
 from bt_manip.bt import from_py_trees
 from bt_manip.bt.context import TreeContext
 from bt_manip.clock import ManualClock
+from tests.bt.py_trees_side_by_side import spy
 
 TREES = 1000
 TICKS = 12
@@ -145,28 +146,8 @@ class Builder:
         return node
 
     def spy(self, node: py_trees.behaviour.Behaviour) -> None:
-        log = self.log
-        name = node.name
-        initialise, update, terminate = node.initialise, node.update, node.terminate
-
-        def logged_initialise() -> None:
-            log.append(("initialise", name, ""))
-            initialise()
-
-        def logged_update() -> Status:
-            result = update()
-            log.append(("update", name, result.name))
-            return result
-
-        def logged_terminate(new_status: Status) -> None:
-            was = "" if node.status == Status.RUNNING else " (was not RUNNING)"
-            log.append(("terminate", name, new_status.name + was))
-            terminate(new_status)
-
         if not isinstance(node, py_trees.timers.Timer):  # Timer becomes PyTreesTimer
-            node.initialise = logged_initialise  # type: ignore[method-assign]
-            node.update = logged_update  # type: ignore[method-assign]
-            node.terminate = logged_terminate  # type: ignore[method-assign]
+            spy(node, self.log)
 
 
 class OwnRepeat(py_trees.decorators.Repeat):
