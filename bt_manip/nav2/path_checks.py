@@ -24,6 +24,19 @@ def _steps(poses: np.ndarray) -> np.ndarray:
     return np.hypot(d[:, 0], d[:, 1])
 
 
+def in_collision(nav: Any, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Which ``points`` (n, 2) of the base's turning point put the robot's footprint on an
+    obstacle of the navigator's costmap as it is now, or off the map; and which are on it."""
+    grid = nav.costmap.grid
+    rows = np.floor((points[:, 1] - grid.origin[1]) / grid.resolution).astype(int)
+    cols = np.floor((points[:, 0] - grid.origin[0]) / grid.resolution).astype(int)
+    r, c = grid.shape
+    inside = (rows >= 0) & (rows < r) & (cols >= 0) & (cols < c)
+    bad = ~inside
+    bad[inside] = np.isinf(nav.cost[rows[inside], cols[inside]])
+    return bad, inside
+
+
 @registry.register
 class ValidatePath(WorldAccess, SyncActionNode):
     """Checks ``path`` against the robot's costmap as it is now (the movable objects drawn
@@ -85,13 +98,7 @@ class ValidatePath(WorldAccess, SyncActionNode):
             begin = nearest_pose(poses, robot.base_pose2d(), 0.0, 0, len(poses))
             end = first_beyond(_steps(poses), begin, lookahead)
         pts = path.shifted(nav.pivot)[begin:end]
-        grid = nav.costmap.grid
-        rows = np.floor((pts[:, 1] - grid.origin[1]) / grid.resolution).astype(int)
-        cols = np.floor((pts[:, 0] - grid.origin[0]) / grid.resolution).astype(int)
-        r, c = grid.shape
-        inside = (rows >= 0) & (rows < r) & (cols >= 0) & (cols < c)
-        bad = ~inside
-        bad[inside] = np.isinf(nav.cost[rows[inside], cols[inside]])
+        bad, inside = in_collision(nav, pts)
         hits = np.flatnonzero(bad)
         if bool(self.get_input("stop_at_first_collision")):
             hits = hits[:1]

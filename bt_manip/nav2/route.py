@@ -20,9 +20,11 @@ from bt_manip.bt.registry import registry
 from bt_manip.nav2.actions import PlanAction, error_ports
 from bt_manip.nav2.conditions import _WouldARecoveryHelp
 from bt_manip.nav2.path import Nav2Path, Pose2D, goal_pose, path_from_points
+from bt_manip.nav2.path_checks import in_collision
 from bt_manip.nav2.route_graph import (
     GraphError,
     Route,
+    RouteEdge,
     RouteGraph,
     graph_from_world,
     read_geojson,
@@ -95,15 +97,18 @@ class ComputeRoute(PlanAction):
 
     With ``use_poses`` the route goes from the node nearest the start (the robot, or
     ``start`` with ``use_start``) to the node nearest ``goal``, as Nav2's route server picks
-    them; otherwise from node ``start_id`` to node ``goal_id``.
+    them; otherwise from node ``start_id`` to node ``goal_id``. Edges are scored as Nav2's
+    CostmapScorer does with ``invalid_on_collision`` and ``invalid_off_map``: an edge along
+    which the robot's footprint would touch an obstacle of its costmap as it is now (the
+    movable objects drawn in), or leave the map, is not taken.
 
     - SUCCESS: ``route`` holds the :class:`~bt_manip.nav2.route_graph.Route` (nodes, edges,
       cost), ``path`` the dense path along its edges from the first node to the last,
       ``planning_time`` 0 (no sim time passes), ``error_code_id`` 0;
     - FAILURE: 402 NO_VALID_GRAPH (no graph, or one without nodes), 403
       INDETERMINANT_NODES_ON_GRAPH (a node id not in the graph, or a pose that cannot be
-      read), 405 NO_VALID_ROUTE (the goal node cannot be reached), with the reason in
-      ``error_msg``.
+      read), 405 NO_VALID_ROUTE (the goal node cannot be reached on the usable edges), with
+      the reason in ``error_msg``.
     """
 
     UNKNOWN = RouteError.UNKNOWN
@@ -151,11 +156,21 @@ class ComputeRoute(PlanAction):
         if not graph.nodes:
             self.fail(RouteError.NO_VALID_GRAPH, "the route graph has no nodes")
         start, goal = self._ends(graph, robot)
-        route = graph.route(start, goal)
-        if route is None:
-            self.fail(RouteError.NO_VALID_ROUTE,
-                      f"no route from node {start} to node {goal} on the graph")
         nav = synced_navigator(self, robot)
+        nav.refresh()
+        blocked: list[int] = []
+
+        def usable(edge: RouteEdge) -> bool:
+            if in_collision(nav, edge.points)[0].any():
+                blocked.append(edge.id)
+                return False
+            return True
+
+        route = graph.route(start, goal, usable)
+        if route is None:
+            why = f" ({len(blocked)} edge(s) blocked on the costmap)" if blocked else ""
+            self.fail(RouteError.NO_VALID_ROUTE,
+                      f"no route from node {start} to node {goal} on the graph{why}")
         self.set_output("route", route)
         self.set_output("path", route_path(route, nav.pivot))
         self.set_output("planning_time", 0.0)

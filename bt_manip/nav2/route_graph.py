@@ -86,9 +86,11 @@ class RouteGraph:
             return None
         return min(self.nodes.values(), key=lambda n: (math.hypot(n.x - x, n.y - y), n.id))
 
-    def route(self, start: int, goal: int) -> Route | None:
+    def route(self, start: int, goal: int,
+              usable: Callable[[RouteEdge], bool] | None = None) -> Route | None:
         """The cheapest route from node ``start`` to node ``goal`` (Dijkstra on the edges'
-        costs), None when the goal cannot be reached."""
+        costs) over the edges ``usable`` accepts (all without it), None when the goal cannot
+        be reached."""
         best = {start: 0.0}
         came: dict[int, RouteEdge] = {}
         queue = [(0.0, start)]
@@ -101,6 +103,8 @@ class RouteGraph:
             if node == goal:
                 break
             for edge in self.out_of(node):
+                if usable is not None and not usable(edge):
+                    continue
                 new = cost + edge.cost
                 if new < best.get(edge.end, math.inf):
                     best[edge.end] = new

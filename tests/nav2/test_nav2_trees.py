@@ -255,3 +255,33 @@ def test_a_crate_falling_in_front_of_the_robot_takes_it_through_the_recovery_bra
         cx, cy, _ = pb.getBasePositionAndOrientation(crate, physicsClientId=world.client)[0]
         route = tree.blackboard.get("path").poses[:, :2]
         assert np.hypot(route[:, 0] - cx, route[:, 1] - cy).min() >= 0.3
+
+
+ROUTING_TREE = SAMPLES / "main" / "navigate_w_routing_global_planning_and_control_w_recovery.xml"
+
+
+@pytest.mark.skipif(not ROUTING_TREE.is_file(), reason="Nav2's main-branch trees are missing")
+def test_crates_on_the_route_are_routed_round_or_end_the_tree_within_its_retries() -> None:
+    """The routing tree recomputes its route when ValidatePath finds the route's path blocked;
+    the route server leaves out the edges blocked on the costmap (Nav2's CostmapScorer), so the
+    new route goes another way, and when no way is left ComputeRoute's 405 ends the tree."""
+    from bt_manip.run.faults import FaultInjector, FaultSpec
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        faults = FaultInjector([FaultSpec("block", 1.0)], seed=0, clock=world.clock)
+        tree = load_tree(str(ROUTING_TREE), context=RunContext.for_world(world, faults=faults),
+                         blackboard={"goal": "2.616;-0.715;0.848",
+                                     "goals": "-0.5;-1.5;0|2.616;-0.715;0.848"})
+        routes: list[list[int]] = []
+
+        def watch(_: list[str]) -> None:
+            route = tree.blackboard.get("route") if tree.blackboard.exists("route") else None
+            if route is not None and (not routes or routes[-1] != [n.id for n in route.nodes]):
+                routes.append([n.id for n in route.nodes])
+
+        status, _ = run(world, tree, on_tick=watch)
+        assert status is not NodeStatus.RUNNING  # it did not loop to the tick budget
+        assert faults.events and faults.events[0].kind == "block"
+        assert len(routes) >= 2  # the crate's edge was left out: the route went another way
+        if status is NodeStatus.FAILURE:
+            assert tree.blackboard.get("compute_route_error_code") == 405
