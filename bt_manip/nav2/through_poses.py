@@ -59,12 +59,18 @@ def goals_list(world: Any, value: Any) -> list[Pose2D]:
     raise ActionFailed(f"goals {value!r} are neither a list of poses nor poses separated by |")
 
 
+ALL_GOALS = -1
+"""``last_reached_index`` of a plan through every goal (Nav2's ComputePathThroughPoses
+ALL_GOALS)."""
+
+
 @registry.register
 class ComputePathThroughPoses(PlanAction):
     """Plans one path from the robot (or ``start``) through every pose of ``goals`` in turn
     (A* on the robot's costmap, leg by leg), ending on the last one.
 
-    - SUCCESS: ``path`` holds the path, ``error_code_id`` 0;
+    - SUCCESS: ``path`` holds the path through every goal, ``last_reached_index`` -1 (Nav2's
+      ALL_GOALS: plans are never partial here), ``error_code_id`` 0;
     - FAILURE: 309 NO_VIAPOINTS_GIVEN without goals, else a leg without a path gives Nav2's
       code (304 GOAL_OUTSIDE_MAP, 306 GOAL_OCCUPIED, 308 NO_VALID_PATH, ...) and the reason.
     """
@@ -74,9 +80,20 @@ class ComputePathThroughPoses(PlanAction):
         **RobotAction.INPUT_PORTS,
         "goals": PortInformation(object, True, "Destinations to plan through"),
         **PLAN_PORTS,
+        "server_name": PortInformation(
+            str, False, "Action server name (no server here: read, not used)",
+            "compute_path_through_poses"
+        ),
+        "server_timeout": PortInformation(
+            float, False, "Action server timeout (ms; read, not used)", 20.0
+        ),
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "path": PortInformation(Nav2Path, False, "Path created by ComputePathThroughPoses node"),
+        "last_reached_index": PortInformation(
+            int, False, "Index of the last goal a partial plan reaches; -1 (ALL_GOALS): the "
+            "plan reaches every goal (always so here: plans are never partial)"
+        ),
         **error_ports("The compute path through poses"),
     }
 
@@ -114,6 +131,7 @@ class ComputePathThroughPoses(PlanAction):
         points = np.vstack(legs)
         path = path_from_points(points, goals[-1], p)
         self.set_output("path", path)
+        self.set_output("last_reached_index", ALL_GOALS)
         key = tuple(goals)
         if key not in self.blocked_goals:
             self.blocked_goals.add(key)

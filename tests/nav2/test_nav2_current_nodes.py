@@ -34,7 +34,7 @@ NEW_NODES = (
     "IsWithinPathTrackingBounds", "PathExpiringTimer", "ProgressCheckerSelector",
     "ComputeRoute", "ExtractRouteNodesAsGoals", "GetNextFewGoals", "AppendGoalPoseToGoals",
     "WouldARouteRecoveryHelp", "GetCurrentPose", "GetPoseFromPath", "ArePosesNear",
-    "ConcatenatePaths",
+    "ConcatenatePaths", "ComputePathThroughPoses",
 )
 
 
@@ -276,6 +276,15 @@ def test_current_pose_and_remove_passed_goals_statuses(rooms: World) -> None:
     assert tree.blackboard.get("left") == [(2.0, 0.0, 0.0)]
     states = [s.waypoint_status for s in tree.blackboard.get("st")]
     assert states == [WaypointState.COMPLETED, WaypointState.PENDING]
+
+
+def test_a_plan_through_every_goal_reports_all_goals_reached(rooms: World) -> None:
+    tree = tree_of('<ComputePathThroughPoses goals="{goals}" path="{path}" '
+                   'last_reached_index="{last}" error_code_id="{code}"/>',
+                   {"goals": "-1.5;0;0|2;0;0", "last": 7}, world=rooms)
+    assert tree.tick().value == "SUCCESS"
+    assert tree.blackboard.get("last") == -1  # ALL_GOALS
+    assert tree.blackboard.get("code") == 0
 
 
 def test_a_world_names_its_geojson_graph() -> None:
