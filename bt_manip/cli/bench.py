@@ -31,9 +31,6 @@ from bt_manip.outputs import check_output_folder, make_folder
 from bt_manip.plugins import add_import_flag
 
 DEFAULT_BENCH_OUT = "out/bench"
-RESUME_KEEPS = ("jobs", "backend", "address", "btlog_failures", "resume")
-"""The bench options that ``--resume`` takes from the command line; the others come from the
-log."""
 DEFINING: dict[str, Any] = {
     "tree": None, "world": None, "runs": 20, "seed": 0, "tree_id": None, "models": [], "bb": [],
     "max_ticks": None, "max_sim_time": DEFAULT_MAX_SIM_TIME, "tick_hz": DEFAULT_TICK_HZ,

@@ -522,10 +522,12 @@ def _parse_world(path: Path, raw: bytes) -> WorldSpec:
                 spec.pose_lines[name] = poses.line_of(name)  # type: ignore[union-attr]
     spec.groups = parse_groups(rd, data, spec)
     if "route_graph" in data:
-        graph = base / rd.text(data, "route_graph", "the world")
-        if not graph.is_file():
-            rd.fail(data.line_of("route_graph"), f"route_graph: no file {graph}")
-        spec.route_graph = graph
+        name = rd.text(data, "route_graph", "the world")  # "" after reporting a non-text value
+        if name:
+            graph = base / name
+            if not graph.is_file():
+                rd.fail(data.line_of("route_graph"), f"route_graph: no file {graph}")
+            spec.route_graph = graph
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)
