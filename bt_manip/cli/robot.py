@@ -9,7 +9,7 @@ from pathlib import Path
 
 from bt_manip.cli.args import joint_list
 from bt_manip.sim.robot_check import check_robot
-from bt_manip.sim.robot_description import RobotDescription
+from bt_manip.sim.robot_description import APPROACH_AXES, RobotDescription
 from bt_manip.sim.robot_init import MOBILE_KINDS, InitOptions, init_descriptor
 
 
@@ -23,7 +23,13 @@ def add_robot_arguments(robot: argparse.ArgumentParser) -> None:
     init.add_argument("--arm-tip", required=True, help="last link of the arm chain (IK tip)")
     init.add_argument(
         "--gripper", type=joint_list, default=(), metavar="JOINT[,JOINT]",
-        help="finger joints (prismatic or revolute); open/closed from their limits",
+        help="finger joints, by name or shell pattern ('hand_*_flex_*'): prismatic (a parallel "
+        "gripper) or revolute (jaws or a hand); which way each closes is measured",
+    )
+    init.add_argument(
+        "--approach-axis", choices=APPROACH_AXES, default="", metavar="AXIS",
+        help="axis of the grasp frame the gripper approaches along (x, y, z, -x, -y, -z; "
+        "default: measured from the arm's last link to the grasp frame)",
     )
     init.add_argument(
         "--grasp-frame", default="", metavar="LINK",
@@ -49,6 +55,7 @@ VERB_ARGUMENTS = {"robot": add_robot_arguments}
 
 
 def cmd_robot_init(args: argparse.Namespace) -> int:
+    notes: list[str] = []
     desc = init_descriptor(
         InitOptions(
             urdf=Path(args.urdf),
@@ -59,18 +66,23 @@ def cmd_robot_init(args: argparse.Namespace) -> int:
             mobile=args.mobile,
             name=args.name,
             grasp_frame=args.grasp_frame,
-        )
+            approach_axis=args.approach_axis,
+        ),
+        notes,
     )
+    g = desc.gripper
+    joints = ", ".join(g.joints[:4]) + (f", ... ({len(g.joints)} joints)" if len(g.joints) > 4
+                                        else "")
     gripper = (
-        f"gripper {', '.join(desc.gripper.joints)} (0 .. {desc.gripper.max_opening:g} m)"
-        if desc.gripper.joints
-        else "no gripper"
+        f"{g.kind} gripper {joints} (0 .. {g.max_opening:g} m)" if g.joints else "no gripper"
     )
     print(
         f"wrote {args.out}: {desc.name}, base {desc.base.type}, arm {len(desc.arm.joints)} joints "
         f"({desc.arm.base_link} -> {desc.end_effector}), {gripper}, states "
         f"{', '.join(desc.states)}"
     )
+    for note in notes:
+        print(f"  assumed: {note}")
     return 0
 
 

@@ -55,7 +55,8 @@ DROPPED_TAGS = ("gazebo", "transmission")
 OPTENV = re.compile(r"\$\(optenv\s+\S+\s*([^)]*)\)")
 LIMIT_KEYS = ("lower", "upper", "velocity", "effort")
 CONTACT_KEYS = ("lateral_friction", "rolling_friction", "spinning_friction", "stiffness", "damping")
-RECIPE_KEYS = {"base", "attach", "joint_limits", "contacts"}
+RECIPE_KEYS = {"base", "attach", "joint_limits", "contacts", "frames", "drop_links"}
+FRAME_KEYS = ("parent", "xyz", "rpy")
 ATTACH_KEYS = {
     "urdf",
     "parent",
@@ -83,6 +84,16 @@ class Attachment:
 
 
 @dataclass(frozen=True)
+class Frame:
+    """A massless link hung from ``parent`` by a fixed joint at xyz/rpy: a named frame (a grasp
+    frame between the pads, a tool frame whose z axis is the approach direction)."""
+
+    parent: str
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rpy: tuple[float, float, float] = (0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
 class Recipe:
     """How to build one robot URDF: ``base`` plus ``attachments``, paths relative to ``folder``."""
 
@@ -94,6 +105,11 @@ class Recipe:
     """Per joint name, any of ``lower``, ``upper``, ``velocity``, ``effort`` to overwrite."""
     contacts: dict[str, dict[str, float]] = field(default_factory=dict)
     """Per link name, the PyBullet ``<contact>`` values that replace the link's own."""
+    frames: dict[str, Frame] = field(default_factory=dict)
+    """Named frames added as massless links (after the attachments)."""
+    drop_links: tuple[str, ...] = ()
+    """Leaf links removed with the joint that carries them (e.g. a planning-only safety box
+    that would hold every object off the fingers)."""
 
 
 def cache_dir() -> Path:
@@ -125,6 +141,8 @@ def _compose_recipe(recipe: Recipe) -> Path:
             "attachments": [asdict(a) for a in recipe.attachments],
             "limits": recipe.joint_limits,
             "contacts": recipe.contacts,
+            "frames": {k: asdict(v) for k, v in recipe.frames.items()},
+            "drop_links": list(recipe.drop_links),
         },
         parts,
     )
@@ -135,6 +153,8 @@ def _compose_recipe(recipe: Recipe) -> Path:
     robot.set("name", recipe.name)
     for i, attachment in enumerate(recipe.attachments):
         _graft(robot, attachment, parts[i + 1], f"{recipe.name}: attachments[{i}]")
+    _drop_leaf_links(robot, recipe.drop_links, recipe.name)
+    _add_frames(robot, recipe.frames, recipe.name)
     _override_limits(robot, recipe.joint_limits, recipe.name)
     _replace_contacts(robot, recipe.contacts, recipe.name)
     _fill_inertials(robot)
@@ -291,6 +311,54 @@ def _graft(robot: ET.Element, att: Attachment, path: Path, where: str) -> None:
 def _joint_end(joint: ET.Element, end: str) -> str:
     el = joint.find(end)
     return el.get("link", "") if el is not None else ""
+
+
+def _drop_leaf_links(robot: ET.Element, names: tuple[str, ...], where: str) -> None:
+    """Remove each named leaf link and the joint that carries it."""
+    links = {el.get("name"): el for el in robot.findall("link")}
+    joints = robot.findall("joint")
+    problems: list[Problem] = []
+    for name in names:
+        if name not in links:
+            problems.append(Problem(where, None, f"drop_links: no link '{name}' in the robot"))
+            continue
+        below = [_joint_end(j, "child") for j in joints if _joint_end(j, "parent") == name]
+        if below:
+            problems.append(Problem(
+                where, None, f"drop_links: link '{name}' carries {sorted(below)}; only a leaf "
+                "link (one no joint hangs from) can be dropped",
+            ))
+            continue
+        robot.remove(links[name])
+        for j in joints:
+            if _joint_end(j, "child") == name:
+                robot.remove(j)
+    if problems:
+        raise InputError(problems)
+
+
+def _add_frames(robot: ET.Element, frames: dict[str, Frame], where: str) -> None:
+    """Add each frame as a massless link on a fixed joint named ``<frame>_joint``."""
+    links = {el.get("name") for el in robot.findall("link")}
+    joints = {el.get("name") for el in robot.findall("joint")}
+    problems: list[Problem] = []
+    for name, frame in frames.items():
+        if name in links or f"{name}_joint" in joints:
+            problems.append(Problem(where, None, f"frames: '{name}' is already a link name"))
+            continue
+        if frame.parent not in links:
+            problems.append(
+                Problem(where, None, f"frames.{name}: no parent link '{frame.parent}' in the robot")
+            )
+            continue
+        ET.SubElement(robot, "link", name=name)
+        joint = ET.SubElement(robot, "joint", name=f"{name}_joint", type="fixed")
+        ET.SubElement(joint, "parent", link=frame.parent)
+        ET.SubElement(joint, "child", link=name)
+        ET.SubElement(joint, "origin", xyz=_vec(frame.xyz), rpy=_vec(frame.rpy))
+        links.add(name)
+    if problems:
+        raise InputError(problems)
 
 
 def _override_limits(robot: ET.Element, limits: dict[str, dict[str, float]], where: str) -> None:
@@ -464,6 +532,28 @@ def parse_recipe(data: dict, path: Path, name: str) -> Recipe:
         )
     limits = table(data, "joint_limits", LIMIT_KEYS)
     contacts = table(data, "contacts", CONTACT_KEYS)
+    frames: dict[str, Frame] = {}
+    raw_frames = data.get("frames") or {}
+    if not isinstance(raw_frames, dict):
+        fail(data, "frames", "urdf.frames must map frame names to {parent, xyz, rpy}")
+        raw_frames = {}
+    for fname, item in raw_frames.items():
+        where = f"urdf.frames.{fname}"
+        if not isinstance(item, dict) or not isinstance(item.get("parent"), str):
+            fail(raw_frames, fname, f"{where} must be a mapping with a parent link name")
+            continue
+        for key in item:
+            if key not in FRAME_KEYS:
+                fail(item, key, f"unknown key '{key}' in {where}; allowed: {', '.join(FRAME_KEYS)}")
+        frames[str(fname)] = Frame(
+            item["parent"], vec3(item, "xyz", where), vec3(item, "rpy", where)
+        )
+    drop_top = data.get("drop_links", [])
+    if not isinstance(drop_top, list) or not all(isinstance(d, str) for d in drop_top):
+        fail(data, "drop_links", "urdf.drop_links must be a list of link names")
+        drop_top = []
     if reader.problems:
         raise InputError(reader.problems)
-    return Recipe(name, base, path.parent, tuple(attachments), limits, contacts)
+    return Recipe(
+        name, base, path.parent, tuple(attachments), limits, contacts, frames, tuple(drop_top)
+    )

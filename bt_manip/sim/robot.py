@@ -174,6 +174,7 @@ class Robot:
         robot = cls(client, body, description, merged)
         robot._apply_friction()
         robot._couple_fingers()
+        robot._hold_other_joints()
         robot.hold_arm()
         robot.set_gripper(robot.gripper_opening())
         if robot.has_wheels or robot.is_holonomic:
@@ -206,13 +207,28 @@ class Robot:
                 physicsClientId=self.client,
             )
 
+    def _hold_other_joints(self) -> None:
+        """Hold every movable joint that is neither arm, gripper, wheel nor base (a head, a
+        torso left out of the arm, a hand's spreading joints) where it is, with its own effort
+        limit, so it neither flops under gravity nor gives way when touched."""
+        used = set(self.arm_joint_ids + self.gripper_joint_ids + self.wheel_ids_left
+                   + self.wheel_ids_right + self.base_joint_ids)
+        for index, info in self._joint_info.items():
+            if index in used or info.type not in (pb.JOINT_REVOLUTE, pb.JOINT_PRISMATIC):
+                continue
+            position = float(pb.getJointState(self.body, index, physicsClientId=self.client)[0])
+            pb.setJointMotorControl2(
+                self.body, index, pb.POSITION_CONTROL, targetPosition=position,
+                force=max(float(info.max_force), 1.0), physicsClientId=self.client,
+            )
+
     def _couple_fingers(self) -> None:
         """Make two fingers move as mirror images (a gear constraint: equal joint positions).
 
         Without it, each finger's motor saturates on its own when squeezing and a held object
         can be walked sideways by the pair.
         """
-        if len(self.gripper_joint_ids) != 2:
+        if len(self.gripper_joint_ids) != 2 or not self.description.gripper.is_parallel:
             return
         a, b = self.gripper_joint_ids
         gear = pb.createConstraint(
@@ -443,23 +459,36 @@ class Robot:
 
     # -- gripper ------------------------------------------------------------------------------
     def set_gripper(self, opening: float) -> None:
-        """Command the distance between the finger pads (m), clipped to the gripper's stroke."""
+        """Command the distance between the finger pads (m), clipped to the gripper's stroke.
+
+        A revolute or hand gripper turns every finger joint the same fraction of its way from
+        closed to open (the opening over the gripper's ``width``)."""
         g = self.description.gripper
         if not self.gripper_joint_ids:  # an arm without a gripper
             self._gripper_target = 0.0
             return
-        finger = float(
-            np.clip(
-                opening / len(self.gripper_joint_ids), min(g.closed, g.open), max(g.closed, g.open)
+        if g.is_parallel:
+            finger = float(
+                np.clip(
+                    opening / len(self.gripper_joint_ids),
+                    min(g.closed, g.open), max(g.closed, g.open),
+                )
             )
-        )
-        self._gripper_target = finger * len(self.gripper_joint_ids)
-        for j in self.gripper_joint_ids:
+            self._gripper_target = finger * len(self.gripper_joint_ids)
+            targets = [finger] * len(self.gripper_joint_ids)
+        else:
+            fraction = float(np.clip(opening / g.width, 0.0, 1.0))
+            self._gripper_target = fraction * g.width
+            targets = [
+                c + fraction * (o - c)
+                for o, c in zip(g.open_positions, g.closed_positions, strict=True)
+            ]
+        for j, target in zip(self.gripper_joint_ids, targets, strict=True):
             pb.setJointMotorControl2(
                 self.body,
                 j,
                 pb.POSITION_CONTROL,
-                targetPosition=finger,
+                targetPosition=target,
                 targetVelocity=0.0,
                 force=g.max_force,
                 maxVelocity=g.max_speed,
@@ -475,8 +504,15 @@ class Robot:
         self.set_gripper(self.description.gripper.min_opening)
 
     def gripper_opening(self) -> float:
-        """Current distance between the finger pads (m)."""
-        return float(self._positions(self.gripper_joint_ids).sum())
+        """Current distance between the finger pads (m); for a revolute or hand gripper, the
+        mean fraction of the way its joints are open times its ``width``."""
+        q = self._positions(self.gripper_joint_ids)
+        g = self.description.gripper
+        if g.is_parallel or not len(q):
+            return float(q.sum())
+        opens = np.asarray(g.open_positions, dtype=float)
+        closeds = np.asarray(g.closed_positions, dtype=float)
+        return float(np.mean((q - closeds) / (opens - closeds)) * g.width)
 
     @property
     def gripper_target(self) -> float:
@@ -508,8 +544,10 @@ class Robot:
         return self.contacts(other_body, self.finger_link_ids)
 
     def is_grasping(self, other_body: int) -> bool:
-        """True when every finger touches ``other_body``."""
+        """True when every finger touches ``other_body`` (for a hand: two fingers or more)."""
         touching = {c.link for c in self.finger_contacts(other_body)}
+        if self.description.gripper.kind == "hand":
+            return len(touching) >= min(2, len(self.finger_link_ids))
         return len(touching) == len(self.finger_link_ids)
 
     # -- base ---------------------------------------------------------------------------------

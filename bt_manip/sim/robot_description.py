@@ -22,7 +22,7 @@ from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError
 from bt_manip.input_files import read_bounded
 from bt_manip.sim.assets import data_root
-from bt_manip.sim.compose import MAX_URDF_BYTES, Recipe, composed_urdf, parse_recipe
+from bt_manip.sim.compose import MAX_URDF_BYTES, Frame, Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
 
 __all__ = [
@@ -50,6 +50,7 @@ TOP_KEYS = {
     "arm",
     "end_effector",
     "grasp_frame",
+    "approach_axis",
     "gripper",
     "states",
     "footprint",
@@ -80,6 +81,8 @@ HOLONOMIC_KEYS = {
 }
 ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
 GRIPPER_KEYS = {
+    "kind",
+    "width",
     "joints",
     "finger_links",
     "open",
@@ -89,6 +92,19 @@ GRIPPER_KEYS = {
     "pad_friction",
 }
 FOOTPRINT_KEYS = {"length", "width", "x_offset", "radius"}
+GRIPPER_KINDS = ("parallel", "revolute", "hand")
+APPROACH_AXES: dict[str, tuple[float, float, float]] = {
+    "z": (0.0, 0.0, 0.0),
+    "-z": (math.pi, 0.0, 0.0),
+    "x": (0.0, math.pi / 2.0, 0.0),
+    "-x": (0.0, -math.pi / 2.0, 0.0),
+    "y": (-math.pi / 2.0, 0.0, 0.0),
+    "-y": (math.pi / 2.0, 0.0, 0.0),
+}
+"""Per approach axis of the grasp link, the rpy of the frame whose z axis is that axis (each
+turn keeps one of the link's other axes)."""
+APPROACH_FRAME = "approach_frame"
+"""The frame added to a robot whose grasp link approaches along another axis than z."""
 
 
 @dataclass(frozen=True)
@@ -143,9 +159,14 @@ class ArmSpec:
 
 @dataclass(frozen=True)
 class GripperSpec:
-    """Parallel gripper: finger joints (each = pad distance from the centre line, m).
+    """The gripper: its finger joints and how an opening (m) maps onto them.
 
-    An arm without a gripper has no joints (``joints == ()``): its opening stays 0.
+    ``parallel`` (the default): prismatic fingers, each joint the distance of one pad from the
+    centre line, so the opening is the sum of the joints. ``revolute`` (jaws that turn) and
+    ``hand`` (several fingers that curl): each joint goes from its ``closed`` to its ``open``
+    position, all together, and the opening is read linearly between 0 (closed) and ``width``
+    (the measured distance between the fingers when open). An arm without a gripper has no
+    joints (``joints == ()``): its opening stays 0.
     """
 
     joints: tuple[str, ...]
@@ -155,16 +176,46 @@ class GripperSpec:
     max_force: float
     max_speed: float = 0.1
     pad_friction: float = 1.5
+    kind: str = "parallel"
+    opens: tuple[float, ...] = ()
+    """Per joint, its open position (``open`` for every joint unless given one by one)."""
+    closeds: tuple[float, ...] = ()
+    """Per joint, its closed position."""
+    width: float = 0.0
+    """``revolute`` / ``hand``: the opening (m) when fully open."""
+
+    @property
+    def is_parallel(self) -> bool:
+        return self.kind == "parallel"
+
+    @property
+    def open_positions(self) -> tuple[float, ...]:
+        return self.opens or (self.open,) * len(self.joints)
+
+    @property
+    def closed_positions(self) -> tuple[float, ...]:
+        return self.closeds or (self.closed,) * len(self.joints)
 
     @property
     def max_opening(self) -> float:
         """Distance between the pads when fully open (m)."""
+        if not self.is_parallel:
+            return self.width
         return max(self.open, self.closed) * len(self.joints)
 
     @property
     def min_opening(self) -> float:
         """Distance between the pads when closed on nothing (m)."""
+        if not self.is_parallel:
+            return 0.0
         return min(self.open, self.closed) * len(self.joints)
+
+    @property
+    def stroke_time(self) -> float:
+        """Seconds the slowest finger joint takes from closed to open at ``max_speed``."""
+        strokes = [abs(o - c) for o, c in zip(self.open_positions, self.closed_positions,
+                                                 strict=True)]
+        return max(strokes, default=0.0) / self.max_speed
 
 
 @dataclass(frozen=True)
@@ -203,9 +254,15 @@ class RobotDescription:
     gripper: GripperSpec
     end_effector: str
     grasp_frame: str
+    """The frame placed by MoveToPose and the grasp planners: z is the approach direction. It
+    is the URDF's grasp link itself, or :data:`APPROACH_FRAME` added on it (``approach_axis``)."""
     states: dict[str, tuple[float, ...]]
     footprint: Footprint
     spawn_height: float = 0.0
+    approach_axis: str = "z"
+    """The axis of ``grasp_link`` along which the gripper approaches an object."""
+    grasp_link: str = ""
+    """The grasp frame as the descriptor names it (a link of the URDF)."""
 
     @classmethod
     def load(cls, name_or_path: str | Path) -> RobotDescription:
@@ -371,17 +428,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     arm_base = f.text(a, "base_link", "arm")
     gain = f.real(a, "position_gain", "arm", 0.3, positive=True)
 
-    g = f.section(data, "gripper", GRIPPER_KEYS, required=False)
-    has_gripper = "gripper" in data
-    gripper = GripperSpec(
-        f.names(g, "joints", "gripper", required=has_gripper),
-        f.names(g, "finger_links", "gripper", required=has_gripper),
-        f.real(g, "open", "gripper", None if has_gripper else 0.0),
-        f.real(g, "closed", "gripper", None if has_gripper else 0.0),
-        f.real(g, "max_force", "gripper", None if has_gripper else 1.0, positive=True),
-        f.real(g, "max_speed", "gripper", 0.1, positive=True),
-        f.real(g, "pad_friction", "gripper", 1.5, minimum=0.0),
-    )
+    gripper = _gripper(f, data)
 
     raw_states = data.get("states")
     s = f.section(data, "states", set(raw_states) if isinstance(raw_states, dict) else set())
@@ -404,10 +451,20 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             f.real(fp, "x_offset", "footprint", 0.0),
         )
     end_effector = f.text(data, "end_effector", "descriptor")
-    grasp_frame = f.text(data, "grasp_frame", "descriptor")
+    grasp_link = f.text(data, "grasp_frame", "descriptor")
     spawn_height = f.real(data, "spawn_height", "descriptor", 0.0)
+    approach_axis = str(data.get("approach_axis", "z"))
+    if approach_axis not in APPROACH_AXES:
+        f.fail(
+            data.line_of("approach_axis"),
+            f"approach_axis must be one of {', '.join(APPROACH_AXES)}, got {approach_axis!r}",
+        )
     if f.problems:
         raise InputError(f.problems)
+    grasp_frame = grasp_link
+    if approach_axis != "z":
+        urdf = _with_approach_frame(urdf, name, grasp_link, APPROACH_AXES[approach_axis])
+        grasp_frame = APPROACH_FRAME
 
     desc = RobotDescription(
         name,
@@ -421,8 +478,61 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
         states,
         footprint,
         spawn_height,
+        approach_axis,
+        grasp_link,
     )
     return _check_against_urdf(desc, data, f)
+
+
+def _with_approach_frame(
+    urdf: Path | Recipe, name: str, grasp_link: str, rpy: tuple[float, float, float]
+) -> Recipe:
+    """``urdf`` (a file or a recipe) with :data:`APPROACH_FRAME` hung from ``grasp_link``."""
+    frame = Frame(grasp_link, rpy=rpy)
+    if isinstance(urdf, Recipe):
+        return dataclasses.replace(urdf, frames={**urdf.frames, APPROACH_FRAME: frame})
+    return Recipe(name, str(urdf), urdf.parent, frames={APPROACH_FRAME: frame})
+
+
+def _gripper(f: _Fields, data: LineDict) -> GripperSpec:
+    """The ``gripper`` section (absent: no gripper)."""
+    g = f.section(data, "gripper", GRIPPER_KEYS, required=False)
+    has_gripper = "gripper" in data
+    joints = f.names(g, "joints", "gripper", required=has_gripper)
+    kind = str(g.get("kind", "parallel"))
+    if kind not in GRIPPER_KINDS:
+        f.fail(g.line_of("kind"), f"gripper.kind must be one of {', '.join(GRIPPER_KINDS)}")
+        kind = "parallel"
+    ends: dict[str, tuple[float, ...]] = {}
+    for key in ("open", "closed"):
+        value = g.get(key)
+        if isinstance(value, list) and kind != "parallel":
+            ends[key] = f.vector(value, len(joints), g.line_of(key), f"gripper.{key}") or ()
+        else:
+            number = f.real(g, key, "gripper", None if has_gripper else 0.0)
+            ends[key] = (number,) * len(joints)
+    width = 0.0
+    if kind != "parallel":
+        width = f.real(g, "width", "gripper", None, positive=True)
+    elif "width" in g:
+        f.fail(g.line_of("width"), "gripper.width is for revolute and hand grippers; a "
+               "parallel gripper's opening is the sum of its joints")
+    opens, closeds = ends["open"], ends["closed"]
+    if any(o == c for o, c in zip(opens, closeds, strict=False)):
+        f.fail(g.line_of("open"), "gripper: a finger joint's open and closed positions are equal")
+    return GripperSpec(
+        joints,
+        f.names(g, "finger_links", "gripper", required=has_gripper),
+        opens[0] if opens else 0.0,
+        closeds[0] if closeds else 0.0,
+        f.real(g, "max_force", "gripper", None if has_gripper else 1.0, positive=True),
+        f.real(g, "max_speed", "gripper", 0.1, positive=True),
+        f.real(g, "pad_friction", "gripper", 1.5, minimum=0.0),
+        kind,
+        opens if kind != "parallel" else (),
+        closeds if kind != "parallel" else (),
+        width,
+    )
 
 
 HOLONOMIC_BOUNDS = {
@@ -532,7 +642,7 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
     need(desc.gripper.joints, joints, "gripper", "joints")
     need(desc.gripper.finger_links, links, "gripper", "finger_links")
     need((desc.end_effector,), links, "", "end_effector")
-    need((desc.grasp_frame,), links, "", "grasp_frame")
+    need((desc.grasp_link,), links, "", "grasp_frame")
     if f.problems:
         raise InputError(f.problems)
     lower, upper = [], []

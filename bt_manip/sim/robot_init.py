@@ -30,12 +30,15 @@ kinematic model); the descriptor is only kept when that works. Every problem is 
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
 import math
 import os
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import defusedxml.ElementTree as SafeET
 import numpy as np
@@ -45,7 +48,16 @@ from bt_manip.geometry import rpy_matrix
 from bt_manip.input_files import read_bounded
 from bt_manip.sim.assets import example_robot_data_share, pybullet_data_dir
 from bt_manip.sim.compose import MAX_URDF_BYTES, composed_urdf
-from bt_manip.sim.robot_description import RobotDescription, load_description
+from bt_manip.sim.gripper_survey import (
+    Body,
+    GripperSurvey,
+    SurveyError,
+    approach_axis,
+    enclosing_leaf_links,
+    expand_joint_patterns,
+    survey_gripper,
+)
+from bt_manip.sim.robot_description import APPROACH_AXES, RobotDescription, load_description
 
 __all__ = ["MOBILE_KINDS", "InitOptions", "holonomic_joints", "init_descriptor", "urdf_uri"]
 
@@ -56,6 +68,8 @@ DEFAULT_VELOCITY = 1.0
 DEFAULT_WHEEL_SPEED = 6.0
 DEFAULT_WHEEL_TORQUE = 50.0
 MAX_NAME = 64
+CASTER_GAP = 0.01
+"""m: a link whose lowest point is this close to the wheels' contact with the floor rests on it."""
 HOLONOMIC_SPEED = 0.5
 """m/s of a holonomic base whose x / y joints give no velocity limit."""
 HOLONOMIC_YAW_RATE = 1.0
@@ -89,6 +103,8 @@ class InitOptions:
     mobile: str | None = None
     name: str = ""
     grasp_frame: str = ""
+    approach_axis: str = ""
+    """``x``, ``-y``, ...: the grasp frame's axis the gripper approaches along; "" = found."""
 
 
 @dataclass(frozen=True)
@@ -127,16 +143,28 @@ class _Urdf:
         self.round_shapes: dict[str, tuple[float, tuple[float, float, float] | None]] = {}
         """Links whose only collision shape is a cylinder or a sphere: its radius and, for a
         cylinder, its axis in the link frame."""
+        self.shaped: set[str] = set()
+        """Links with at least one collision shape."""
         for el in root.findall("link"):
             name = el.get("name", "")
             self.links[name] = _line(text, "link", name)
+            if el.find("collision") is not None:
+                self.shaped.add(name)
             round_shape = _round_shape(el)
             if round_shape is not None:
                 self.round_shapes[name] = round_shape
         self.joints: dict[str, _Joint] = {}
+        self.mimics: dict[str, tuple[str, float, float]] = {}
+        """Follower joint -> (leader, multiplier, offset)."""
         for el in root.findall("joint"):
             name = el.get("name", "")
             jline = _line(text, "joint", name)
+            mimic = el.find("mimic")
+            if mimic is not None and mimic.get("joint"):
+                with contextlib.suppress(ValueError):
+                    self.mimics[name] = (mimic.get("joint", ""),
+                                         float(mimic.get("multiplier", "1")),
+                                         float(mimic.get("offset", "0")))
 
             def num(key: str, default: float | None, el: ET.Element = el,
                     where: tuple[str, int | None] = (name, jline)) -> float | None:
@@ -189,6 +217,11 @@ class _Urdf:
                     seen.add(c)
                     todo.append(c)
         return seen
+
+    def leaves(self) -> list[str]:
+        """Links no joint hangs from."""
+        parents = {j.parent for j in self.joints.values()}
+        return [name for name in self.links if name not in parents]
 
     def root_link(self) -> str:
         roots = [name for name in self.links if name not in self.parent_joint]
@@ -338,6 +371,10 @@ def _check_names(urdf: _Urdf, opts: InitOptions) -> list[Problem]:
                     "must be prismatic or revolute",
                 )
             )
+    if opts.approach_axis and opts.approach_axis not in APPROACH_AXES:
+        problems.append(urdf.problem(
+            None, f"--approach-axis must be one of {', '.join(APPROACH_AXES)}"
+        ))
     if opts.mobile is not None and opts.mobile not in MOBILE_KINDS:
         problems.append(
             urdf.problem(None, f"--mobile must be one of {', '.join(MOBILE_KINDS)}")
@@ -392,7 +429,7 @@ def holonomic_joints(urdf: _Urdf, base_link: str) -> list[_Joint]:
     return above
 
 
-def init_descriptor(opts: InitOptions) -> RobotDescription:
+def init_descriptor(opts: InitOptions, notes: list[str] | None = None) -> RobotDescription:
     """Write the descriptor ``opts.out`` for ``opts.urdf`` and return it loaded and checked.
 
     Raises :class:`~bt_manip.errors.InputError` (file and line of each problem) when the URDF
@@ -409,6 +446,13 @@ def init_descriptor(opts: InitOptions) -> RobotDescription:
             str(opts.out), None,
             f"robot name {name!r}: use 1..{MAX_NAME} letters, digits, '_' or '-'",
         )
+    movable = [j.name for j in urdf.joints.values() if j.type in ("prismatic", "revolute")]
+    gripper, explicit, unmatched = expand_joint_patterns(opts.gripper, movable)
+    if unmatched:
+        raise InputError.single(
+            str(opts.urdf), 1, f"--gripper: no joint matches {', '.join(unmatched)}"
+        )
+    opts = dataclasses.replace(opts, gripper=tuple(gripper))
     problems = _check_names(urdf, opts)
     if problems:
         raise InputError(problems)
@@ -436,7 +480,8 @@ def init_descriptor(opts: InitOptions) -> RobotDescription:
         )
     # the composed file checks every mesh (missing files reported with their line)
     composed = composed_urdf(opts.urdf)
-    text = _descriptor_text(urdf, opts, name, arm, composed, virtual)
+    said: list[str] = [] if notes is None else notes
+    text = _descriptor_text(urdf, opts, name, arm, composed, virtual, explicit, said)
     return _write_checked(opts.out, text)
 
 
@@ -447,6 +492,8 @@ def _descriptor_text(
     arm: list[_Joint],
     composed: Path,
     virtual: list[_Joint],
+    explicit: set[str],
+    notes: list[str],
 ) -> str:
     lower = [j.lower for j in arm]
     upper = [j.upper for j in arm]
@@ -457,7 +504,8 @@ def _descriptor_text(
     ]
     velocities = [j.velocity if j.velocity and j.velocity > 0 else DEFAULT_VELOCITY for j in arm]
     efforts = [j.effort if j.effort and j.effort > 0 else None for j in arm]
-    geometry = _Geometry(composed, urdf, opts, arm, virtual)
+    geometry = _Geometry(composed, urdf, opts, arm, virtual, explicit)
+    notes += geometry.notes
     uri = urdf_uri(opts.urdf, opts.out.parent)
     lines = [
         f"# {name}: written by `bt-manip robot init` from {Path(uri).name}.",
@@ -466,6 +514,15 @@ def _descriptor_text(
         "urdf:",
         f"  base: {uri}",
     ]
+    if geometry.dropped:
+        lines.append(f"  drop_links: [{', '.join(geometry.dropped)}]   # box around the hand")
+    if geometry.frictionless:
+        lines.append("  contacts:                # passive wheels and casters roll freely")
+        lines += [
+            f"    {link}: {{lateral_friction: 0.0, rolling_friction: 0.0, "
+            "spinning_friction: 0.0}"
+            for link in geometry.frictionless
+        ]
     if opts.mobile in ("skid", "diff"):
         lines += geometry.mobile_base_lines()
     elif virtual:
@@ -484,20 +541,10 @@ def _descriptor_text(
         f"end_effector: {opts.arm_tip}",
         f"grasp_frame: {opts.grasp_frame or opts.arm_tip}",
     ]
-    if opts.gripper:
-        fingers = [urdf.joints[g] for g in opts.gripper]
-        open_, closed = fingers[0].upper, fingers[0].lower
-        force = min((f.effort for f in fingers if f.effort and f.effort > 0), default=40.0)
-        speed = min((f.velocity for f in fingers if f.velocity and f.velocity > 0), default=0.1)
-        lines += [
-            "gripper:",
-            f"  joints: [{', '.join(opts.gripper)}]",
-            f"  finger_links: [{', '.join(f.child for f in fingers)}]",
-            f"  open: {_fmt(open_)}        # finger joint upper limit",
-            f"  closed: {_fmt(closed)}      # finger joint lower limit",
-            f"  max_force: {_fmt(force)}",
-            f"  max_speed: {_fmt(speed)}",
-        ]
+    if geometry.axis != "z":
+        lines.append(f"approach_axis: {geometry.axis}   # of the grasp frame, measured")
+    if geometry.gripper is not None:
+        lines += _gripper_lines(geometry.gripper)
     lines += [
         "states:                  # rad, arm joint order, within the joint limits",
         f"  home: {_state(ready, lower, upper)}    # = ready",
@@ -507,6 +554,29 @@ def _descriptor_text(
     ]
     lines += geometry.footprint_lines()
     return "\n".join(lines) + "\n"
+
+
+def _gripper_lines(g: GripperSurvey) -> list[str]:
+    lines = ["gripper:"]
+    if g.kind != "parallel":
+        lines.append(f"  kind: {g.kind}")
+    lines += [
+        f"  joints: [{', '.join(g.joints)}]",
+        f"  finger_links: [{', '.join(g.finger_links)}]",
+    ]
+    if g.kind == "parallel":
+        lines += [
+            f"  open: {_fmt(g.opens[0])}        # finger joint upper limit",
+            f"  closed: {_fmt(g.closeds[0])}      # finger joint lower limit",
+        ]
+    else:
+        lines += [
+            f"  open: {_vector(list(g.opens))}     # the limit farther from the grasp frame",
+            f"  closed: {_vector(list(g.closeds))}   # the limit nearer to it",
+            f"  width: {_fmt(g.width)}      # m between the fingers when open (measured)",
+        ]
+    lines += [f"  max_force: {_fmt(g.max_force)}", f"  max_speed: {_fmt(g.max_speed)}"]
+    return lines
 
 
 class _Geometry:
@@ -519,12 +589,18 @@ class _Geometry:
         opts: InitOptions,
         arm: list[_Joint],
         virtual: list[_Joint],
+        explicit: set[str] | None = None,
     ) -> None:
         import pybullet as pb
 
         from bt_manip.sim import pybullet_queries as pbq
 
         self.opts = opts
+        self.notes: list[str] = []
+        self.dropped: list[str] = []
+        self.frictionless: list[str] = []
+        self.axis = "z"
+        self.gripper: GripperSurvey | None = None
         moved = urdf.below(arm[0].child)
         for g in opts.gripper:
             moved |= urdf.below(urdf.joints[g].child)
@@ -553,10 +629,15 @@ class _Geometry:
                 self.origin = np.asarray(
                     pb.getLinkState(body, yaw_index, physicsClientId=client)[4], dtype=float
                 )
+            self._survey_hand(pb, client, body, names, urdf, opts, explicit or set())
+            skipped = []
             for index, link in names.items():
                 lo, hi = pb.getAABB(body, index, physicsClientId=client)
                 lo_a, hi_a = np.asarray(lo), np.asarray(hi)
-                if np.all(hi_a - lo_a < 1e-6):  # no collision shape
+                if link not in urdf.shaped or link in self.dropped:
+                    # PyBullet gives a link without a shape a +-1 mm box: not an outline
+                    if link not in moved and np.any(hi_a - lo_a > 1e-6):
+                        skipped.append(link)
                     continue
                 self.all_min = np.minimum(self.all_min, lo_a)
                 if link not in moved:
@@ -582,8 +663,98 @@ class _Geometry:
                         wheel_effort.append(joint.effort)
             self.wheel_speed = min(wheel_max, default=DEFAULT_WHEEL_SPEED)
             self.wheel_torque = min(wheel_effort, default=DEFAULT_WHEEL_TORQUE)
+            if opts.mobile in ("skid", "diff"):
+                self._passive_contacts(pb, client, body, names, urdf, moved)
+            self._note_footprint(skipped)
         finally:
             pb.disconnect(client)
+
+    def _note_footprint(self, skipped: list[str]) -> None:
+        if skipped:
+            shown = ", ".join(skipped[:6]) + (", ..." if len(skipped) > 6 else "")
+            self.notes.append(
+                f"footprint: {len(skipped)} link(s) without a collision shape left out "
+                f"({shown}): PyBullet gives each a 1 mm box, not a part of the outline"
+            )
+
+    def _passive_contacts(
+        self, pb: Any, client: int, body: int, names: dict[int, str], urdf: _Urdf,
+        moved: set[str],
+    ) -> None:
+        """Keep the driven wheels (for a diff drive, the largest on each side); give the other
+        wheels and every other link resting on the floor (casters) frictionless contact."""
+        if self.opts.mobile == "diff":
+            driven = []
+            for side in (1.0, -1.0):
+                mine = [w for w in self.wheels if w[1] * side > 1e-6]
+                biggest = max((w[2] for w in mine), default=0.0)
+                driven += [w for w in mine if w[2] >= biggest - 1e-4]
+            passive = [w for w in self.wheels if w not in driven]
+            self.wheels = driven
+            for w in passive:
+                self.notes.append(f"base: '{w[0]}' is a passive wheel (smaller than the driven "
+                                  "one on its side): frictionless, not driven")
+        wheel_links = {urdf.joints[w[0]].child for w in self.wheels}
+        floor = float(self.all_min[2])
+        for index, link in names.items():
+            if link in wheel_links or link in moved or link not in urdf.shaped:
+                continue
+            below = urdf.below(link)
+            if any(urdf.joints[w[0]].child in below for w in self.wheels):
+                continue  # a link that carries a driven wheel (the chassis)
+            lo, _ = pb.getAABB(body, index, physicsClientId=client)
+            if lo[2] <= floor + CASTER_GAP:
+                self.frictionless.append(link)
+        if self.frictionless:
+            self.notes.append(
+                f"base: {', '.join(self.frictionless)} rest on the floor beside the driven "
+                "wheels (casters or passive wheels): written with frictionless contact "
+                "(urdf.contacts), so they roll instead of dragging"
+            )
+
+    def _survey_hand(
+        self, pb: Any, client: int, body: int, names: dict[int, str], urdf: _Urdf,
+        opts: InitOptions, explicit: set[str],
+    ) -> None:
+        """The gripper, the approach axis and any box enclosing the grasp frame."""
+        joint_index = {
+            pb.getJointInfo(body, i, physicsClientId=client)[1].decode(): i
+            for i in range(pb.getNumJoints(body, physicsClientId=client))
+        }
+        link_index = {name: index for index, name in names.items()}
+        robot = Body(client, body, link_index, joint_index, urdf.below,
+                     lambda n: n in urdf.shaped)
+        grasp = opts.grasp_frame or opts.arm_tip
+        shaped_fingers: set[str] = set()
+        for g in opts.gripper:
+            shaped_fingers |= {n for n in urdf.below(urdf.joints[g].child) if n in urdf.shaped}
+        if opts.approach_axis:
+            self.axis = opts.approach_axis
+            self.notes.append(f"approach axis {self.axis} of '{grasp}' (given)")
+        else:
+            self.axis, how = approach_axis(robot, grasp, opts.arm_tip, sorted(shaped_fingers))
+            self.notes.append(how)
+        turn = rpy_matrix(*APPROACH_AXES[self.axis])
+        direction = robot.frame(grasp)[1] @ turn[:, 2]
+        if opts.gripper:
+            try:
+                self.gripper = survey_gripper(
+                    robot, urdf.joints, urdf.mimics, opts.gripper, explicit, grasp, direction
+                )
+            except SurveyError as exc:
+                first = urdf.joints.get(opts.gripper[0])
+                raise InputError.single(
+                    str(urdf.path), first.line if first else None, f"--gripper: {exc}"
+                ) from None
+            self.notes += self.gripper.notes
+            keep = set(self.gripper.finger_links) | shaped_fingers
+            self.dropped = enclosing_leaf_links(robot, grasp, urdf.leaves(), keep)
+            for link in self.dropped:
+                self.notes.append(
+                    f"'{link}' is a collision box around the grasp frame (a planning safety "
+                    "box): it would hold every object off the fingers, so it is left out "
+                    "(urdf.drop_links)"
+                )
 
     def mobile_base_lines(self) -> list[str]:
         left = [w for w in self.wheels if w[1] > 1e-6]
