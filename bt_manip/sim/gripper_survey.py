@@ -14,8 +14,8 @@ headless PyBullet client, every joint at its zero pose:
   centre line, so it must open as it grows); one or two revolute jaws a ``revolute`` gripper;
   more revolute joints a ``hand``. Mixed prismatic and revolute joints are refused.
 - ``width`` of a revolute gripper or hand: the largest distance across the approach axis
-  between two fingers' shapes when open (twice one jaw's distance from the axis when there is
-  a single jaw).
+  between two fingers' shapes when open (for a single jaw, how far its shapes move from closed
+  to open).
 - mimic joints: a joint that mimics a finger joint moves with it (PyBullet ignores ``mimic``),
   so it joins the gripper with its open and closed positions from the multiplier and offset.
 - the approach axis (:func:`approach_axis`): the axis of the grasp frame pointing from the arm's
@@ -244,11 +244,7 @@ def survey_gripper(
     fingers = _tips(body, [j for j, _, _ in kept])
     width = 0.0
     if not prismatic:
-        for joint, open_, _ in kept:
-            body.set_joint(joint.name, open_)
-        width = _width(body, [j for j, _, _ in kept], grasp, approach)
-        for joint, _, _ in kept:
-            body.set_joint(joint.name, 0.0)
+        width = _width(body, kept, grasp, approach)
     efforts = [j.effort for j, _, _ in kept if j.effort and j.effort > 0]
     speeds = [j.velocity for j, _, _ in kept if j.velocity and j.velocity > 0]
     unit = "m" if prismatic else "rad"
@@ -289,20 +285,30 @@ def _tips(body: Body, kept: list[JointLike]) -> list[str]:
     return out
 
 
-def _width(body: Body, kept: list[JointLike], grasp: str, approach: np.ndarray) -> float:
-    """Largest distance across the approach axis between two fingers' shapes (open)."""
-    origin = body.frame(grasp)[0]
+def _width(
+    body: Body, kept: list[tuple[JointLike, float, float]], grasp: str, approach: np.ndarray
+) -> float:
+    """How wide the gripper opens, across the approach axis: the largest distance between two
+    fingers' shapes when open; for a single jaw, how far its shapes move from closed to open."""
     axis = approach / max(float(np.linalg.norm(approach)), 1e-9)
-    points = []
-    for j in kept:
-        centre = body.shape_centre(_finger_links(body, j))
-        if centre is not None:
-            d = centre - origin
-            points.append(d - float(np.dot(d, axis)) * axis)
-    if len(points) == 1:
-        return 2.0 * float(np.linalg.norm(points[0]))
+
+    def across(points: list[np.ndarray]) -> list[np.ndarray]:
+        return [p - float(np.dot(p, axis)) * axis for p in points]
+
+    def centres(which: int) -> list[np.ndarray]:
+        for joint, open_, closed in kept:
+            body.set_joint(joint.name, (open_, closed)[which])
+        out = [body.shape_centre(_finger_links(body, j)) for j, _, _ in kept]
+        for joint, _, _ in kept:
+            body.set_joint(joint.name, 0.0)
+        return [c for c in out if c is not None]
+
+    opened = across(centres(0))
+    if len(opened) == 1:
+        closed = across(centres(1))
+        return float(np.linalg.norm(opened[0] - closed[0])) if closed else 0.0
     return max(
-        (float(np.linalg.norm(a - b)) for i, a in enumerate(points) for b in points[i + 1:]),
+        (float(np.linalg.norm(a - b)) for i, a in enumerate(opened) for b in opened[i + 1:]),
         default=0.0,
     )
 
