@@ -81,11 +81,25 @@ def ur3_urdf() -> Path:
     )
 
 
+def _in_package(rest: str, folder: Path) -> Path | None:
+    """``package://PKG/...`` found beside a URDF, as ROS finds it: the nearest folder above
+    ``folder`` named ``PKG`` (the package's root), or a ``PKG`` folder beside one of them."""
+    package, _, inner = rest.partition("/")
+    for above in (folder.resolve(), *folder.resolve().parents):
+        for root in (above, above / package):
+            if root.name == package and (root / inner).exists():
+                return (root / inner).resolve()
+    return None
+
+
 def resolve_uri(uri: str, relative_to: Path | None = None) -> Path:
     """Turn an asset URI into an absolute path on this machine (the file may not exist)."""
     if uri.startswith("package://"):
         rest = uri[len("package://") :]
-        return example_robot_data_share() / rest
+        shared = example_robot_data_share() / rest
+        if shared.exists() or relative_to is None:
+            return shared
+        return _in_package(rest, relative_to) or shared
     if uri.startswith("pybullet_data://"):
         return pybullet_data_dir() / uri[len("pybullet_data://") :]
     if uri.startswith("file://"):

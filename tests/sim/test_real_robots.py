@@ -223,3 +223,24 @@ def test_recipe_frames_and_dropped_links(tmp_path: Path) -> None:
     path.write_text(bad)
     with pytest.raises(InputError, match="only a leaf link"):
         load_description(path)
+
+
+def test_package_meshes_resolve_against_the_urdfs_own_package(tmp_path: Path) -> None:
+    """``package://my_arm/...`` outside example-robot-data: found in the folder named after the
+    package above the URDF, as ROS finds it."""
+    import shutil
+
+    from bt_manip.sim.compose import composed_urdf
+
+    package = tmp_path / "ws" / "my_arm"
+    (package / "urdf").mkdir(parents=True)
+    (package / "meshes").mkdir()
+    mesh = ERD / "tiago_description" / "meshes" / "hey5" / "palm_collision.stl"
+    shutil.copy(mesh, package / "meshes" / "palm.stl")
+    (package / "urdf" / "arm.urdf").write_text(
+        '<robot name="arm"><link name="base"><collision><geometry>'
+        '<mesh filename="package://my_arm/meshes/palm.stl"/></geometry></collision></link>'
+        "</robot>\n"
+    )
+    text = composed_urdf(package / "urdf" / "arm.urdf").read_text()
+    assert str((package / "meshes" / "palm.stl").resolve()) in text
