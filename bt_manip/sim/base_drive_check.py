@@ -5,9 +5,9 @@ quarter turn on the spot at 1 rad/s (each clipped to what the base can do), thro
 :meth:`~bt_manip.sim.robot.Robot.set_base_twist`, in sim time. The achieved speed of a move is
 the distance (or yaw) covered over its steady part, after the first :data:`SETTLE_S` of
 acceleration, divided by that part's duration. Over the steady part it also samples what could
-hold the base back: the robot's links other than the driven wheels that touch the floor (with
-their normal forces), the wheels' own speed and motor torque (skid-steer), or the virtual
-joints' motor effort (holonomic). :func:`explain` turns a slow move into one line of plain
+hold the base back: the robot's links other than the driven wheels that drag on the floor (with
+their normal and friction forces), the wheels' own speed and motor torque (skid-steer), or the
+virtual joints' motor effort (holonomic). :func:`explain` turns a slow move into one line of plain
 words naming the likeliest cause.
 
 PyBullet reports a contact on the link that carries a collision shape; a link on a ``fixed``
@@ -48,6 +48,9 @@ SAMPLE_EVERY = 4
 """Steps between two samples of contacts and motors."""
 CONTACT_SHARE = 0.1
 """A link counts as touching the floor when it does in at least this share of the samples."""
+DRAG_MIN = 1.0
+"""N of mean friction force from which a link touching the floor drags (a frictionless caster
+carries weight but does not)."""
 WHEELS_TURN = 0.9
 """Wheels turning at this fraction of their commanded speed or more turn as commanded."""
 AT_LIMIT = 0.95
@@ -64,6 +67,8 @@ class FloorContact:
     """Type of the joint above the link in the URDF (``fixed``, ``continuous``, ...; ``root``)."""
     force: float
     """N: normal force, averaged over the samples of the steady part."""
+    drag: float
+    """N: friction force, averaged likewise."""
     share: float
     """Share of the samples in which it touched."""
 
@@ -77,6 +82,7 @@ class BaseMove:
     achieved: float
     time_s: float
     contacts: tuple[FloorContact, ...] = ()
+    """The links other than the driven wheels that dragged on the floor, heaviest first."""
     wheel_rate: float | None = None
     """Skid-steer: the speed (drive, m/s) or yaw rate (turn, rad/s) the wheels' own mean speeds
     give through ``wheel_radius`` and ``track_width``; None for a holonomic base."""
@@ -175,6 +181,7 @@ class _Samples:
     def __init__(self) -> None:
         self.n = 0
         self.force: dict[str, float] = {}
+        self.drag: dict[str, float] = {}
         self.seen: dict[str, int] = {}
         self.left = 0.0
         self.right = 0.0
@@ -186,12 +193,13 @@ class _Samples:
         self.n += 1
         wheels = set(robot.wheel_ids_left + robot.wheel_ids_right)
         touching: set[str] = set()
-        for c in robot.contacts(floor):
-            index = robot.link_index(c.link)
-            if index in wheels:
+        for c in pbq.contacts(robot.client, robot.body, floor):
+            if c.link_a in wheels:
                 continue
-            name = _attribute(robot, index, c.position, kinds)
+            name = _attribute(robot, c.link_a, c.position_on_a, kinds)
             self.force[name] = self.force.get(name, 0.0) + c.normal_force
+            friction = math.hypot(c.lateral_friction_1, c.lateral_friction_2)
+            self.drag[name] = self.drag.get(name, 0.0) + friction
             touching.add(name)
         for name in touching:
             self.seen[name] = self.seen.get(name, 0) + 1
@@ -215,9 +223,12 @@ class _Samples:
     def contacts(self, kinds: dict[str, tuple[str, bool]]) -> tuple[FloorContact, ...]:
         n = max(self.n, 1)
         found = [
-            FloorContact(name, kinds.get(name, ("fixed", True))[0], self.force[name] / n, seen / n)
+            FloorContact(
+                name, kinds.get(name, ("fixed", True))[0], self.force[name] / n,
+                self.drag[name] / n, seen / n,
+            )
             for name, seen in self.seen.items()
-            if seen / n >= CONTACT_SHARE
+            if seen / n >= CONTACT_SHARE and self.drag[name] / n >= DRAG_MIN
         ]
         return tuple(sorted(found, key=lambda c: -c.force))
 
@@ -237,7 +248,7 @@ class _Samples:
 def _attribute(
     robot: Robot,
     index: int,
-    point: tuple[float, float, float],
+    point: tuple[float, ...],
     kinds: dict[str, tuple[str, bool]],
 ) -> str:
     """The URDF link a contact on PyBullet link ``index`` at ``point`` is on: the link itself,
@@ -269,18 +280,20 @@ def _link_kinds(robot: Robot) -> dict[str, tuple[str, bool]]:
 
 def explain(move: BaseMove, robot: Robot) -> str:
     """One line: how slow ``move`` was and the likeliest cause, in plain words."""
+    percent = 100.0 * move.achieved / max(move.commanded, 1e-9)
     head = (
-        f"base {move.phase}: {move.achieved:.2f} {move.unit} of {move.commanded:.2f} {move.unit} "
-        f"commanded ({100.0 * move.achieved / max(move.commanded, 1e-9):.0f} %)"
+        f"base {move.phase}: {_num(move.achieved)} {move.unit} of "
+        f"{_num(move.commanded)} {move.unit} commanded ({percent:.0f} %)"
     )
     if move.contacts:
         return f"{head}: {_touching(move, robot)}"
-    return f"{head}: nothing but the driven wheels touches the floor; {_motors(move, robot)}"
+    return f"{head}: nothing but the driven wheels drags on the floor; {_motors(move, robot)}"
 
 
 def _touching(move: BaseMove, robot: Robot) -> str:
     names = ", ".join(c.link for c in move.contacts)
     force = sum(c.force for c in move.contacts)
+    drag = sum(c.drag for c in move.contacts)
     kinds = {c.kind for c in move.contacts}
     if len(kinds) == 1:
         (kind,) = kinds
@@ -290,7 +303,8 @@ def _touching(move: BaseMove, robot: Robot) -> str:
     verb = "touches" if len(move.contacts) == 1 else "touch"
     share = f" of the robot's {move.weight:.0f} N weight" if robot.has_wheels else ""
     return (
-        f"{names} {verb} the floor ({what} carrying {force:.0f} N{share}); give passive wheels "
+        f"{names} {verb} the floor ({what} carrying {force:.0f} N{share}, dragging with "
+        f"{drag:.0f} N); give passive wheels "
         f"and casters frictionless contact in the descriptor's contacts: section ({README})"
     )
 
@@ -308,7 +322,7 @@ def _motors(move: BaseMove, robot: Robot) -> str:
             f"the base's motors use {100.0 * move.effort:.0f} % of their limit; check the "
             f"virtual joints' speed limits and damping in the URDF"
         )
-    wheels = f"{move.wheel_rate:.2f} {move.unit}"
+    wheels = f"{_num(move.wheel_rate)} {move.unit}"
     torque = f"wheel_max_torque {base.wheel_max_torque:g} N m"
     if move.wheel_rate >= WHEELS_TURN * move.commanded:
         if move.phase == "turn":
@@ -332,6 +346,11 @@ def _motors(move: BaseMove, robot: Robot) -> str:
         f"the wheels turn for only {wheels}, their motors at {100.0 * move.effort:.0f} % of "
         f"{torque}: check max_wheel_speed and the wheel joints' damping and friction"
     )
+
+
+def _num(value: float) -> str:
+    """``value`` to two decimals, never ``-0.00``."""
+    return f"{round(value, 2) + 0.0:.2f}"
 
 
 def _step(client: int, n: int) -> None:

@@ -149,6 +149,15 @@ def test_frictionless_casters_pass_the_drive_and_the_turn(tmp_path: Path) -> Non
     assert report.causes == []
 
 
+def test_weak_wheel_motors_are_named_when_nothing_drags(tmp_path: Path) -> None:
+    path = _descriptor(tmp_path, FREE)
+    path.write_text(path.read_text().replace("wheel_max_torque: 20.0", "wheel_max_torque: 0.05"))
+    report = check_robot(RobotDescription.load(path))
+    assert _base_rows(report) == {"drive": False, "turn": False}, report.table()
+    drive = next(c for c in report.causes if c.startswith("base drive:"))
+    assert "nothing but the driven wheels drags" in drive and "wheel_max_torque" in drive, drive
+
+
 @pytest.mark.parametrize("name", ["husky_ur3", "omni_sawyer"])
 def test_shipped_mobile_robots_pass_the_whole_check(name: str) -> None:
     report = check_robot(RobotDescription.load(name))
