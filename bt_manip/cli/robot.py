@@ -98,4 +98,6 @@ def _written_here(name_or_path: str) -> str:
 def cmd_robot_check(args: argparse.Namespace) -> int:
     report = check_robot(RobotDescription.load(_written_here(args.robot)))
     print(report.table())
+    for cause in report.causes:
+        print(cause)
     return 0 if report.ok else 1

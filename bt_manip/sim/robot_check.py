@@ -1,14 +1,28 @@
 """``bt-manip robot check``: does a described robot move as its descriptor says?
 
 :func:`check_robot` spawns the robot alone in an empty headless PyBullet world (a floor for
-mobile bases, none for fixed arms), puts the arm in its ``home`` state, then moves each arm
-joint in turn to its lower limit, its upper limit (each less a margin) and back, in sim time
-with the robot's own position controllers. A move passes when the joint settles within the
-tolerance of its target before a time-out computed from the joint's speed limit. The gripper,
-when there is one, must open to its full opening and close again. A holonomic base then drives
-a 0.3 m square (x, then y, then back) and turns a quarter turn and back, through
-:meth:`~bt_manip.sim.robot.Robot.set_base_velocity`; each move is one row of its virtual
-joint. The result is a table (:meth:`CheckReport.table`) and ``ok``.
+mobile bases, none for fixed arms; friction as in every bt-manip world), puts the arm in its
+``home`` state, then moves each arm joint in turn to its lower limit, its upper limit (each less
+a margin) and back, in sim time with the robot's own position controllers. A move passes when
+the joint settles within the tolerance of its target before a time-out computed from the
+joint's speed limit. The gripper, when there is one, must open to its full opening and close
+again. A holonomic base then drives a 0.3 m square (x, then y, then back) and turns a quarter
+turn and back, through :meth:`~bt_manip.sim.robot.Robot.set_base_velocity`; each move is one
+row of its virtual joint.
+
+Last, every base that is not fixed (skid-steer or holonomic) drives 2 m straight at 0.5 m/s and
+turns a quarter turn on the spot at 1 rad/s, each clipped to the base's own top speed, through
+:meth:`~bt_manip.sim.robot.Robot.set_base_twist` (:mod:`bt_manip.sim.base_drive_check`). These
+are the rows ``base drive`` and ``base turn``: their target is the commanded speed (m/s, rad/s)
+and what they reach the speed achieved over the steady part of the move (its first 0.5 s of
+acceleration left out), in sim time. A speed row passes when it achieves at least 80 % of the
+commanded speed. For each one that does not, :attr:`CheckReport.causes` holds a line of plain
+words: the links other than the driven wheels that touch the floor and the force they carry
+(casters that drag: give them frictionless contact in the descriptor's ``contacts:`` section),
+or, when nothing else touches, what the wheels did (they turned as commanded and slipped, or
+their motors were at their torque limit).
+
+The result is a table (:meth:`CheckReport.table`), the causes, and ``ok`` (every row passed).
 """
 
 from __future__ import annotations
@@ -18,6 +32,7 @@ from dataclasses import dataclass, field
 
 import pybullet as pb
 
+from bt_manip.sim.base_drive_check import MIN_FRACTION, drive_and_turn, explain
 from bt_manip.sim.robot import Robot
 from bt_manip.sim.robot_description import RobotDescription
 
@@ -48,9 +63,14 @@ class MoveResult:
     target: float
     reached: float
     time_s: float
+    speed: bool = False
+    """A speed row (the base's ``drive`` and ``turn``): target and reached are speeds, and it
+    passes when it reaches at least :data:`MIN_FRACTION` of the target."""
 
     @property
     def ok(self) -> bool:
+        if self.speed:
+            return self.reached >= MIN_FRACTION * self.target
         tol = GRIPPER_TOLERANCE if self.joint == "gripper" else TOLERANCE
         return abs(self.reached - self.target) <= tol
 
@@ -61,6 +81,8 @@ class CheckReport:
 
     robot: str
     moves: list[MoveResult] = field(default_factory=list)
+    causes: list[str] = field(default_factory=list)
+    """One line of plain words for each speed row that failed: why the base was slow."""
 
     @property
     def ok(self) -> bool:
@@ -96,18 +118,23 @@ def check_robot(description: RobotDescription) -> CheckReport:
     try:
         pb.setGravity(0, 0, -9.81, physicsClientId=client)
         pb.setTimeStep(1.0 / RATE_HZ, physicsClientId=client)
+        # friction as in every bt-manip world (World._setup_physics): a pyramid, not a cone
+        pb.setPhysicsEngineParameter(
+            enableConeFriction=0, deterministicOverlappingPairs=1, physicsClientId=client
+        )
+        floor = -1
         if description.base.type != "fixed":
             import pybullet_data
 
             pb.setAdditionalSearchPath(pybullet_data.getDataPath(), physicsClientId=client)
-            pb.loadURDF("plane.urdf", physicsClientId=client)
+            floor = pb.loadURDF("plane.urdf", physicsClientId=client)
         robot = Robot.spawn(client, description, 0.0, 0.0, 0.0)
-        return _run(client, robot)
+        return _run(client, robot, floor)
     finally:
         pb.disconnect(client)
 
 
-def _run(client: int, robot: Robot) -> CheckReport:
+def _run(client: int, robot: Robot, floor: int) -> CheckReport:
     desc = robot.description
     report = CheckReport(desc.name)
     start = list(desc.state("home"))
@@ -140,6 +167,13 @@ def _run(client: int, robot: Robot) -> CheckReport:
             )
     if robot.is_holonomic:
         _check_holonomic(client, robot, report)
+    if robot.is_holonomic or robot.has_wheels:
+        for move in drive_and_turn(client, robot, floor):
+            report.moves.append(
+                MoveResult("base", move.phase, move.commanded, move.achieved, move.time_s, True)
+            )
+            if not move.ok:
+                report.causes.append(explain(move, robot))
     return report
 
 

@@ -1,0 +1,168 @@
+"""``robot check`` drives a wheeled or holonomic base straight and turns it on the spot, and
+names what holds a slow base back: a differential-drive robot written here whose casters drag
+on the floor (high friction, on ``fixed`` joints) fails, with frictionless casters it passes,
+and the shipped husky_ur3 and omni_sawyer pass the whole check."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from bt_manip.cli import main
+from bt_manip.sim.robot_check import CheckReport, check_robot
+from bt_manip.sim.robot_description import RobotDescription
+
+WHEEL_RADIUS = 0.08
+CASTERS = ("caster_front", "caster_back")
+INERTIA = '<inertia ixx="{i}" ixy="0" ixz="0" iyy="{i}" iyz="0" izz="{i}"/>'
+DRAG = "{lateral_friction: 1.0, rolling_friction: 0.0, spinning_friction: 0.0}"
+FREE = "{lateral_friction: 0.0, rolling_friction: 0.0, spinning_friction: 0.0}"
+
+
+def _link(
+    name: str, mass: float, collision: str = "", contact: str = "", com: str = "0 0 0"
+) -> str:
+    return (
+        f'  <link name="{name}">{collision}{contact}<inertial><origin xyz="{com}"/>'
+        f'<mass value="{mass}"/>{INERTIA.format(i=max(mass * 0.01, 1e-4))}</inertial></link>'
+    )
+
+
+def _urdf(tmp_path: Path, contact: str = "") -> Path:
+    """A 10 kg box chassis (frame at the wheel axles, 8 cm up, its centre of mass 10 cm ahead of
+    them) on two 8 cm wheels on continuous joints, left and right, and two 4 cm sphere casters on
+    fixed joints, front and back, reaching the floor: the front one carries about half the
+    weight. A one-joint arm on top. ``contact`` (a ``<contact>`` element) is given
+    to the chassis and both casters alike."""
+    wheel = f'<collision><origin rpy="1.5708 0 0"/><geometry><cylinder radius="{WHEEL_RADIUS}" ' \
+        'length="0.04"/></geometry></collision>'
+    ball = '<collision><geometry><sphere radius="0.04"/></geometry></collision>'
+    lines = [
+        '<robot name="diffy">',
+        _link("chassis", 10.0, '<collision><origin xyz="0 0 0.05"/><geometry>'
+              '<box size="0.4 0.3 0.1"/></geometry></collision>', contact, com="0.1 0 0.05"),
+    ]
+    for side, y in (("left", 0.18), ("right", -0.18)):
+        lines += [
+            f'  <joint name="{side}_wheel" type="continuous"><parent link="chassis"/>'
+            f'<child link="{side}_wheel_link"/><origin xyz="0 {y} 0"/><axis xyz="0 1 0"/>'
+            "</joint>",
+            _link(f"{side}_wheel_link", 1.0, wheel),
+        ]
+    for name, x in zip(CASTERS, (0.15, -0.15), strict=True):
+        lines += [
+            f'  <joint name="{name}_joint" type="fixed"><parent link="chassis"/>'
+            f'<child link="{name}"/><origin xyz="{x} 0 -0.04"/></joint>',
+            _link(name, 0.5, ball, contact),
+        ]
+    lines += [
+        '  <joint name="mount_joint" type="fixed"><parent link="chassis"/><child link="mount"/>'
+        '<origin xyz="0 0 0.1"/></joint>',
+        _link("mount", 0.2),
+        '  <joint name="j1" type="revolute"><parent link="mount"/><child link="tip"/>'
+        '<origin xyz="0 0 0.05"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1.5" upper="1.5" velocity="1" effort="10"/></joint>',
+        _link("tip", 0.2, '<collision><origin xyz="0 0 0.05"/><geometry>'
+              '<cylinder radius="0.02" length="0.1"/></geometry></collision>'),
+        "</robot>",
+    ]
+    path = tmp_path / "diffy.urdf"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _descriptor(tmp_path: Path, caster_contact: str | None, urdf_contact: str = "") -> Path:
+    """``diffy.yaml`` for :func:`_urdf`; ``caster_contact`` (a flow mapping) replaces both
+    casters' contact through the recipe's ``contacts:`` section."""
+    _urdf(tmp_path, urdf_contact)
+    if caster_contact is None:
+        source = "urdf: diffy.urdf"
+    else:
+        rows = "".join(f"    {name}: {caster_contact}\n" for name in CASTERS)
+        source = f"urdf:\n  base: diffy.urdf\n  contacts:\n{rows}"
+    text = f"""name: diffy
+{source.rstrip()}
+spawn_height: {WHEEL_RADIUS + 0.001}
+base:
+  type: skid_steer
+  left_wheels: [left_wheel]
+  right_wheels: [right_wheel]
+  wheel_radius: {WHEEL_RADIUS}
+  track_width: 0.36
+  max_wheel_speed: 12.0
+  wheel_max_torque: 20.0
+arm:
+  base_link: mount
+  joints: [j1]
+  velocity_limits: [1.0]
+end_effector: tip
+grasp_frame: tip
+states:
+  home: [0.0]
+  tuck: [0.0]
+footprint:
+  length: 0.5
+  width: 0.44
+"""
+    path = tmp_path / "diffy.yaml"
+    path.write_text(text)
+    return path
+
+
+def _base_rows(report: CheckReport) -> dict[str, bool]:
+    return {m.phase: m.ok for m in report.moves if m.joint == "base"}
+
+
+def test_dragging_casters_fail_the_drive_and_are_named(
+    tmp_path: Path, capsys: pytest.CaptureFixture
+) -> None:
+    path = _descriptor(tmp_path, DRAG)
+    report = check_robot(RobotDescription.load(path))
+    rows = _base_rows(report)
+    assert set(rows) == {"drive", "turn"}
+    assert not rows["drive"] and not report.ok, report.table()
+    drive = next(c for c in report.causes if c.startswith("base drive:"))
+    assert "caster_front" in drive and "caster_back" in drive, drive
+    assert "touch the floor" in drive and "fixed links" in drive and "contacts:" in drive
+    # the arm moves still pass: only the base is slow
+    assert all(m.ok for m in report.moves if m.joint != "base")
+    assert main(["robot", "check", str(path)]) == 1
+    out = capsys.readouterr().out
+    assert "moves missed" in out and "base drive:" in out and "caster_front" in out
+
+
+def test_casters_folded_into_the_chassis_are_still_named(tmp_path: Path) -> None:
+    """Casters whose contact is the chassis's are folded into it when loaded headless; the
+    cause names them all the same, not the chassis."""
+    sticky = "<contact><lateral_friction value=\"1.0\"/></contact>"
+    report = check_robot(RobotDescription.load(_descriptor(tmp_path, None, sticky)))
+    assert not _base_rows(report)["drive"], report.table()
+    drive = next(c for c in report.causes if c.startswith("base drive:"))
+    assert "caster_front" in drive and "caster_back" in drive and "chassis" not in drive, drive
+
+
+def test_frictionless_casters_pass_the_drive_and_the_turn(tmp_path: Path) -> None:
+    report = check_robot(RobotDescription.load(_descriptor(tmp_path, FREE)))
+    assert report.ok, report.table() + "\n" + "\n".join(report.causes)
+    assert _base_rows(report) == {"drive": True, "turn": True}
+    assert report.causes == []
+
+
+def test_weak_wheel_motors_are_named_when_nothing_drags(tmp_path: Path) -> None:
+    path = _descriptor(tmp_path, FREE)
+    path.write_text(path.read_text().replace("wheel_max_torque: 20.0", "wheel_max_torque: 0.05"))
+    report = check_robot(RobotDescription.load(path))
+    assert _base_rows(report) == {"drive": False, "turn": False}, report.table()
+    drive = next(c for c in report.causes if c.startswith("base drive:"))
+    assert "nothing but the driven wheels drags" in drive and "wheel_max_torque" in drive, drive
+
+
+@pytest.mark.parametrize("name", ["husky_ur3", "omni_sawyer"])
+def test_shipped_mobile_robots_pass_the_whole_check(name: str) -> None:
+    report = check_robot(RobotDescription.load(name))
+    assert report.ok, report.table() + "\n" + "\n".join(report.causes)
+    assert list(_base_rows(report)) == ["drive", "turn"]
+    if name == "omni_sawyer":  # the square is still driven before
+        phases = [m.phase for m in report.moves if m.joint.startswith("base_")]
+        assert phases == ["+", "+", "back", "back", "turn", "back"]
