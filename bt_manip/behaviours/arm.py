@@ -348,7 +348,8 @@ class MoveToPose(JointMove):
     closing across its thinner side; ``orientation`` and ``match_object_yaw`` are then not used).
     The orientation is ``orientation`` (quaternion x;y;z;w, world frame; default ``0;1;0;0``: the
     tool pointing straight down). The frame placed is the robot's grasp frame, whose z axis is
-    the gripper's approach direction (the descriptor's ``approach_axis``, see robots/README.md). With ``match_object_yaw`` the orientation is turned about the
+    the gripper's approach direction (the descriptor's ``approach_axis``, see robots/README.md).
+    With ``match_object_yaw`` the orientation is turned about the
     vertical to the object's yaw (modulo 90 deg, the turn nearest the current wrist), so a parallel
     gripper closes on two faces of a box; with ``free_yaw`` the rotation about the tool axis is left
     to the solver. ``path="line"`` moves the tool on a straight line from where it is (orientation

@@ -160,7 +160,7 @@ def _run(client: int, robot: Robot, floor: int) -> CheckReport:
         moves = (("open", g.max_opening), ("close", g.min_opening), ("open", g.max_opening))
         for phase, opening in moves:
             robot.set_gripper(opening)
-            timeout = g.max_opening / len(g.joints) / g.max_speed * 2.0 + 2.0
+            timeout = g.stroke_time * 2.0 + 2.0
             took = _until(client, timeout, lambda o=opening: abs(robot.gripper_opening() - o))
             report.moves.append(
                 MoveResult("gripper", phase, opening, robot.gripper_opening(), took)
