@@ -244,3 +244,15 @@ def test_package_meshes_resolve_against_the_urdfs_own_package(tmp_path: Path) ->
     )
     text = composed_urdf(package / "urdf" / "arm.urdf").read_text()
     assert str((package / "meshes" / "palm.stl").resolve()) in text
+
+
+def test_mimic_joint_follows_its_leader(tmp_path: Path) -> None:
+    """The Panda's second finger mimics the first: naming the first is enough."""
+    notes: list[str] = []
+    desc = init_descriptor(InitOptions(
+        PANDA, "panda_link0", "panda_hand", tmp_path / "panda.yaml",
+        gripper=("panda_finger_joint1",), grasp_frame="panda_hand_tcp",
+    ), notes)
+    assert desc.gripper.joints == ("panda_finger_joint1", "panda_finger_joint2")
+    assert desc.gripper.kind == "parallel" and desc.gripper.max_opening == pytest.approx(0.08)
+    assert any("'panda_finger_joint2' mimics 'panda_finger_joint1'" in n for n in notes)
