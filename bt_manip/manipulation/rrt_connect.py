@@ -1,0 +1,252 @@
+"""Collision-free joint paths: bidirectional RRT-Connect, then shortcutting.
+
+:func:`plan` grows one tree from the start and one from the goal (RRT-Connect: each round one
+tree extends toward a random configuration and the other tries to connect to the new node all
+the way), joins them and shortcuts the path. Everything is deterministic: the random stream is
+a ``numpy`` generator seeded by the caller (from the episode seed and the node's path), and the
+budget is a count of collision checks (:attr:`PlanOptions.max_checks`), never wall time, so a
+plan is the same on every machine. Segments are checked at :attr:`PlanOptions.step` rad per
+joint at most.
+
+A plan that cannot be made raises :class:`PlanError` whose message says why: the start or the
+goal in collision (naming what touches), outside the joint limits, or no path within the budget
+(with how far each tree grew).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bt_manip.manipulation.collision_scene import CollisionScene
+
+__all__ = ["PlanError", "PlanOptions", "PlanResult", "path_length", "plan", "shortcut"]
+
+
+class PlanError(ValueError):
+    """No collision-free path; the message says why."""
+
+
+@dataclass(frozen=True)
+class PlanOptions:
+    """Budgets and resolutions of one plan (counts and radians, never seconds)."""
+
+    step: float = 0.05
+    """Largest joint move (rad) between two collision checks along a segment."""
+    extend: float = 0.4
+    """Largest joint-space distance (rad, Euclidean) a tree grows by in one extension."""
+    max_checks: int = 200_000
+    """Collision checks the search may spend before giving up."""
+    shortcut_rounds: int = 60
+    """Random shortcut attempts after a path is found."""
+    goal_bias: float = 0.05
+    """Share of samples that are the other tree's root."""
+    validate_step: float = 0.01
+    """The found path is checked again at this resolution (rad per joint); a segment that
+    clips an obstacle between the coarser checks is planned again at this resolution."""
+
+
+@dataclass(frozen=True)
+class PlanResult:
+    """A path from start to goal (every segment free at ``step``) and what it cost."""
+
+    path: list[np.ndarray]
+    samples: int
+    checks: int
+    nodes: tuple[int, int]
+    """Nodes of the start and goal trees when they met."""
+
+
+class _Tree:
+    def __init__(self, root: np.ndarray, capacity: int) -> None:
+        self.q = np.empty((capacity, root.size))
+        self.parent = np.empty(capacity, dtype=np.int64)
+        self.q[0] = root
+        self.parent[0] = -1
+        self.n = 1
+
+    def add(self, q: np.ndarray, parent: int) -> int:
+        if self.n == len(self.q):
+            self.q = np.concatenate([self.q, np.empty_like(self.q)])
+            self.parent = np.concatenate([self.parent, np.empty_like(self.parent)])
+        self.q[self.n] = q
+        self.parent[self.n] = parent
+        self.n += 1
+        return self.n - 1
+
+    def nearest(self, q: np.ndarray) -> int:
+        d = self.q[: self.n] - q
+        return int(np.argmin(np.einsum("ij,ij->i", d, d)))
+
+    def branch(self, index: int) -> list[np.ndarray]:
+        out = []
+        while index >= 0:
+            out.append(self.q[index].copy())
+            index = int(self.parent[index])
+        return out
+
+
+def _steer(a: np.ndarray, b: np.ndarray, extend: float) -> np.ndarray:
+    d = b - a
+    dist = float(np.linalg.norm(d))
+    return b.copy() if dist <= extend else a + d * (extend / dist)
+
+
+def _check_end(scene: CollisionScene, q: np.ndarray, which: str) -> None:
+    if not scene.within_limits(q):
+        bad = [scene.joint_names[i] for i in range(q.size)
+               if not scene.lower[i] - 1e-9 <= q[i] <= scene.upper[i] + 1e-9]
+        raise PlanError(f"the {which} is outside the joint limits of {', '.join(bad)}")
+    if scene.collides(q):
+        pairs = scene.contacts(q)
+        named = ", ".join(f"{a} touches {b}" for a, b in pairs[:4])
+        raise PlanError(f"the {which} is in collision: {named}")
+
+
+def plan(
+    scene: CollisionScene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    rng: np.random.Generator,
+    options: PlanOptions = PlanOptions(),
+) -> PlanResult:
+    """A collision-free path ``start`` -> ``goal`` (see the module docstring)."""
+    start = np.asarray(start, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    first = scene.checks
+    _check_end(scene, start, "start")
+    _check_end(scene, goal, "goal")
+    if scene.segment_free(start, goal, options.step):
+        return PlanResult([start, goal], 0, scene.checks - first, (1, 1))
+    lo = np.where(np.isfinite(scene.lower), scene.lower, -math.pi)
+    hi = np.where(np.isfinite(scene.upper), scene.upper, math.pi)
+    trees = (_Tree(start, 1024), _Tree(goal, 1024))
+    samples = 0
+    a, b = 0, 1
+    while scene.checks - first < options.max_checks:
+        samples += 1
+        if rng.random() < options.goal_bias:
+            target = trees[b].q[0].copy()
+        else:
+            target = rng.uniform(lo, hi)
+        grown = _extend(scene, trees[a], target, options)
+        if grown is not None:
+            met = _connect(scene, trees[b], trees[a].q[grown], options)
+            if met is not None:
+                one, other = trees[a].branch(grown), trees[b].branch(met)
+                path = one[::-1] + other if a == 0 else other[::-1] + one
+                path = _dedupe(path)
+                path = shortcut(scene, path, rng, options)
+                path = _validated(scene, path, rng, options, first)
+                return PlanResult(path, samples, scene.checks - first,
+                                  (trees[0].n, trees[1].n))
+        a, b = b, a
+    raise PlanError(
+        f"no path within {options.max_checks} collision checks ({samples} samples; the start "
+        f"tree grew to {trees[0].n} nodes, the goal tree to {trees[1].n})"
+    )
+
+
+def _validated(
+    scene: CollisionScene, path: list[np.ndarray], rng: np.random.Generator,
+    options: PlanOptions, first: int,
+) -> list[np.ndarray]:
+    """``path`` with every segment free at ``validate_step``: a segment that is not is planned
+    again at that resolution (within what is left of the budget)."""
+    if options.validate_step >= options.step:
+        return path
+    out = [path[0]]
+    for a, b in itertools.pairwise(path):
+        if scene.segment_free(a, b, options.validate_step):
+            out.append(b)
+            continue
+        left = options.max_checks - (scene.checks - first)
+        fine = dataclasses.replace(options, step=options.validate_step, max_checks=max(left, 1))
+        out += plan(scene, a, b, rng, fine).path[1:]
+    return out
+
+
+def _extend(
+    scene: CollisionScene, tree: _Tree, target: np.ndarray, options: PlanOptions
+) -> int | None:
+    near = tree.nearest(target)
+    q = _steer(tree.q[near], target, options.extend)
+    if scene.segment_free(tree.q[near], q, options.step):
+        return tree.add(q, near)
+    return None
+
+
+def _connect(
+    scene: CollisionScene, tree: _Tree, target: np.ndarray, options: PlanOptions
+) -> int | None:
+    """Grow ``tree`` toward ``target`` until it reaches it (its index) or is blocked (None)."""
+    near = tree.nearest(target)
+    while True:
+        q = _steer(tree.q[near], target, options.extend)
+        if not scene.segment_free(tree.q[near], q, options.step):
+            return None
+        near = tree.add(q, near)
+        if np.array_equal(q, target):
+            return near
+
+
+def _dedupe(path: list[np.ndarray]) -> list[np.ndarray]:
+    out = [path[0]]
+    for q in path[1:]:
+        if not np.array_equal(q, out[-1]):
+            out.append(q)
+    return out
+
+
+def path_length(path: list[np.ndarray]) -> float:
+    """Sum of the Euclidean joint-space lengths of the segments (rad)."""
+    return float(sum(np.linalg.norm(b - a) for a, b in itertools.pairwise(path)))
+
+
+def shortcut(
+    scene: CollisionScene, path: list[np.ndarray], rng: np.random.Generator,
+    options: PlanOptions = PlanOptions(),
+) -> list[np.ndarray]:
+    """``path`` with waypoints skipped where the straight segment between them is free: first
+    greedily from the start, then ``options.shortcut_rounds`` random pairs of points on it."""
+    path = _greedy(scene, path, options.step)
+    for _ in range(options.shortcut_rounds):
+        if len(path) < 3:
+            break
+        total = path_length(path)
+        if total <= 0.0:
+            break
+        s, t = sorted(rng.uniform(0.0, total, 2))
+        (i, qa), (j, qb) = _point_at(path, s), _point_at(path, t)
+        if j <= i:
+            continue
+        if scene.segment_free(qa, qb, options.step):
+            path = [*path[:i + 1], qa, qb, *path[j + 1:]]
+            path = _dedupe(path)
+    return path
+
+
+def _greedy(scene: CollisionScene, path: list[np.ndarray], step: float) -> list[np.ndarray]:
+    out = [path[0]]
+    i = 0
+    while i < len(path) - 1:
+        j = len(path) - 1
+        while j > i + 1 and not scene.segment_free(path[i], path[j], step):
+            j -= 1
+        out.append(path[j])
+        i = j
+    return out
+
+
+def _point_at(path: list[np.ndarray], s: float) -> tuple[int, np.ndarray]:
+    """The point ``s`` rad along ``path`` and the index of the segment's first waypoint."""
+    for i, (a, b) in enumerate(itertools.pairwise(path)):
+        length = float(np.linalg.norm(b - a))
+        if s <= length or i == len(path) - 2:
+            return i, a + (b - a) * (min(s, length) / max(length, 1e-12))
+        s -= length
+    return len(path) - 2, path[-1]

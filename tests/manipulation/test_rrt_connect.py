@@ -1,0 +1,99 @@
+"""The arm's planning scene and RRT-Connect: a Panda (example-robot-data, its collision meshes)
+beside a wall. Paths are checked again on the exact meshes at 0.01 rad per joint."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+
+from bt_manip.manipulation.collision_scene import CollisionScene, Obstacle, never_colliding_pairs
+from bt_manip.manipulation.rrt_connect import PlanError, PlanOptions, path_length, plan
+from bt_manip.sim.assets import example_robot_data_share
+
+PANDA = example_robot_data_share() / "example-robot-data/robots/panda_description/urdf/panda.urdf"
+JOINTS = [f"panda_joint{i}" for i in range(1, 8)]
+HOME = np.array([0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785])
+LEFT = np.array([1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.785])
+RIGHT = np.array([-1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.785])
+
+
+def _pose(x: float, y: float, z: float) -> tuple[tuple[float, ...], ...]:
+    m = np.eye(4)
+    m[:3, 3] = (x, y, z)
+    return tuple(map(tuple, m))
+
+
+WALL = Obstacle("wall", "box", (0.3, 0.05, 0.9), _pose(0.5, 0.0, 0.45))
+
+
+def _scene(exact: bool = False, wall: bool = True) -> CollisionScene:
+    scene = CollisionScene(PANDA, JOINTS, locked={"panda_finger_joint1": 0.02,
+                                                  "panda_finger_joint2": 0.02}, exact=exact)
+    if wall:
+        scene.add_obstacle(WALL)
+    return scene
+
+
+def test_contacts_name_the_link_and_the_obstacle() -> None:
+    scene = _scene(wall=False)
+    assert not scene.collides(HOME)
+    scene.add_obstacle(Obstacle("crate", "box", (0.2, 0.2, 0.2), _pose(0.31, 0.0, 0.49)))
+    assert scene.collides(HOME)
+    links = {a for a, b in scene.contacts(HOME) if b == "crate"}
+    assert links & {"panda_hand", "panda_leftfinger", "panda_rightfinger", "panda_link7"}
+    scene.move_obstacle("crate", _pose(0.0, 1.5, 0.1))
+    assert not scene.collides(HOME)
+
+
+def test_direct_move_through_the_wall_is_blocked_and_the_plan_goes_round() -> None:
+    scene = _scene()
+    assert not scene.collides(LEFT) and not scene.collides(RIGHT)
+    assert not scene.segment_free(LEFT, RIGHT, 0.05)
+    result = plan(scene, LEFT, RIGHT, np.random.default_rng(7))
+    path = result.path
+    assert np.allclose(path[0], LEFT) and np.allclose(path[-1], RIGHT)
+    assert len(path) >= 3 and result.checks > 0
+    exact = _scene(exact=True)
+    for a, b in itertools.pairwise(path):
+        assert exact.segment_free(a, b, 0.01)
+    assert path_length(path) < 10.0
+
+
+def test_same_seed_same_path() -> None:
+    one = plan(_scene(), LEFT, RIGHT, np.random.default_rng(3)).path
+    two = plan(_scene(), LEFT, RIGHT, np.random.default_rng(3)).path
+    assert len(one) == len(two) and all(np.array_equal(a, b) for a, b in zip(one, two,
+                                                                             strict=True))
+
+
+def test_free_direct_move_is_one_segment() -> None:
+    result = plan(_scene(wall=False), LEFT, RIGHT, np.random.default_rng(0))
+    assert len(result.path) == 2 and result.samples == 0
+
+
+def test_start_in_collision_names_what_touches() -> None:
+    scene = _scene(wall=False)
+    scene.add_obstacle(Obstacle("crate", "box", (0.2, 0.2, 0.2), _pose(0.31, 0.0, 0.49)))
+    with pytest.raises(PlanError, match=r"the start is in collision: .*touches crate"):
+        plan(scene, HOME, RIGHT, np.random.default_rng(0))
+
+
+def test_goal_outside_the_limits_is_refused() -> None:
+    goal = RIGHT.copy()
+    goal[3] = 0.5  # panda_joint4 reaches -0.0698 at most
+    with pytest.raises(PlanError, match="goal is outside the joint limits of panda_joint4"):
+        plan(_scene(), LEFT, goal, np.random.default_rng(0))
+
+
+def test_budget_is_a_count_of_checks() -> None:
+    with pytest.raises(PlanError, match=r"no path within 40 collision checks .* start tree grew"):
+        plan(_scene(), LEFT, RIGHT, np.random.default_rng(0), PlanOptions(max_checks=40))
+
+
+def test_never_colliding_pairs_leave_out_pairs_that_do_collide() -> None:
+    scene = _scene(wall=False)
+    quiet = never_colliding_pairs(scene, samples=200, seed=1)
+    assert quiet  # many distant links never meet
+    assert frozenset(("panda_link0", "panda_link1")) not in quiet  # adjacent: never a pair
