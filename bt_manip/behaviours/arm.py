@@ -8,10 +8,12 @@ end the move with FAILURE and a reason; the arm then holds where it is.
 
 from __future__ import annotations
 
+import itertools
 import math
 import operator
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from py_trees.common import Status
@@ -24,7 +26,10 @@ from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix
 from bt_manip.kinematics.reasons import BEYOND_REACH, JOINT_LIMITS, NOT_CONVERGED, SOLVER_KNOBS
 from bt_manip.manipulation import cartesian
+from bt_manip.manipulation.arm_planner import PADDING, PLANNERS, ArmPlanner
 from bt_manip.manipulation.base_search import object_grasp
+from bt_manip.manipulation.rrt_connect import PlanError, path_length
+from bt_manip.sim.randomize import entity_rng
 
 if TYPE_CHECKING:
     from bt_manip.run.context import RobotServices
@@ -49,6 +54,21 @@ VIA = Port(
 )
 CORRECTION_SPEED = 0.2
 """Every joint may correct at no less than this fraction of its allowed speed."""
+PLANNED_VIA = 0.01
+"""rad: how close each joint passes a planned waypoint."""
+IK_GOAL_TRIES = 12
+"""Other IK seeds tried when the first solution for a pose is in collision."""
+CHECKS_PER_TICK = 4000
+"""Collision checks a planning node spends per tick at most (plus one search round)."""
+PLANNER = Port(
+    str, False, "auto: plan round obstacles when the direct joint move would collide (and pick "
+    "a collision-free IK solution); rrtconnect: always plan; none: move directly", "none",
+    Accepts(choices=PLANNERS),
+)
+PLAN_OUTPUTS: dict[str, PortInformation] = {
+    "path_length": PortInformation(float, False, "joint-space length of the move (rad)"),
+    "plan_samples": PortInformation(int, False, "samples the planner drew (0: direct move)"),
+}
 
 
 @dataclass
@@ -59,6 +79,11 @@ class Stage:
     command: np.ndarray
     joints: list[int]
     via: bool = False
+    plannable: bool = False
+    """A free joint move that may be replaced by a planned, collision-free one."""
+    planned: bool = False
+    """A waypoint of a planned path: passed within :data:`PLANNED_VIA` rad, so the arm keeps
+    to the checked path."""
 
 
 def to_radians(values: list[float], units: str) -> np.ndarray:
@@ -86,9 +111,120 @@ class JointMove(RobotAction):
         "check_collisions": CHECK,
     }
 
+    PLANS = False
+    """Whether the node has a ``planner`` port (its plannable stages may be planned)."""
+
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         """The stages of the move."""
         raise NotImplementedError
+
+    def grasping(self) -> str:
+        """The object the move goes to grasp ("" for none): allowed to touch the hand."""
+        return ""
+
+    def _planner(self) -> ArmPlanner | None:
+        """The robot's arm planner, or None when this node does not plan."""
+        if not self.PLANS or self.get_input("planner") == "none":
+            return None
+        services = self.services()
+        if services.arm_planner is None:
+            robot = self.robot()
+            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
+        planner: ArmPlanner = services.arm_planner
+        return planner
+
+    def _free_goal(
+        self, tip: str, pose: np.ndarray, q: np.ndarray, q_now: np.ndarray, free: bool,
+        then: Callable[[np.ndarray], list[np.ndarray]] | None = None,
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """``q`` (IK's answer for ``pose``) when the planning scene finds it free, and the
+        straight moves ``then`` makes from it (an approach) too; else another IK solution,
+        from other seeds, that is. Returns the goal and ``then``'s waypoints; ActionFailed
+        naming what every solution touches."""
+        planner = self._planner()
+        follow = then or (lambda _q: [])
+        if planner is None:
+            return q, follow(q)
+        scene = planner.scene()
+        planner.sync(scene, self.grasping(), (q_now,), movables=False)
+        step = planner.options.validate_step
+        rng = entity_rng(self.world.seed, f"ik-goal:{self.name}:{planner.plans}")
+        touched: dict[str, int] = {}
+        tries = 0
+        candidate: np.ndarray | None = q
+        for attempt in range(IK_GOAL_TRIES + 1):
+            if attempt:
+                seed = rng.uniform(np.maximum(scene.lower, -np.pi),
+                                   np.minimum(scene.upper, np.pi))
+                try:
+                    candidate = cartesian.solve(self.services(), tip, pose, seed, free)
+                except cartesian.CartesianError:
+                    continue
+            assert candidate is not None
+            tries += 1
+            try:
+                line = follow(candidate)
+            except cartesian.CartesianError:
+                continue
+            blocked = _first_blocked(scene, [candidate, *line], step)
+            if blocked is None:
+                return candidate, line
+            for a, b in scene.contacts(blocked):
+                touched[f"{a} touches {b}"] = touched.get(f"{a} touches {b}", 0) + 1
+        named = "; ".join(f"{k} ({v} of {tries})" for k, v in
+                          sorted(touched.items(), key=lambda kv: -kv[1])[:4])
+        what = "or its approach " if then is not None else ""
+        raise ActionFailed(f"every IK solution found for the pose ({tries}) {what}is in "
+                           f"collision: {named or 'no solution'}")
+
+    def _start_planning(self, robot: Robot, q_now: np.ndarray) -> None:
+        """Check the plannable stage's direct move; start a plan when it is needed."""
+        self._planning = None
+        index = next((i for i, st in enumerate(self.stages) if st.plannable), None)
+        if not self.PLANS or index is None:
+            return
+        mode = self.get_input("planner")
+        start = q_now if index == 0 else self.stages[index - 1].command
+        goal = self.stages[index].command
+        self.set_output("path_length", float(np.linalg.norm(goal - start)))
+        self.set_output("plan_samples", 0)
+        planner = self._planner()
+        if planner is None:
+            return
+        scene = planner.scene()
+        planner.sync(scene, self.grasping(), (start,), movables=False)
+        if scene.collides(goal):  # a goal must be free without padding
+            pairs = ", ".join(f"{a} touches {b}" for a, b in scene.contacts(goal)[:4])
+            raise ActionFailed(f"planning the arm's move: the goal is in collision: {pairs}")
+        planner.sync(scene, self.grasping(), (start, goal), PADDING)
+        if mode == "auto" and planner.direct_is_free(scene, start, goal):
+            return
+        self._planning = (index, planner.steps(scene, start, goal, self.name))
+        robot.hold_arm()
+
+    def _advance_planning(self) -> bool:
+        """One tick of planning; True when the plan is ready (its stages spliced in)."""
+        assert self._planning is not None
+        index, steps = self._planning
+        spent = 0
+        try:
+            while spent < CHECKS_PER_TICK:
+                spent = next(steps)
+        except StopIteration as done:
+            result = done.value
+        except PlanError as exc:
+            raise ActionFailed(f"planning the arm's move: {exc}") from None
+        else:
+            return False
+        stage = self.stages[index]
+        vias = [Stage(np.asarray(q, dtype=float), list(range(len(q))), via=True, planned=True)
+                for q in result.path[1:-1]]
+        self.stages[index:index] = vias
+        self.set_output("path_length", path_length(result.path))
+        self.set_output("plan_samples", int(result.samples))
+        self._planning = None
+        del stage
+        return True
 
     def start(self) -> None:
         robot = self.robot()
@@ -129,7 +265,9 @@ class JointMove(RobotAction):
         # contacts the arm already has may stay (it can then move away from them); only new
         # ones end the move
         self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
-        self._next_stage(robot, robot.arm_motion()[0])
+        self._start_planning(robot, q_now)
+        if self._planning is None:
+            self._next_stage(robot, robot.arm_motion()[0])
 
     def _next_stage(self, robot: Robot, q: list[float]) -> None:
         """Start the next stage from the arm's joint positions ``q`` (rad)."""
@@ -164,6 +302,12 @@ class JointMove(RobotAction):
 
     def step(self) -> Status:
         robot = self.robot()
+        if self._planning is not None:
+            if not self._advance_planning():
+                return Status.RUNNING
+            self.stage_started = self.now()
+            self._next_stage(robot, robot.arm_motion()[0])
+            return Status.RUNNING
         if self.check:
             hits = sorted(set(arm_collisions(self.world, robot)) - self.initial_contacts)
             if hits:
@@ -177,7 +321,8 @@ class JointMove(RobotAction):
         err = list(map(abs, map(operator.sub, q, self._command)))
         # "every e < tol" as tol > e on each (False for a NaN, as numpy's comparison)
         if self.stages[self.stage].via:
-            arrived = all(map(float(self.via_tol).__gt__, err))
+            tol = PLANNED_VIA if self.stages[self.stage].planned else self.via_tol
+            arrived = all(map(float(tol).__gt__, err))
         else:
             arrived = all(map(float(self.tol).__gt__, err)) and all(
                 map(SETTLE_SPEED.__gt__, map(abs, qd))
@@ -253,13 +398,16 @@ class MoveJoints(JointMove):
     """
 
     REQUIRED_ONE_OF = (("targets", "state"),)
+    PLANS = True
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "targets": PortInformation(
             list[float], False, "joint targets (deg or rad, see units), or use state", []
         ),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
+        "planner": PLANNER,
     }
+    OUTPUT_PORTS: dict[str, PortInformation] = dict(PLAN_OUTPUTS)
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         state = self.get_input("state")
@@ -275,7 +423,7 @@ class MoveJoints(JointMove):
             targets = to_radians(values, self.get_input("units"))
         if len(targets) != len(q_now):
             raise ActionFailed(f"targets has {len(targets)} values; the arm has {len(q_now)}")
-        return [Stage(targets, list(range(len(q_now))))]
+        return [Stage(targets, list(range(len(q_now))), plannable=True)]
 
 
 @registry.register
@@ -396,7 +544,13 @@ class MoveToPose(JointMove):
             Accepts(choices=("joint", "line")),
         ),
         "via_tolerance": VIA,
+        "planner": PLANNER,
     }
+    OUTPUT_PORTS: dict[str, PortInformation] = dict(PLAN_OUTPUTS)
+    PLANS = True
+
+    def grasping(self) -> str:
+        return str(self.get_input("object") or "")
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         robot = self.robot()
@@ -460,7 +614,17 @@ class MoveToPose(JointMove):
             q_first = stages[-1].command
         elif self.get_input("path") == "joint":
             q_first = cartesian.solve(services, tip, first, q_now, free)
-            stages.append(Stage(q_first, list(range(n))))
+
+            def approach_line(q: np.ndarray) -> list[np.ndarray]:
+                if approach <= 0:
+                    return []
+                return list(cartesian.line(services, tip, first, target, q, free))
+
+            q_first, line = self._free_goal(tip, first, q_first, q_now, free, approach_line)
+            stages.append(Stage(q_first, list(range(n)), plannable=True))
+            if approach > 0:
+                stages += _through(line, n)
+            return stages
         else:
             raise ActionFailed(f"path must be 'joint' or 'line', got '{self.get_input('path')}'")
         if approach > 0:
@@ -502,6 +666,20 @@ def _with_knobs(reason: str, free_yaw: bool, approach: float, path: str) -> str:
     if SOLVER_KNOBS in reason:
         return reason.replace(SOLVER_KNOBS, text)
     return f"{reason}; {text}"
+
+
+def _first_blocked(scene: Any, waypoints: list[np.ndarray], step: float) -> np.ndarray | None:
+    """The first configuration along ``waypoints`` (the first included) in collision."""
+    first: np.ndarray = waypoints[0]
+    if scene.collides(first):
+        return first
+    for a, b in itertools.pairwise(waypoints):
+        n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
+        for k in range(1, n + 1):
+            q: np.ndarray = a + (b - a) * (k / n)
+            if scene.collides(q):
+                return q
+    return None
 
 
 def _through(path: list[np.ndarray], n: int) -> list[Stage]:

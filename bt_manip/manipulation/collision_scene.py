@@ -35,6 +35,7 @@ import defusedxml.ElementTree as SafeET
 import numpy as np
 import pinocchio as pin
 
+from bt_manip.cache import Memo, bytes_key
 from bt_manip.sim.compose import composed_urdf
 
 __all__ = ["CollisionScene", "Obstacle", "SceneError", "never_colliding_pairs", "srdf_pairs"]
@@ -46,16 +47,27 @@ class SceneError(ValueError):
 
 @dataclass(frozen=True)
 class Obstacle:
-    """A primitive in the model's root frame: ``box`` (x, y, z sizes), ``cylinder`` (radius,
-    length along its z) or ``sphere`` (radius); ``pose`` is a 4x4 transform."""
+    """A shape in the model's root frame: ``box`` (x, y, z sizes), ``cylinder`` (radius,
+    length along its z), ``sphere`` (radius) or ``convex`` (the hull of ``points``, in the
+    obstacle's frame); ``pose`` is a 4x4 transform."""
 
     name: str
     shape: str
     size: tuple[float, ...]
     pose: tuple[tuple[float, ...], ...]
+    points: tuple[tuple[float, float, float], ...] = ()
 
 
-def _shape(kind: str, size: Sequence[float], padding: float = 0.0) -> coal.CollisionGeometry:
+def _shape(kind: str, size: Sequence[float], padding: float = 0.0,
+           points: Sequence[Sequence[float]] = ()) -> coal.CollisionGeometry:
+    if kind == "convex" and len(points) >= 4:
+        vertices = coal.StdVec_Vec3s()
+        for point in np.asarray(points, dtype=float):
+            vertices.append(point)
+        hull = coal.Convex.convexHull(vertices, False, "")
+        if padding > 0.0:
+            hull.setSweptSphereRadius(padding)
+        return hull
     if kind == "box" and len(size) == 3:
         return coal.Box(*(float(s) + 2.0 * padding for s in size))
     if kind == "cylinder" and len(size) == 2:
@@ -63,12 +75,32 @@ def _shape(kind: str, size: Sequence[float], padding: float = 0.0) -> coal.Colli
     if kind == "sphere" and len(size) == 1:
         return coal.Sphere(float(size[0]) + padding)
     raise SceneError(f"obstacle shape {kind!r} with {len(size)} size value(s): use box (3), "
-                     "cylinder (radius, length) or sphere (radius)")
+                     "cylinder (radius, length), sphere (radius) or convex (4 points or more)")
 
 
 def _se3(pose: Sequence[Sequence[float]] | np.ndarray) -> pin.SE3:
     m = np.asarray(pose, dtype=float)
     return pin.SE3(m[:3, :3], m[:3, 3])
+
+
+_LOADED: Memo[tuple[pin.Model, pin.GeometryModel]] = Memo(8)
+"""Models and collision geometry read in this process, by URDF bytes (the meshes' hulls are
+built once and shared by every scene made from them)."""
+
+
+def _loaded(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
+    key = bytes_key(urdf.read_bytes() + repr(package_dirs).encode())
+    known = _LOADED.get(key)
+    if known is None:
+        full = pin.buildModelFromUrdf(str(urdf))
+        dirs = [str(urdf.resolve().parent), *package_dirs]
+        try:
+            geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION, package_dirs=dirs)
+        except (ValueError, RuntimeError) as exc:
+            raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
+        known = (full, geometry)
+        _LOADED.put(key, known)
+    return known[0], known[1].clone()
 
 
 def srdf_pairs(path: Path) -> set[frozenset[str]]:
@@ -97,12 +129,7 @@ class CollisionScene:
         package_dirs: Sequence[str] = (),
     ) -> None:
         urdf = composed_urdf(urdf)  # mesh paths made absolute, as PyBullet loads them
-        full = pin.buildModelFromUrdf(str(urdf))
-        dirs = [str(Path(urdf).resolve().parent), *package_dirs]
-        try:
-            geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION, package_dirs=dirs)
-        except (ValueError, RuntimeError) as exc:
-            raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
+        full, geometry = _loaded(Path(urdf), tuple(package_dirs))
         names = [full.names[i] for i in range(1, full.njoints)]
         missing = [j for j in joints if j not in names]
         if missing:
@@ -127,7 +154,8 @@ class CollisionScene:
         for g in self.geometry.geometryObjects:
             shape = g.geometry
             if isinstance(shape, coal.BVHModelBase) and not exact:
-                shape.buildConvexRepresentation(False)
+                if shape.convex is None:
+                    shape.buildConvexRepresentation(False)
                 g.geometry = shape.convex
             if padding > 0.0 and not isinstance(g.geometry, coal.BVHModelBase):
                 g.geometry = _padded(g.geometry, padding)
@@ -138,6 +166,7 @@ class CollisionScene:
             if a != b and frozenset((a, b)) not in self.allowed:
                 self._add_pair(i, j)
         self.obstacles: dict[str, int] = {}
+        self.held: dict[str, int] = {}
         self.data = self.model.createData()
         self._rebuild()
         self.checks = 0
@@ -198,19 +227,65 @@ class CollisionScene:
 
     # -- obstacles ----------------------------------------------------------------------------
     def add_obstacle(self, obstacle: Obstacle, padding: float = 0.0) -> None:
-        """Add a primitive checked against every robot link (the pairs allowed aside)."""
-        if obstacle.name in self.obstacles:
-            raise SceneError(f"obstacle '{obstacle.name}' is already in the scene")
-        shape = _shape(obstacle.shape, obstacle.size, padding)
+        """Add a shape checked against every robot link (the pairs allowed aside)."""
+        self.add_obstacles([obstacle], padding)
+
+    def add_obstacles(self, obstacles: Sequence[Obstacle], padding: float = 0.0,
+                      allowed: Iterable[frozenset[str]] = ()) -> None:
+        """Add several obstacles at once (the broad phase is rebuilt once); ``allowed``: pairs
+        of a link and an obstacle left unchecked besides the scene's own."""
+        allowed = self.allowed | set(allowed)
+        for obstacle in obstacles:
+            if obstacle.name in self.obstacles:
+                raise SceneError(f"obstacle '{obstacle.name}' is already in the scene")
+            shape = _shape(obstacle.shape, obstacle.size, padding, obstacle.points)
+            for geometry in self._geometries():
+                index = geometry.addGeometryObject(pin.GeometryObject(
+                    f"obstacle:{obstacle.name}", 0, 0, _se3(obstacle.pose), shape.clone()
+                ))
+            self.obstacles[obstacle.name] = index
+            self.link_of.append(obstacle.name)
+            for i in [*range(self._robot_geoms), *self.held.values()]:
+                if frozenset((self.link_of[i], obstacle.name)) not in allowed:
+                    self._add_pair(i, index)
+        self._rebuild()
+
+    def hold(self, obstacle: Obstacle, link: str, touching: Iterable[str] = ()) -> None:
+        """Carry ``obstacle`` with ``link``: its ``pose`` is then in ``link``'s frame, it moves
+        with the arm and is checked against the obstacles and the robot's links, except the
+        ``touching`` links (the fingers and hand holding it). Call before adding obstacles."""
+        if self.obstacles:
+            raise SceneError("hold objects before adding obstacles (clear_obstacles first)")
+        frame_id = self.model.getFrameId(link)
+        if frame_id >= len(self.model.frames):
+            raise SceneError(f"no link '{link}' in the planning model")
+        frame = self.model.frames[frame_id]
+        shape = _shape(obstacle.shape, obstacle.size, 0.0, obstacle.points)
+        placement = frame.placement * _se3(obstacle.pose)
         for geometry in self._geometries():
-            index = geometry.addGeometryObject(
-                pin.GeometryObject(f"obstacle:{obstacle.name}", 0, 0, _se3(obstacle.pose), shape)
-            )
-        self.obstacles[obstacle.name] = index
+            index = geometry.addGeometryObject(pin.GeometryObject(
+                f"held:{obstacle.name}", frame.parentJoint, frame_id, placement, shape.clone()
+            ))
+        self.held[obstacle.name] = index
         self.link_of.append(obstacle.name)
+        allowed = set(touching)
         for i in range(self._robot_geoms):
-            if frozenset((self.link_of[i], obstacle.name)) not in self.allowed:
+            if self.link_of[i] not in allowed:
                 self._add_pair(i, index)
+        self._rebuild()
+
+    def clear_obstacles(self) -> None:
+        """Remove every obstacle and held object (the robot's own shapes stay)."""
+        if not self.obstacles and not self.held:
+            return
+        for geometry in self._geometries():
+            for name in self.obstacles:
+                geometry.removeGeometryObject(f"obstacle:{name}")
+            for name in self.held:
+                geometry.removeGeometryObject(f"held:{name}")
+        self.link_of = self.link_of[: self._robot_geoms]
+        self.obstacles = {}
+        self.held = {}
         self._rebuild()
 
     def move_obstacle(self, name: str, pose: Sequence[Sequence[float]] | np.ndarray) -> None:
@@ -239,10 +314,11 @@ class CollisionScene:
                            else (self.geometry, self.gdata))
         pin.computeCollisions(self.model, self._mesh_data, geometry, gdata,
                               np.asarray(q, dtype=float), False)
-        out = []
+        out: list[tuple[str, str]] = []
         for k, pair in enumerate(geometry.collisionPairs):
-            if gdata.collisionResults[k].isCollision():
-                out.append((self.link_of[pair.first], self.link_of[pair.second]))
+            named = (self.link_of[pair.first], self.link_of[pair.second])
+            if gdata.collisionResults[k].isCollision() and named not in out:
+                out.append(named)
         return out
 
     def segment_free(self, a: np.ndarray, b: np.ndarray, step: float) -> bool:

@@ -18,13 +18,16 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+from collections.abc import Generator
 from dataclasses import dataclass
 
 import numpy as np
 
 from bt_manip.manipulation.collision_scene import CollisionScene
 
-__all__ = ["PlanError", "PlanOptions", "PlanResult", "path_length", "plan", "shortcut"]
+__all__ = [
+    "PlanError", "PlanOptions", "PlanResult", "path_length", "plan", "plan_steps", "shortcut",
+]
 
 
 class PlanError(ValueError):
@@ -115,6 +118,26 @@ def plan(
     options: PlanOptions = PlanOptions(),
 ) -> PlanResult:
     """A collision-free path ``start`` -> ``goal`` (see the module docstring)."""
+    steps = plan_steps(scene, start, goal, rng, options)
+    while True:
+        try:
+            next(steps)
+        except StopIteration as done:
+            result: PlanResult = done.value
+            return result
+
+
+def plan_steps(
+    scene: CollisionScene,
+    start: np.ndarray,
+    goal: np.ndarray,
+    rng: np.random.Generator,
+    options: PlanOptions = PlanOptions(),
+) -> Generator[int, None, PlanResult]:
+    """:func:`plan` in rounds: yields the checks spent so far after every round of the search
+    (one extension and one connection: at most ``2 * extend / step`` segment checks and a
+    connection's), returns the :class:`PlanResult` (raises :class:`PlanError`). A caller that
+    advances it once per tick bounds each tick's work by a count of checks."""
     start = np.asarray(start, dtype=float)
     goal = np.asarray(goal, dtype=float)
     first = scene.checks
@@ -145,6 +168,7 @@ def plan(
                 return PlanResult(path, samples, scene.checks - first,
                                   (trees[0].n, trees[1].n))
         a, b = b, a
+        yield scene.checks - first
     raise PlanError(
         f"no path within {options.max_checks} collision checks ({samples} samples; the start "
         f"tree grew to {trees[0].n} nodes, the goal tree to {trees[1].n})"
@@ -160,13 +184,21 @@ def _validated(
     if options.validate_step >= options.step:
         return path
     out = [path[0]]
-    for a, b in itertools.pairwise(path):
+    i = 0
+    while i < len(path) - 1:
+        a, b = path[i], path[i + 1]
         if scene.segment_free(a, b, options.validate_step):
             out.append(b)
+            i += 1
             continue
+        # plan again, finely, to the next waypoint that is itself free (the goal is)
+        j = i + 1
+        while j < len(path) - 1 and scene.collides(path[j]):
+            j += 1
         left = options.max_checks - (scene.checks - first)
         fine = dataclasses.replace(options, step=options.validate_step, max_checks=max(left, 1))
-        out += plan(scene, a, b, rng, fine).path[1:]
+        out += plan(scene, a, path[j], rng, fine).path[1:]
+        i = j
     return out
 
 
@@ -224,7 +256,7 @@ def shortcut(
         (i, qa), (j, qb) = _point_at(path, s), _point_at(path, t)
         if j <= i:
             continue
-        if scene.segment_free(qa, qb, options.step):
+        if not scene.collides(qa) and scene.segment_free(qa, qb, options.step):
             path = [*path[:i + 1], qa, qb, *path[j + 1:]]
             path = _dedupe(path)
     return path

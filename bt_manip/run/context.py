@@ -61,6 +61,10 @@ class RobotServices:
     robot: Robot
     _navigator: Navigator | None = field(default=None, init=False, repr=False)
     _arm_iks: dict[str, ArmIK] = field(default_factory=dict, init=False, repr=False)
+    arm_planner: Any = field(default=None, init=False, repr=False)
+    """The arm's planning scene and planner
+    (:class:`~bt_manip.manipulation.arm_planner.ArmPlanner`), made by the first node that
+    plans."""
 
     @property
     def navigator(self) -> Navigator:

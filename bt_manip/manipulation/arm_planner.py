@@ -1,0 +1,216 @@
+"""The planning scene of one robot's arm, kept in step with its world, and its plans.
+
+:class:`ArmPlanner` builds a :class:`~bt_manip.manipulation.collision_scene.CollisionScene` from
+the robot's URDF (the one PyBullet loaded): the arm joints are planned, every other joint
+(wheels, a holonomic base's virtual joints, fingers, a head) is locked where it is. Before each
+plan it is brought up to date with the world (:meth:`ArmPlanner.sync`):
+
+- every body near the arm (walls, furniture, the floor, movable objects where they are now),
+  in the frame of the robot's root link;
+- the objects the robot holds (attach joints), carried by the link that holds them and allowed
+  to touch the fingers and the hand;
+- the object about to be grasped, allowed to touch the fingers and the hand.
+
+Robot links that no arm joint moves are never tested against the world (the wheels stand on the
+floor; nothing the arm does changes that). A scene is built per setting of the locked joints
+(rounded to a millimetre or a milliradian), so opening the gripper builds another; a few are
+kept. Plans are :func:`~bt_manip.manipulation.rrt_connect.plan_steps` generators: a node
+advances one a few thousand checks per tick.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections import OrderedDict
+from collections.abc import Generator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+import pybullet as pb
+
+from bt_manip.geometry import inverse_matrix
+from bt_manip.manipulation.collision_scene import CollisionScene, Obstacle, never_colliding_pairs
+from bt_manip.manipulation.rrt_connect import PlanOptions, PlanResult, plan_steps
+from bt_manip.manipulation.world_obstacles import body_obstacles, world_obstacles
+from bt_manip.sim.compose import cache_dir, write_atomic_bytes
+from bt_manip.sim.randomize import entity_rng
+
+__all__ = ["PLANNERS", "ArmPlanner"]
+
+PLANNERS = ("auto", "rrtconnect", "none")
+"""``auto``: plan only when the direct joint move would collide; ``rrtconnect``: always plan
+(a free direct move is the plan); ``none``: move directly, as without a planner."""
+SCENES_KEPT = 4
+SELF_SAMPLES = 1000
+"""Random configurations sampled to find the link pairs that never touch."""
+REACH_MARGIN = 0.5
+"""m added to the arm's reach when choosing the bodies near enough to matter."""
+PADDING = 0.02
+"""m the world's shapes are grown by when planning a path (not when checking a goal or a
+straight approach): room for how the arm follows its waypoints under its own weight and for
+PyBullet's contact threshold."""
+
+
+@dataclass(frozen=True)
+class _Key:
+    locked: tuple[tuple[str, float], ...]
+
+
+class ArmPlanner:
+    """Plans of one robot's arm in one world (see the module docstring)."""
+
+    def __init__(self, world: Any, robot: Any, robot_name: str) -> None:
+        self.world = world
+        self.robot = robot
+        self.robot_name = robot_name
+        self._scenes: OrderedDict[_Key, CollisionScene] = OrderedDict()
+        self._quiet: set[frozenset[str]] | None = None
+        self.options = PlanOptions(max_checks=60_000)
+        self.plans = 0
+        self._movables = True
+
+    # -- the scene ----------------------------------------------------------------------------
+    def _locked(self) -> dict[str, float]:
+        arm = set(self.robot.description.arm.joints)
+        out = {}
+        for name, index in self.robot._joints.items():
+            info = self.robot._joint_info[index]
+            if name in arm or info.type not in (pb.JOINT_REVOLUTE, pb.JOINT_PRISMATIC):
+                continue
+            q = float(pb.getJointState(self.robot.body, index,
+                                       physicsClientId=self.robot.client)[0])
+            out[name] = round(q, 3)
+        return out
+
+    def scene(self) -> CollisionScene:
+        """The scene for the locked joints as they are now (built on first use)."""
+        locked = self._locked()
+        key = _Key(tuple(sorted(locked.items())))
+        scene = self._scenes.get(key)
+        if scene is None:
+            desc = self.robot.description
+            scene = CollisionScene(desc.urdf_path, list(desc.arm.joints), locked=locked)
+            if self._quiet is None:
+                self._quiet = _quiet_pairs(scene, desc.urdf_path, desc.arm.joints)
+            scene.allow(self._quiet)
+            self._scenes[key] = scene
+            while len(self._scenes) > SCENES_KEPT:
+                self._scenes.popitem(last=False)
+        self._scenes.move_to_end(key)
+        return scene
+
+    def _root(self, scene: CollisionScene) -> np.ndarray:
+        """World pose (4x4) of the planning model's root frame."""
+        root = next(f.name for f in scene.model.frames if f.type == pin.FrameType.BODY)
+        transform: np.ndarray = self.robot.link_transform(root)
+        return transform
+
+    def _reach(self, scene: CollisionScene) -> tuple[np.ndarray, float]:
+        """A point at the arm's base (root frame) and how far the arm can reach from it."""
+        model = scene.model
+        base = model.jointPlacements[1].translation if model.njoints > 1 else np.zeros(3)
+        reach = sum(float(np.linalg.norm(model.jointPlacements[j].translation))
+                    for j in range(2, model.njoints))
+        return np.asarray(base, dtype=float), reach + REACH_MARGIN
+
+    def sync(self, scene: CollisionScene, grasping: str = "",
+             ends: tuple[np.ndarray, ...] = (), padding: float = 0.0,
+             movables: bool = True) -> None:
+        """Bring ``scene`` up to date with the world (see the module docstring), its shapes
+        grown by ``padding``. The contacts the arm has at the ``ends`` of a move (its start,
+        and its goal once checked free without padding) are allowed for this plan: the arm may
+        move away from what it touches, as a move without a plan may, and come as close to
+        what the goal is close to. Without ``movables``, the world's movable objects are left
+        out (a goal may brush one, as a move may push one)."""
+        self._movables = movables
+        self._fill(scene, grasping, set(), padding)
+        touching: set[frozenset[str]] = set()
+        for q in ends:
+            if scene.collides(np.asarray(q, dtype=float)):
+                touching |= {frozenset(pair) for pair in scene.contacts(np.asarray(q, float))}
+        if touching:
+            self._fill(scene, grasping, touching, padding)
+
+    def _fill(self, scene: CollisionScene, grasping: str, extra: set[frozenset[str]],
+              padding: float) -> None:
+        scene.clear_obstacles()
+        desc = self.robot.description
+        hand = set(desc.gripper.finger_links) | {desc.end_effector, desc.grasp_link
+                                                 or desc.grasp_frame}
+        touching = hand | _hand(scene)
+        world_from_root = self._root(scene)
+        root_from_world = inverse_matrix(world_from_root)
+        held = [(a.object_name, a.object_body, a.link_name)
+                for a in self.world.attachments.held_by(self.robot_name)]
+        carrier = desc.grasp_link or desc.grasp_frame
+        held += [(name, body, carrier) for name, body in self.world.movable.items()
+                 if name not in {h[0] for h in held} and self.robot.is_grasping(body)]
+        for name, body, link in held:
+            link_from_world = inverse_matrix(self.robot.link_transform(link))
+            for shape in body_obstacles(self.world.client, body, name):
+                scene.hold(_moved(shape, link_from_world), link, touching)
+        base, reach = self._reach(scene)
+        near = (world_from_root @ np.append(base, 1.0))[:3]
+        skip = {h[0] for h in held}
+        if not self._movables:
+            skip |= set(self.world.movable) - {grasping}
+        shapes = [_moved(o, root_from_world)
+                  for o in world_obstacles(self.world, skip, near, reach)]
+        static = {scene.link_of[i] for i in range(scene._robot_geoms)
+                  if scene.geometry.geometryObjects[i].parentJoint == 0}
+        allowed = {frozenset((link, o.name)) for o in shapes for link in static} | extra
+        if grasping:
+            allowed |= {frozenset((link, o.name)) for o in shapes
+                        if o.name == grasping or o.name.startswith(grasping + "#")
+                        for link in touching}
+        scene.add_obstacles(shapes, padding, allowed)
+
+    # -- plans --------------------------------------------------------------------------------
+    def direct_is_free(self, scene: CollisionScene, a: np.ndarray, b: np.ndarray) -> bool:
+        """Whether the straight joint move is free, checked as finely as a plan's result."""
+        return scene.segment_free(np.asarray(a, float), np.asarray(b, float),
+                                  self.options.validate_step)
+
+    def steps(self, scene: CollisionScene, start: np.ndarray, goal: np.ndarray, who: str
+              ) -> Generator[int, None, PlanResult]:
+        """The plan generator, seeded by the world's seed, ``who`` (the node) and a count."""
+        self.plans += 1
+        rng = entity_rng(self.world.seed, f"arm-plan:{who}:{self.plans}")
+        return plan_steps(scene, np.asarray(start, float), np.asarray(goal, float), rng,
+                          self.options)
+
+
+def _quiet_pairs(scene: CollisionScene, urdf: Path, joints: tuple[str, ...]
+                 ) -> set[frozenset[str]]:
+    """:func:`never_colliding_pairs` of the robot, found once and kept in the cache folder
+    (keyed by the URDF's bytes and the arm's joints)."""
+    key = hashlib.sha256(urdf.read_bytes() + "\n".join(joints).encode()).hexdigest()[:20]
+    path = cache_dir() / f"quiet-pairs-{key}-{SELF_SAMPLES}.json"
+    if path.is_file():
+        try:
+            return {frozenset(pair) for pair in json.loads(path.read_text())}
+        except (ValueError, TypeError):
+            pass  # a damaged file is found again
+    pairs = never_colliding_pairs(scene, SELF_SAMPLES, seed=0)
+    write_atomic_bytes(path, json.dumps(sorted(sorted(p) for p in pairs)).encode())
+    return pairs
+
+
+def _hand(scene: CollisionScene) -> set[str]:
+    """The links the arm's last joint carries (the wrist's last link, the hand, the fingers
+    locked in place): what may touch an object held or being grasped."""
+    model = scene.model
+    last = model.njoints - 1
+    return {f.name for f in model.frames
+            if f.type == pin.FrameType.BODY and f.parentJoint == last}
+
+
+def _moved(obstacle: Obstacle, transform: np.ndarray) -> Obstacle:
+    pose = transform @ np.asarray(obstacle.pose, dtype=float)
+    return Obstacle(obstacle.name, obstacle.shape, obstacle.size,
+                    tuple(tuple(float(v) for v in row) for row in pose), obstacle.points)
+
