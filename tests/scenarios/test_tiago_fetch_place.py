@@ -15,7 +15,7 @@ from bt_manip.run.runner import Runner
 ROOT = Path(__file__).resolve().parents[2]
 TREE = str(ROOT / "trees" / "tiago_fetch_place.xml")
 WORLD = str(ROOT / "worlds" / "tiago_tables.yaml")
-PLACE = (-2.15, -1.2, 0.725)
+PLACE = (-2.03, -1.2, 0.725)
 """Where the tree puts the block's centre on table_b."""
 
 
