@@ -54,7 +54,8 @@ def test_the_block_is_carried_in_the_hand_from_table_a_to_table_b() -> None:
         assert math.dist(start[:2], pos[:2]) > 4.0
         assert path["held"] > 4.0
         assert path["free"] < 0.15
-        assert world.attachments.touched("block") == []
+        # while held it touched nothing but the table it was set down on
+        assert set(world.attachments.touched("block")) <= {"table_b"}
         # the robot backed away from table_b with the arm tucked
         x, y, _ = robot.base_pose2d()
         near = world.poses["near_table_b"]
