@@ -577,8 +577,10 @@ class MoveToPose(JointMove):
             target[:3, 3] += np.asarray(offset, dtype=float)
         else:
             target = pose_matrix(np.add(position, offset), self.get_input("orientation"))
+        turns = [target]
         if self.get_input("match_object_yaw") and yaw is not None and not grasp:
-            target = self._turned_to(robot, tip, target, yaw)
+            turns = self._turns(robot, tip, target, yaw)
+            target = turns[0]
         self.overlay.show_frame("ik_target", target)  # drawn when a viewer is on
         services = self.services()
         free = bool(self.get_input("free_yaw"))
@@ -587,7 +589,17 @@ class MoveToPose(JointMove):
         if approach < 0 or retreat < 0:
             raise ActionFailed("approach and retreat are distances: they cannot be negative")
         try:
-            return self._stages(robot, tip, target, q_now, services, free, approach, retreat)
+            if self._planner() is None or self.get_input("path") != "joint":
+                return self._stages(robot, tip, target, q_now, services, free, approach, retreat)
+            # planning: a turn of the tool by another quarter turn may clear what the first hits
+            for k, turned in enumerate(turns):
+                try:
+                    return self._stages(robot, tip, turned, q_now, services, free, approach,
+                                        retreat)
+                except ActionFailed:
+                    if k == len(turns) - 1:
+                        raise
+            raise AssertionError("unreachable")
         except cartesian.CartesianError as exc:
             raise cartesian.CartesianError(_with_knobs(str(exc), free, approach,
                                                        self.get_input("path"))) from None
@@ -632,20 +644,19 @@ class MoveToPose(JointMove):
         return stages
 
     @staticmethod
-    def _turned_to(robot: Robot, tip: str, target: np.ndarray, yaw: float) -> np.ndarray:
-        """``target`` turned about the world vertical by the object's yaw plus k x 90 deg,
-        choosing k so the tool turns least from where it points now."""
+    def _turns(robot: Robot, tip: str, target: np.ndarray, yaw: float) -> list[np.ndarray]:
+        """``target`` turned about the world vertical by the object's yaw plus k x 90 deg, for
+        k = 0 .. 3, the turn the tool makes least from where it points now first."""
         now = robot.link_transform(tip)[:3, :3]
-        best, best_angle = target, np.inf
+        found = []
         for k in range(4):
             a = yaw + k * np.pi / 2
             rz = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
             cand = target.copy()
             cand[:3, :3] = rz @ target[:3, :3]
             turn = np.arccos(np.clip((np.trace(now.T @ cand[:3, :3]) - 1) / 2, -1, 1))
-            if turn < best_angle:
-                best, best_angle = cand, turn
-        return best
+            found.append((float(turn), k, cand))
+        return [cand for _, _, cand in sorted(found, key=lambda f: (f[0], f[1]))]
 
 
 def _with_knobs(reason: str, free_yaw: bool, approach: float, path: str) -> str:
