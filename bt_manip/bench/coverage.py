@@ -311,14 +311,16 @@ def coverage_text(data: dict[str, Any], shown: int = RECOVERIES_SHOWN) -> str:
     return "\n".join(lines)
 
 
-def coverage_diff(a: dict[str, Any], b: dict[str, Any]) -> str:
-    """How two coverage.json differ: branch coverage, and each branch that ran in one bench
-    only or in a different number of episodes (by path)."""
+def coverage_diff(a: dict[str, Any], b: dict[str, Any], names: tuple[str, str] = ("A", "B")
+                  ) -> str:
+    """How the coverage ``b`` differs from ``a`` (both coverage.json, named ``names``): branch
+    coverage, and each branch (by path) that ran in one only or in a different number of
+    episodes."""
     ba, bb = a["branch_coverage"], b["branch_coverage"]
     lines = [f"branch coverage: {ba['covered']}/{ba['total']} "
-             f"({_percent(ba['covered'], ba['total'])}, {a['runs']} episodes) -> "
+             f"({_percent(ba['covered'], ba['total'])}, {a['runs']} episodes) in {names[0]} -> "
              f"{bb['covered']}/{bb['total']} ({_percent(bb['covered'], bb['total'])}, "
-             f"{b['runs']} episodes)"]
+             f"{b['runs']} episodes) in {names[1]}"]
 
     def branches(data: dict[str, Any]) -> dict[str, dict[str, Any]]:
         return {br["path"]: br for bn in data["branch_nodes"] for br in bn["branches"]}
@@ -330,18 +332,30 @@ def coverage_diff(a: dict[str, Any], b: dict[str, Any]) -> str:
                and first[p]["episodes"] != second[p]["episodes"]]
     only_a = [p for p in first if p not in second]
     only_b = [p for p in second if p not in first]
-    for title, paths in (("ran only in the second bench", gained),
-                         ("ran only in the first bench", lost)):
+    for title, paths in ((f"ran in {names[1]} only", gained), (f"ran in {names[0]} only", lost)):
         if paths:
             lines.append(f"{title} ({len(paths)}):")
             lines.extend(f"  {p} [{(second.get(p) or first[p])['role']}]" for p in paths)
     if changed:
-        lines.append("episodes each branch ran in (first -> second):")
+        lines.append(f"episodes each branch ran in ({names[0]} -> {names[1]}):")
         lines.extend(f"  {first[p]['episodes']:4d} -> {second[p]['episodes']:4d}  {p}"
                      for p in changed)
     if only_a or only_b:
-        lines.append(f"branches of one tree only: {len(only_a)} in the first, {len(only_b)} "
-                     "in the second (the trees differ)")
+        lines.append(f"branches of one tree only: {len(only_a)} in {names[0]}, {len(only_b)} "
+                     f"in {names[1]} (the trees differ)")
     if len(lines) == 1:
         lines.append("the same branches ran in the same number of episodes")
+    return "\n".join(lines)
+
+
+def branches_text(data: dict[str, Any]) -> str:
+    """Every branch of a coverage.json: the episodes it ran and won in, by branch node."""
+    lines = []
+    for bn in data["branch_nodes"]:
+        where = f"{bn['file']}:{bn['line']}" if bn.get("line") else bn["file"]
+        lines.append(f"{bn['path']} [{bn['node']}] {where}: {bn['covered']}/{bn['total']} "
+                     f"branches ran (the node ran in {bn['episodes']} episodes)")
+        for br in bn["branches"]:
+            lines.append(f"  {br['episodes']:4d} ran {br['won']:4d} won  {br['role']:<9} "
+                         f"{br['path'].rsplit('/', 1)[-1]} [{br['node']}]")
     return "\n".join(lines)
