@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
+from bt_manip.bt.node import BtNode
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.walk import walk_nodes
 
@@ -35,8 +36,10 @@ class NodeCounter:
 
     @staticmethod
     def can_watch(tree: Any) -> bool:
-        """Whether ``tree`` is a bt-manip tree (its context tells an observer of its ticks)."""
-        return hasattr(getattr(tree, "context", None), "observer")
+        """Whether ``tree`` is a bt-manip tree: its root a bt-manip node, its context one that
+        tells an observer of its ticks (the nodes of a plain py_trees tree tell nobody)."""
+        return (isinstance(getattr(tree, "root", None), BtNode)
+                and hasattr(getattr(tree, "context", None), "observer"))
 
     def attach(self) -> NodeCounter:
         """Start counting: become the tree context's observer."""
