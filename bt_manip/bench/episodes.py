@@ -17,10 +17,12 @@ from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.walk import children_of, walk_nodes
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.groot.monitor import watch
+from bt_manip.run.node_counts import COUNT_FIELDS
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 """Version of the bench's output formats (episodes.jsonl, episodes.json, summary.json,
-episodes.csv); documented by the JSON Schemas in docs/schemas/. Version 1 had none written."""
+episodes.csv, coverage.json); documented by the JSON Schemas in docs/schemas/. Version 1 had
+none written; version 2 had no per-node counts in the episodes (``coverage``)."""
 
 
 @dataclass
@@ -40,6 +42,9 @@ class EpisodeResult:
     """Numeric entries of the root blackboard at the end (counters a tree keeps)."""
     leaf_failures: dict[str, int] = field(default_factory=dict)
     """Per action node (by path), how many times it failed during the episode."""
+    coverage: dict[str, list[int]] = field(default_factory=dict)
+    """Per node ticked in the episode (by path): its counts, in the order of
+    :data:`bt_manip.run.node_counts.COUNT_FIELDS` (ticks, success, failure, skipped, halted)."""
 
     @property
     def success(self) -> bool:
@@ -82,6 +87,8 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         injected=list(report.extra.get("injected", [])),
         metrics=metrics,
         leaf_failures=dict(leaf_failures),
+        coverage={n.path: [n.counts[k] for k in COUNT_FIELDS]
+                  for n in report.nodes if n.counts and n.counts["ticks"]},
     )
 
 

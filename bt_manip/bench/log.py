@@ -181,9 +181,14 @@ def read_log(folder: str | Path) -> LoggedBench:
         first = json.loads(complete[0])
         if first.get("kind") != "bench":
             raise ValueError("the first line is not the bench's (kind 'bench')")
-        if first.get("schema_version") != SCHEMA_VERSION:
-            raise ValueError(f"schema version {first.get('schema_version')!r}; this bt-manip "
-                             f"reads {SCHEMA_VERSION}")
+        version = first.get("schema_version")
+        if isinstance(version, int) and version < SCHEMA_VERSION:
+            raise InputError.single(
+                where, 1, f"written by an older bt-manip (format version {version}, whose "
+                "episodes lack the per-node counts of coverage.json); resuming it would mix "
+                f"two formats: start a new bench (this bt-manip writes version {SCHEMA_VERSION})")
+        if version != SCHEMA_VERSION:
+            raise ValueError(f"schema version {version!r}; this bt-manip reads {SCHEMA_VERSION}")
         header = BenchHeader(dict(first["spec"]), [int(s) for s in first["seeds"]],
                              dict(first.get("digests", {})))
         spec = spec_from_json(header.spec)

@@ -11,6 +11,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from bt_manip.bench.coverage import (
+    BenchCoverage,
+    bench_coverage,
+    coverage_info,
+    tree_outline,
+    write_coverage,
+)
+from bt_manip.bench.coverage_plot import write_coverage_png
 from bt_manip.bench.episodes import EpisodeResult
 from bt_manip.bench.files import write_outputs
 from bt_manip.bench.log import LOG_NAME, BenchHeader, BenchLog, check_unchanged, read_log
@@ -51,6 +59,8 @@ class Point:
     value: str = ""
     done: list[EpisodeResult] | None = None
     valid_bytes: int = 0
+    results: list[EpisodeResult] | None = None
+    """Every episode of the point, once it has run (:func:`run_point`)."""
 
 
 def resume_points(folder: Path) -> tuple[str | None, list[Point]]:
@@ -132,17 +142,38 @@ def run_point(options: PoolOptions, point: Point, sweep: str | None) -> BenchSum
               f"{options.folder}")
         raise
     results = sorted(done + new, key=lambda r: r.seed)
+    point.results = results
     summary = summarise(results, point.spec)
     summary.first_seed = first
     print(summary.text())
+    coverage = bench_coverage(tree_outline(point.spec), results, coverage_info(point.spec))
+    print(coverage.text())
     try:
         write_outputs(results, summary, point.folder)
+        _write_coverage(coverage, point.folder)
     except OSError as exc:
         raise InputError.single("--out", None, f"cannot write {point.folder}: "
                                 f"{exc.strerror or exc}") from None
     print(f"wrote {point.folder}/{LOG_NAME}, episodes.json, episodes.csv, summary.json, "
-          "outcomes.png")
+          "outcomes.png, coverage.json, coverage.png")
     return summary
+
+
+def _write_coverage(coverage: BenchCoverage, folder: Path) -> None:
+    """coverage.json and coverage.png in ``folder``."""
+    write_coverage(coverage, folder)
+    write_coverage_png(coverage.to_json(), folder / "coverage.png")
+
+
+def _sweep_coverage(points: list[Point], sweep: str, out: Path) -> None:
+    """The sweep's coverage.json and coverage.png in ``out``: the episodes of every point
+    summed (the same tree at every value; each point's episodes count apart)."""
+    base = points[0].spec
+    every = [r for point in points for r in point.results or []]
+    info = {**coverage_info(base), "inject": [f.text() for f in base.inject], "sweep": sweep}
+    merged = bench_coverage(tree_outline(base), every, info)
+    print(f"sweep {merged.text()}")
+    _write_coverage(merged, out)
 
 
 def _count_episodes(folder: Path) -> int:
@@ -168,5 +199,6 @@ def run_points(options: PoolOptions, points: list[Point],
             lo, hi = s.ci95
             print(f"  {p.value:>10}: {s.successes}/{s.runs} = {100 * s.success_rate:.1f} % "
                   f"({100 * lo:.1f}-{100 * hi:.1f} %)")
-        print(f"wrote {out}/sweep.json, sweep.csv, sweep.png")
+        _sweep_coverage(points, sweep, out)
+        print(f"wrote {out}/sweep.json, sweep.csv, sweep.png, coverage.json, coverage.png")
     return summaries

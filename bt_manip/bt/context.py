@@ -8,11 +8,26 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any, Protocol
 
 from bt_manip.clock import Clock, MonotonicClock
 
+if TYPE_CHECKING:
+    from bt_manip.bt.status import NodeStatus
+
 TIME_EPS = 1e-9  # seconds: tolerance when comparing clock readings
+
+
+class TickObserver(Protocol):
+    """What a tree tells its context's ``observer`` as it runs."""
+
+    def result(self, node: Any, status: NodeStatus) -> None:
+        """``node`` was ticked and returned ``status`` (RUNNING, SUCCESS, FAILURE, SKIPPED)."""
+        ...
+
+    def halted(self, node: Any) -> None:
+        """``node`` was halted while RUNNING."""
+        ...
 
 
 @dataclass
@@ -35,6 +50,9 @@ class TreeContext:
     """Nodes ticked in the current tree tick, in the order they returned (set by Tree)."""
     tree: Any = None
     """The Tree that ticks this context (for py_trees tools ticking the root)."""
+    observer: TickObserver | None = None
+    """Told of every node's tick result and of every halt of a RUNNING node (the run's
+    :class:`~bt_manip.run.coverage.NodeCounter`); None costs nothing."""
 
     def now(self) -> float:
         return self.clock.now()

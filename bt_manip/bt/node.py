@@ -309,9 +309,12 @@ class BtNode(PortsMixin):
         if new is not _SKIPPED:
             self.bt_status = new
             self.status = _PY_BY_ID[id(new)]
-        visited = self.context.visited
+        context = self.context
+        visited = context.visited
         if visited is not None:  # for py_trees tools: the nodes that ran in this tick
             visited.append(self)
+        if context.observer is not None:
+            context.observer.result(self, new)
         return new
 
     def tick_node(self) -> NodeStatus:
@@ -333,6 +336,9 @@ class BtNode(PortsMixin):
 
     def halt_node(self) -> None:
         """Halt, then run the ``_onHalted`` script if any."""
+        observer = self.context.observer
+        if observer is not None and self.bt_status is NodeStatus.RUNNING:
+            observer.halted(self)
         self.halt()
         script = self._post.get("_onHalted") if self._post else None
         if script is not None:

@@ -4,6 +4,7 @@ family has its module (arguments and handler), and the work is done by the libra
 Verbs:
   run TREE.xml [--world W]   tick a tree (against a world's sim clock when one is given)
   bench TREE.xml --world W   many seeded episodes in parallel, with statistics
+  coverage BENCH_DIR         the branches and recoveries a bench exercised (--min for CI)
   world W.yaml               load a world, print its summary, optionally let it settle
   bim BUILDING.ifc --out D   an IFC building and its schedule to a world and schedule.json
   bim-report REPORT --png P  the floor plan of an installation run, as built
@@ -55,6 +56,8 @@ class Verb:
 VERBS = (
     Verb("run", "run", "tick a tree until it succeeds, fails or runs out of budget"),
     Verb("bench", "bench", "run many seeded episodes and report statistics"),
+    Verb("coverage", "coverage",
+         "which branches and recoveries of the tree a bench exercised"),
     Verb("world", "world", "load a world and print its summary"),
     Verb("bim", "bim",
          "an IFC building model and its schedule to a world and the elements to install"),

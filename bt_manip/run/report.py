@@ -18,6 +18,7 @@ from bt_manip.bt.status import as_status
 from bt_manip.bt.walk import walk_nodes
 from bt_manip.outputs import write_text
 from bt_manip.run.failure_cause import FailureCause
+from bt_manip.run.node_counts import NodeCounter
 from bt_manip.run.status import RunStatus
 
 REPORT_SCHEMA_VERSION = 1
@@ -35,6 +36,11 @@ class NodeReport:
     status: str
     reason: str = ""
     last_status: str = ""
+    counts: dict[str, int] | None = None
+    """How often the node was ticked in the run and what it returned: ``ticks``, ``success``,
+    ``failure``, ``skipped``, and ``halted`` (stopped while RUNNING); see
+    :mod:`bt_manip.run.node_counts`. None for a tree whose ticks cannot be watched (a plain
+    py_trees tree)."""
 
 
 @dataclass
@@ -82,6 +88,9 @@ class RunReport:
         data["exit_code"] = self.exit_code
         if self.as_built is None:
             del data["as_built"]
+        for node in data["nodes"]:
+            if node["counts"] is None:
+                del node["counts"]
         del data["notes"]
         return data
 
@@ -113,9 +122,10 @@ def cause_json(cause: FailureCause | None) -> dict[str, str]:
     return {"path": cause.path, "name": cause.name, "node": cause.node_id, "reason": cause.reason}
 
 
-def node_reports(tree: Any) -> list[NodeReport]:
+def node_reports(tree: Any, counter: NodeCounter | None = None) -> list[NodeReport]:
     """Every node of ``tree`` (a bt-manip tree or anything with a py_trees ``root``) with its
-    status and feedback, in the order and with the paths of :func:`bt_manip.bt.walk.walk_nodes`.
+    status and feedback, in the order and with the paths of :func:`bt_manip.bt.walk.walk_nodes`;
+    with ``counter``, each with its counts of the run.
     """
     root = getattr(tree, "root", None)
     if root is None:
@@ -128,5 +138,6 @@ def node_reports(tree: Any) -> list[NodeReport]:
         else:
             status = last = as_status(node.status).value
         out.append(NodeReport(walked.path, walked.node_id, status,
-                              node.feedback_message or "", last))
+                              node.feedback_message or "", last,
+                              counter.of(walked.path) if counter is not None else None))
     return out

@@ -30,6 +30,7 @@ import py_trees
 from bt_manip.bt.node import BtNode, TreeRuntimeError
 from bt_manip.run.failure_cause import FailureCause, failure_cause
 from bt_manip.run.hooks import RunHook, TickCallback, close_hooks
+from bt_manip.run.node_counts import NodeCounter
 from bt_manip.run.report import NodeReport, RunReport, cause_json, node_reports
 from bt_manip.run.status import RunStatus
 
@@ -93,6 +94,8 @@ class Runner:
         self.options = options or RunOptions()
         self.on_tick = list(on_tick)
         self.ticks = 0
+        self.counter: NodeCounter | None = None
+        """Each node's ticks and results in the run (bt_manip trees; None otherwise)."""
         self.cause: FailureCause | None = None
         """The node whose failure ended the run (bt_manip trees; None otherwise)."""
         if world is not None:
@@ -118,6 +121,8 @@ class Runner:
         try:
             return self._run()
         finally:
+            if self.counter is not None:
+                self.counter.detach()
             self.close_hooks()
 
     def close_hooks(self) -> None:
@@ -130,6 +135,8 @@ class Runner:
         self._pace_wall0 = wall0
         self._start_sim = self._now()
         status, reason = RunStatus.BUDGET, ""
+        counter = NodeCounter(self.tree).attach() if NodeCounter.can_watch(self.tree) else None
+        self.counter = counter
         try:
             while True:
                 result = self.tree.tick().name
@@ -196,7 +203,7 @@ class Runner:
             time.sleep(1.0 / opts.tick_hz)
 
     def _records(self) -> list[NodeReport]:
-        return node_reports(self.tree)
+        return node_reports(self.tree, self.counter)
 
     def _failure_reason(self) -> str:
         """The reason of the failure that ended the run (see

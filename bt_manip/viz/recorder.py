@@ -27,7 +27,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from bt_manip.bt.walk import walk_nodes
 from bt_manip.overlay import FrameItem, Overlay, run_overlay
+from bt_manip.run.node_counts import COUNT_FIELDS, NodeCounter
 from bt_manip.sim.events import Attached, BodyAdded, BodyRemoved, Detached, WorldEvent
 from bt_manip.viz.camera import replay_camera
 from bt_manip.viz.overlay import item_json
@@ -86,6 +88,8 @@ class Recorder:
         self._overlay_items: dict[str, Any] = {}
         self._last_time = 0.0
         self._closed = False
+        self._counter: NodeCounter | None = None
+        self._paths = [w.path for w in walk_nodes(tree.root)]
         if world is not None:
             self._scene = Scene(client=world.client)
             for info_ in world.infos.values():
@@ -177,6 +181,7 @@ class Recorder:
         is due (or a body just appeared)."""
         t = self._now(runner)
         self._last_time = t
+        self._counter = getattr(runner, "counter", None)
         for index, code, reason in self.watcher.update():
             self.rec.status_events.append((t, index, code, reason))
         if t >= self._next_sample or self._appeared:
@@ -195,6 +200,9 @@ class Recorder:
         self._closed = True
         if self._unsubscribe is not None:
             self._unsubscribe()
+        if self._counter is not None:  # the run's counts, each node's ticks and results
+            self.rec.counts = [[self._counter.of(p)[k] for k in COUNT_FIELDS]
+                               for p in self._paths]
         if self.world is None:
             self._sample(self._last_time)
         elif self.world.client >= 0:  # a closed world has no poses left to read

@@ -44,6 +44,9 @@ class Recording:
     """(time, body key, held)"""
     result: str = ""
     info: dict[str, Any] = field(default_factory=dict)
+    counts: list[list[int]] | None = None
+    """Per node (in the order of ``nodes``), its counts of the run: ticks, success, failure,
+    skipped, halted (:mod:`bt_manip.run.node_counts`); None when the run could not count."""
 
     @property
     def objects(self) -> list[SceneObject]:

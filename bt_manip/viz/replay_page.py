@@ -122,6 +122,8 @@ def build_container(rec: Recording, title: str = "") -> bytes:
         r = reasons.setdefault(reason, len(reasons))
         events.append([float(t), index, code, r])
     header["tree"] = {"nodes": rec.nodes, "events": events, "reasons": list(reasons)}
+    if rec.counts is not None:
+        header["tree"]["counts"] = rec.counts
     header["overlay"] = [[float(t), name, obj, m] for t, name, obj, m in
                          rec.overlay_events]
     header["highlights"] = [[float(t), name, on] for t, name, on in

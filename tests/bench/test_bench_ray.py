@@ -44,6 +44,10 @@ def test_ray_backend_gives_the_process_pools_results_seed_for_seed(
     assert [o[0] for o in ray] == [0, 1, 2, 3]
     assert {o[1] for o in ray} == {"SUCCESS", "FAILURE"}
     assert ray == pool
+    # and the same tree coverage, to the byte
+    coverage = (tmp_path / "pool" / "coverage.json").read_text()
+    assert (tmp_path / "ray" / "coverage.json").read_text() == coverage
+    assert json.loads(coverage)["node_coverage"]["ticked"] == 4
 
 
 def test_ray_backend_refuses_files_outside_the_folder_it_ships(

@@ -207,7 +207,7 @@ def test_bench_runs_episodes_in_processes_and_writes_outputs(
     text = capsys.readouterr().out
     summary = json.loads((out / "summary.json").read_text())
     listed = json.loads((out / "episodes.json").read_text())
-    assert listed["schema_version"] == summary["schema_version"] == 2
+    assert listed["schema_version"] == summary["schema_version"] == 3
     episodes = listed["episodes"]
     assert [e["seed"] for e in episodes] == [1, 2, 3, 4]
     assert summary["runs"] == 4

@@ -36,5 +36,5 @@ def test_an_unknown_schema_is_bad_input_naming_the_known_ones(
         capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["schema", "run_report"]) == 2
     err = capsys.readouterr().err
-    assert "schema: no schema named 'run_report'; known: bench-episode," in err
+    assert "schema: no schema named 'run_report'; known: bench-coverage, bench-episode," in err
     assert "run-report" in err and "Traceback" not in err

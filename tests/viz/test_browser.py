@@ -395,3 +395,26 @@ def test_failed_leaves_stay_red_and_long_failure_lines_wrap(browser: Any, tmp_pa
     )
     assert overflow and max(overflow) <= 0, overflow  # wrapped, not cut off at the edge
     page.close()
+
+
+def test_replay_tree_shows_each_nodes_ticks_and_dims_nodes_never_ticked(
+        browser: Any, tmp_path: Path) -> None:
+    from bt_manip.bt import load_tree_string
+
+    tree = load_tree_string(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Fallback name="choose">'
+        '<AlwaysSuccess name="first"/><AlwaysSuccess name="second"/>'
+        "</Fallback></BehaviorTree></root>")
+    page_file = tmp_path / "cov.html"
+    recorder = Recorder(page_file, None, tree)
+    Runner(tree, None, RunOptions(tick_hz=200), on_tick=[recorder]).run()
+    recorder.close()
+    page = browser.new_page(viewport=VIEWPORT)
+    page.goto(page_file.as_uri())
+    page.wait_for_function("window.btReplay !== undefined", timeout=30000)
+    badges = page.evaluate(
+        "[...document.querySelectorAll('#tree .node')].map(r => [r.querySelector('.name')"
+        ".textContent, r.querySelector('.cov').textContent, r.classList.contains('never')])")
+    assert badges == [["choose", "\u00d71", False], ["first", "\u00d71", False],
+                      ["second", "never ticked", True]]
+    page.close()

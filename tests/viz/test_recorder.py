@@ -205,3 +205,26 @@ def test_a_block_fault_crate_is_in_the_replay(tmp_path: Path) -> None:
     assert crate["disappear"] is None and crate["path"] == f"{ROOT}/dropped_crate_0"
     z = track_samples(header, blobs, f"{ROOT}/dropped_crate_0")[:, 2]
     assert z[0] > z[-1] + 0.1  # it fell onto the route
+
+
+
+def test_replay_holds_each_nodes_counts_of_a_bt_manip_trees_run(tmp_path: Path) -> None:
+    from bt_manip.episode import Episode, EpisodeSpec
+
+    page = tmp_path / "demo.html"
+    tree = Path(__file__).resolve().parents[2] / "trees" / "builtins_demo.xml"
+    with Episode(EpisodeSpec(tree=str(tree))) as episode:
+        report = episode.run([Recorder(page, None, episode.tree)], RunOptions(tick_hz=1000))
+    header, _ = read_replay(page)
+    names = [n["name"] for n in header["tree"]["nodes"]]
+    counts = header["tree"]["counts"]
+    assert counts[names.index("plan_a")][:3] == [1, 0, 1]  # ticked once, failed once
+    assert counts[names.index("third_time_lucky")][:3] == [3, 1, 2]
+    assert len(counts) == len(report.nodes)
+
+
+def test_a_py_trees_tree_has_no_counts_in_its_replay(tmp_path: Path) -> None:
+    report, header, _, world = _record(tmp_path / "run.html")
+    world.close()
+    assert "counts" not in header["tree"]
+    assert all(n.counts is None for n in report.nodes)

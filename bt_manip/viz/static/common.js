@@ -96,6 +96,23 @@ class TreePanel {
     }
   }
 
+  // counts: per node [ticks, success, failure, skipped, halted] over the whole run (the run
+  // report's counts): each row gets a badge with its ticks, and rows never ticked are dimmed
+  setCounts(counts) {
+    this.counts = counts;
+    counts.forEach((c, i) => {
+      const row = this.rows[i];
+      if (!row || !c) return;
+      const badge = document.createElement("span");
+      badge.className = "cov";
+      badge.textContent = c[0] ? "\u00d7" + c[0] : "never ticked";
+      badge.title = c[0] ? `ticked ${c[0]} times: ${c[1]} success, ${c[2]} failure, ` +
+        `${c[3]} skipped, halted ${c[4]} times while running` : "never ticked in this run";
+      row.insertBefore(badge, row.querySelector(".st"));
+      row.classList.toggle("never", !c[0]);
+    });
+  }
+
   // failures: [[time, node index, reason]] in time order
   setFailures(failures) {
     this.failures = failures;

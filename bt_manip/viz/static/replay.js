@@ -90,6 +90,7 @@
   // -- tree -----------------------------------------------------------------------------------
   const tree = header.tree;
   const panel = new TreePanel(document.getElementById("tree"), document.getElementById("details"), tree.nodes);
+  if (tree.counts) panel.setCounts(tree.counts);
   const reasons = tree.reasons;
   const events = tree.events;
   const statuses = tree.nodes.map(() => 0);
