@@ -4,6 +4,7 @@ beside a wall. Paths are checked again on the exact meshes at 0.01 rad per joint
 from __future__ import annotations
 
 import itertools
+from typing import cast
 
 import numpy as np
 import pytest
@@ -97,3 +98,35 @@ def test_never_colliding_pairs_leave_out_pairs_that_do_collide() -> None:
     quiet = never_colliding_pairs(scene, samples=200, seed=1)
     assert quiet  # many distant links never meet
     assert frozenset(("panda_link0", "panda_link1")) not in quiet  # adjacent: never a pair
+
+
+class _Band:
+    """A plane scene: a disc at (0.5, 0.5) and a band thinner than the check step along the
+    first segment of the path, which the checks at 0.05 step over."""
+
+    checks = 0
+
+    def collides(self, q: np.ndarray) -> bool:
+        self.checks += 1
+        return bool(np.hypot(q[0] - 0.5, q[1] - 0.5) < 0.3
+                    or (0.51 < q[0] < 0.53 and abs(q[1]) < 0.02))
+
+    def segment_free(self, a: np.ndarray, b: np.ndarray, step: float) -> bool:
+        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
+        return not any(self.collides(a + (b - a) * k / n) for k in range(1, n + 1))
+
+
+def test_shortcut_never_leaves_a_waypoint_in_collision() -> None:
+    # A shortcut starts and ends at points inside segments of the path, between the
+    # configurations the segment was checked at: both ends, and the pieces of the segments
+    # left in the path, must be checked on their own.
+    from bt_manip.manipulation.rrt_connect import shortcut
+
+    scene = _Band()
+    path = [np.array([0.0, 0.0]), np.array([1.0, 0.0]), np.array([1.0, 1.0])]
+    assert all(scene.segment_free(a, b, 0.05) for a, b in itertools.pairwise(path))
+    for seed in range(40):
+        out = shortcut(cast(CollisionScene, scene), path, np.random.default_rng(seed),
+                       PlanOptions(shortcut_rounds=60))
+        assert not any(scene.collides(q) for q in out), seed
+        assert all(scene.segment_free(a, b, 0.05) for a, b in itertools.pairwise(out)), seed
