@@ -127,7 +127,10 @@ class CollisionScene:
         for g in self.geometry.geometryObjects:
             shape = g.geometry
             if isinstance(shape, coal.BVHModelBase) and not exact:
-                shape.buildConvexRepresentation(False)
+                # the convex hull itself: buildConvexRepresentation keeps the mesh's vertices
+                # and faces as they are, whose support search gets stuck on a concave mesh
+                # and can find it free where the mesh touches
+                shape.buildConvexHull(True, "Qt")
                 g.geometry = shape.convex
             if padding > 0.0 and not isinstance(g.geometry, coal.BVHModelBase):
                 g.geometry = _padded(g.geometry, padding)

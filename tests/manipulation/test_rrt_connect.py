@@ -130,3 +130,29 @@ def test_shortcut_never_leaves_a_waypoint_in_collision() -> None:
                        PlanOptions(shortcut_rounds=60))
         assert not any(scene.collides(q) for q in out), seed
         assert all(scene.segment_free(a, b, 0.05) for a, b in itertools.pairwise(out)), seed
+
+
+def test_the_hulls_hold_the_meshes() -> None:
+    # Each configuration is checked on the links' convex hulls first and is free when they
+    # are: a hull must contain its mesh, so nothing is nearer to the mesh than to the hull.
+    import coal
+
+    scene = _scene(wall=False)
+    assert scene.mesh_geometry is not None
+    rng = np.random.default_rng(0)
+    ball = coal.Sphere(0.01)
+    here = coal.Transform3s()
+    for hull_obj, mesh_obj in zip(scene.geometry.geometryObjects,
+                                  scene.mesh_geometry.geometryObjects, strict=False):
+        hull, mesh = hull_obj.geometry, mesh_obj.geometry
+        if not isinstance(mesh, coal.BVHModelBase):
+            continue
+        mesh.computeLocalAABB()
+        lo, hi = mesh.aabb_local.min_, mesh.aabb_local.max_
+        for _ in range(150):
+            at = coal.Transform3s(np.eye(3), rng.uniform(lo - 0.02, hi + 0.02))
+            to_hull = coal.distance(hull, here, ball, at, coal.DistanceRequest(),
+                                    coal.DistanceResult())
+            to_mesh = coal.distance(mesh, here, ball, at, coal.DistanceRequest(),
+                                    coal.DistanceResult())
+            assert to_hull <= to_mesh + 1e-6, (hull_obj.name, to_hull, to_mesh)
