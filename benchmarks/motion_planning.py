@@ -47,6 +47,7 @@ import numpy as np
 from bt_manip.manipulation.mbm import family_problems, read_problem
 from bt_manip.manipulation.mbm_data import fetch_mbm
 from bt_manip.manipulation.motion_bench import (
+    VALIDATE_STEP,
     BenchOptions,
     load_robot,
     run_problem,
@@ -164,6 +165,20 @@ def run_roboplan(python: Path, robot: Any, group: str, joints: tuple[str, ...],
         return list(json.loads(out_file.read_text()))
 
 
+def first_contact(exact: Any, path: list[np.ndarray]) -> str:
+    """Where an invalid path first touches, checked as the validator does: the segment, how
+    far along it (rad of the largest joint move) and the pairs in contact."""
+    for i in range(len(path) - 1):
+        a, b = path[i], path[i + 1]
+        n = max(1, int(np.ceil(float(np.max(np.abs(b - a))) / VALIDATE_STEP)))
+        for k in range(n + 1):
+            q = a + (b - a) * (k / n)
+            if exact.collides(q):
+                pairs = ", ".join(f"{x}-{y}" for x, y in exact.contacts(q)[:3])
+                return f"touches on segment {i} at {k}/{n}: {pairs}"
+    return "leaves the joint limits or misses the start or goal"
+
+
 # -- figures -----------------------------------------------------------------------------------
 def stats(values: list[float]) -> dict[str, float | None]:
     if not values:
@@ -262,7 +277,8 @@ def main() -> int:
     for family in families:
         pairs = family_problems(problems_dir / family)[: args.per_family]
         peer_jobs: list[dict] = []
-        checks: dict[str, Callable[[list[list[float]] | None], tuple[bool, float | None]]] = {}
+        checks: dict[str, Callable[[list[list[float]] | None],
+                                   tuple[bool, float | None, str]]] = {}
         group_joints: tuple[str, ...] = ()
         group = ""
         for scene_file, request_file in pairs:
@@ -273,27 +289,29 @@ def main() -> int:
             key = f"{family}/{scene_file.name}"
 
             def check(path: list[list[float]] | None, exact: Any = exact,
-                      setup: Any = setup) -> tuple[bool, float | None]:
+                      setup: Any = setup) -> tuple[bool, float | None, str]:
                 if path is None:
-                    return False, None
+                    return False, None, ""
                 q = [np.asarray(p, dtype=float) for p in path]
-                return validate_path(exact, q, setup.start, setup.goal), path_length(q)
+                valid = validate_path(exact, q, setup.start, setup.goal)
+                return valid, path_length(q), "" if valid else first_contact(exact, q)
 
             checks[key] = check
             if "bt-manip" in planners:
                 o = run_problem(robot, scene_file, request_file, options)
+                contact = "" if o.valid or o.path is None else check(o.path)[2]
                 rows.append({"planner": "bt-manip", "family": family, "scene": scene_file.name,
                              "solved": o.solved, "valid": o.valid, "planning_ms": o.planning_ms,
                              "search_ms": None, "path_length_rad": o.path_length_rad,
-                             "error": o.reason})
+                             "error": contact or o.reason})
             if ompl is not None:
                 scene = scene_for(robot, setup, problem)
                 r = plan_ompl(ompl, scene, setup, args.time_limit, args.step)
-                valid, length = check(r["path"])
+                valid, length, contact = check(r["path"])
                 rows.append({"planner": "ompl", "family": family, "scene": scene_file.name,
                              "solved": r["solved"], "valid": valid,
                              "planning_ms": _total(r), "search_ms": r["plan_ms"],
-                             "path_length_rad": length, "error": r["error"]})
+                             "path_length_rad": length, "error": r["error"] or contact})
             peer_jobs.append({
                 "id": key, "start": setup.start.tolist(), "goal": setup.goal.tolist(),
                 "locked": setup.locked,
@@ -302,11 +320,11 @@ def main() -> int:
             })
         if roboplan is not None and peer_jobs:
             for r in run_roboplan(roboplan, robot, group, group_joints, peer_jobs, options):
-                valid, length = checks[r["id"]](r["path"])
+                valid, length, contact = checks[r["id"]](r["path"])
                 rows.append({"planner": "roboplan", "family": family,
                              "scene": r["id"].split("/", 1)[1], "solved": r["solved"],
                              "valid": valid, "planning_ms": _total(r), "search_ms": r["plan_ms"],
-                             "path_length_rad": length, "error": r["error"]})
+                             "path_length_rad": length, "error": r["error"] or contact})
         for planner in planners:
             print(json.dumps(summarise(rows, planner, family)), flush=True)
     out = Path(args.out)
