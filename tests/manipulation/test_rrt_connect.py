@@ -156,3 +156,14 @@ def test_the_hulls_hold_the_meshes() -> None:
             to_mesh = coal.distance(mesh, here, ball, at, coal.DistanceRequest(),
                                     coal.DistanceResult())
             assert to_hull <= to_mesh + 1e-6, (hull_obj.name, to_hull, to_mesh)
+
+
+def test_a_stop_callback_ends_the_search() -> None:
+    calls = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > 3
+
+    with pytest.raises(PlanError, match=r"stopped after 3 samples"):
+        plan(_scene(), LEFT, RIGHT, np.random.default_rng(7), stop=stop)
