@@ -40,6 +40,13 @@ from bt_manip.sim.compose import composed_urdf
 __all__ = ["CollisionScene", "Obstacle", "SceneError", "never_colliding_pairs", "srdf_pairs"]
 
 
+HULL_MARGIN = 1e-4
+"""Gap (m) under which the hull pass counts two shapes as touching and asks the meshes. coal's
+GJK, stopping on its tolerance, can report a shallow contact of a hull (a convex shape) with a
+cylinder as a gap of a few nanometres; the margin keeps the hull pass from calling free what
+the meshes touch."""
+
+
 class SceneError(ValueError):
     """A URDF, SRDF or obstacle the scene cannot be built from; the message says why."""
 
@@ -179,6 +186,9 @@ class CollisionScene:
         phase culls pairs by their bounding boxes before the exact test (about five times fewer
         microseconds per check than testing every pair for the Panda among six boxes)."""
         self.gdata = pin.GeometryData(self.geometry)
+        if self.mesh_geometry is not None:
+            for request in self.gdata.collisionRequests:
+                request.security_margin = HULL_MARGIN
         self._broad = pin.BroadPhaseManager_NaiveCollisionManager(
             self.model, self.geometry, self.gdata
         )

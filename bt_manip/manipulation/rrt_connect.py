@@ -125,7 +125,9 @@ def plan(
     _check_end(scene, start, "start")
     _check_end(scene, goal, "goal")
     if scene.segment_free(start, goal, options.step):
-        return PlanResult([start, goal], 0, scene.checks - first, (1, 1))
+        # checked again at the validation step, as every path is
+        direct = _validated(scene, [start, goal], rng, options, first, stop)
+        return PlanResult(direct, 0, scene.checks - first, (1, 1))
     lo = np.where(np.isfinite(scene.lower), scene.lower, -math.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, math.pi)
     trees = (_Tree(start, 1024), _Tree(goal, 1024))

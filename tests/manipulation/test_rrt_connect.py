@@ -167,3 +167,39 @@ def test_a_stop_callback_ends_the_search() -> None:
 
     with pytest.raises(PlanError, match=r"stopped after 3 samples"):
         plan(_scene(), LEFT, RIGHT, np.random.default_rng(7), stop=stop)
+
+
+class _Plane(_Band):
+    """The band's plane as a planning scene for :func:`plan`."""
+
+    lower = np.array([-2.0, -2.0])
+    upper = np.array([2.0, 2.0])
+    joint_names = ("x", "y")
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        return bool(np.all(np.abs(q) <= 2.0))
+
+    def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
+        return [("point", "band")] if self.collides(q) else []
+
+
+def test_a_direct_move_free_at_the_coarse_step_is_checked_at_the_fine_one() -> None:
+    # The straight move steps over the band at 0.05 rad: it is checked again at 0.01 like
+    # every other path, and planned round the band.
+    scene = _Plane()
+    start, goal = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    assert scene.segment_free(start, goal, 0.05) and not scene.segment_free(start, goal, 0.01)
+    path = plan(cast(CollisionScene, scene), start, goal, np.random.default_rng(0)).path
+    assert np.array_equal(path[0], start) and np.array_equal(path[-1], goal) and len(path) > 2
+    assert all(scene.segment_free(a, b, 0.01) for a, b in itertools.pairwise(path))
+
+
+def test_the_hull_pass_counts_a_hair_gap_as_a_contact() -> None:
+    # GJK stopping on its tolerance can report a shallow hull contact as a gap of nanometres:
+    # the hull pass asks the meshes below HULL_MARGIN; the meshes' own pass has no margin.
+    from bt_manip.manipulation.collision_scene import HULL_MARGIN
+
+    scene = _scene()
+    assert all(r.security_margin == HULL_MARGIN for r in scene.gdata.collisionRequests)
+    assert all(r.security_margin == 0.0 for r in scene.mesh_gdata.collisionRequests)
+    assert all(r.security_margin == 0.0 for r in _scene(exact=True).gdata.collisionRequests)
