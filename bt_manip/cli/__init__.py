@@ -9,6 +9,7 @@ Verbs:
   bim BUILDING.ifc --out D   an IFC building and its schedule to a world and schedule.json
   bim-report REPORT --png P  the floor plan of an installation run, as built
   robot init|check           write a robot descriptor from a URDF, or check one
+  motion-bench DIR --urdf U  plan MotionBenchMaker arm problems, figures per family
   validate TREE.xml          check a tree without running it, listing every problem
   convert V3.xml [-o OUT]    a BehaviorTree.CPP v3 tree in its v4 form
   show TREE.xml              print a tree as text (or Graphviz with --dot)
@@ -64,6 +65,8 @@ VERBS = (
     Verb("bim-report", "bim",
          "the floor plan of an installation run, elements coloured by their deviation"),
     Verb("robot", "robot", "write a robot descriptor from a URDF, or check one"),
+    Verb("motion-bench", "motion_bench",
+         "plan MotionBenchMaker arm problems and report solved counts, times and lengths"),
     Verb("demo", "run", "run Scenario A headless; write its report and replay page"),
     Verb("examples", "examples", "list the shipped trees, worlds and robots, or copy them"),
     Verb("schema", "schema", "list the JSON Schemas of bt-manip's output files, or print one"),

@@ -41,6 +41,13 @@ from bt_manip.sim.compose import composed_urdf
 __all__ = ["CollisionScene", "Obstacle", "SceneError", "never_colliding_pairs", "srdf_pairs"]
 
 
+HULL_MARGIN = 1e-4
+"""Gap (m) under which the hull pass counts two shapes as touching and asks the meshes. coal's
+GJK, stopping on its tolerance, can report a shallow contact of a hull (a convex shape) with a
+cylinder as a gap of a few nanometres; the margin keeps the hull pass from calling free what
+the meshes touch."""
+
+
 class SceneError(ValueError):
     """A URDF, SRDF or obstacle the scene cannot be built from; the message says why."""
 
@@ -154,8 +161,11 @@ class CollisionScene:
         for g in self.geometry.geometryObjects:
             shape = g.geometry
             if isinstance(shape, coal.BVHModelBase) and not exact:
+                # the convex hull itself (built once per mesh read): buildConvexRepresentation
+                # keeps the mesh's vertices and faces as they are, whose support search gets
+                # stuck on a concave mesh and can find it free where the mesh touches
                 if shape.convex is None:
-                    shape.buildConvexRepresentation(False)
+                    shape.buildConvexHull(True, "Qt")
                 g.geometry = shape.convex
             if padding > 0.0 and not isinstance(g.geometry, coal.BVHModelBase):
                 g.geometry = _padded(g.geometry, padding)
@@ -205,6 +215,9 @@ class CollisionScene:
         phase culls pairs by their bounding boxes before the exact test (about five times fewer
         microseconds per check than testing every pair for the Panda among six boxes)."""
         self.gdata = pin.GeometryData(self.geometry)
+        if self.mesh_geometry is not None:
+            for request in self.gdata.collisionRequests:
+                request.security_margin = HULL_MARGIN
         self._broad = pin.BroadPhaseManager_NaiveCollisionManager(
             self.model, self.geometry, self.gdata
         )

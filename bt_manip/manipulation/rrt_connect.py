@@ -10,7 +10,8 @@ joint at most.
 
 A plan that cannot be made raises :class:`PlanError` whose message says why: the start or the
 goal in collision (naming what touches), outside the joint limits, or no path within the budget
-(with how far each tree grew).
+(with how far each tree grew), or stopped by the caller's ``stop`` callback (which a benchmark
+uses to hold a wall-clock limit per problem; the planner itself never reads a clock).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-from collections.abc import Generator
+from collections.abc import Callable, Generator
 from dataclasses import dataclass
 
 import numpy as np
@@ -116,9 +117,11 @@ def plan(
     goal: np.ndarray,
     rng: np.random.Generator,
     options: PlanOptions = PlanOptions(),
+    stop: Callable[[], bool] | None = None,
 ) -> PlanResult:
-    """A collision-free path ``start`` -> ``goal`` (see the module docstring)."""
-    steps = plan_steps(scene, start, goal, rng, options)
+    """A collision-free path ``start`` -> ``goal`` (see the module docstring). ``stop``, when
+    given, is asked once per sample and ends the search (PlanError) when it answers True."""
+    steps = plan_steps(scene, start, goal, rng, options, stop)
     while True:
         try:
             next(steps)
@@ -133,6 +136,7 @@ def plan_steps(
     goal: np.ndarray,
     rng: np.random.Generator,
     options: PlanOptions = PlanOptions(),
+    stop: Callable[[], bool] | None = None,
 ) -> Generator[int, None, PlanResult]:
     """:func:`plan` in rounds: yields the checks spent so far after every round of the search
     (one extension and one connection: at most ``2 * extend / step`` segment checks and a
@@ -144,13 +148,18 @@ def plan_steps(
     _check_end(scene, start, "start")
     _check_end(scene, goal, "goal")
     if scene.segment_free(start, goal, options.step):
-        return PlanResult([start, goal], 0, scene.checks - first, (1, 1))
+        # checked again at the validation step, as every path is
+        direct = _validated(scene, [start, goal], rng, options, first, stop)
+        return PlanResult(direct, 0, scene.checks - first, (1, 1))
     lo = np.where(np.isfinite(scene.lower), scene.lower, -math.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, math.pi)
     trees = (_Tree(start, 1024), _Tree(goal, 1024))
     samples = 0
     a, b = 0, 1
     while scene.checks - first < options.max_checks:
+        if stop is not None and stop():
+            raise PlanError(f"stopped after {samples} samples ({scene.checks - first} collision "
+                            f"checks; trees of {trees[0].n} and {trees[1].n} nodes)")
         samples += 1
         if rng.random() < options.goal_bias:
             target = trees[b].q[0].copy()
@@ -164,7 +173,7 @@ def plan_steps(
                 path = one[::-1] + other if a == 0 else other[::-1] + one
                 path = _dedupe(path)
                 path = shortcut(scene, path, rng, options)
-                path = _validated(scene, path, rng, options, first)
+                path = _validated(scene, path, rng, options, first, stop)
                 return PlanResult(path, samples, scene.checks - first,
                                   (trees[0].n, trees[1].n))
         a, b = b, a
@@ -177,7 +186,7 @@ def plan_steps(
 
 def _validated(
     scene: CollisionScene, path: list[np.ndarray], rng: np.random.Generator,
-    options: PlanOptions, first: int,
+    options: PlanOptions, first: int, stop: Callable[[], bool] | None = None,
 ) -> list[np.ndarray]:
     """``path`` with every segment free at ``validate_step``: a segment that is not is planned
     again at that resolution (within what is left of the budget)."""
@@ -197,7 +206,7 @@ def _validated(
             j += 1
         left = options.max_checks - (scene.checks - first)
         fine = dataclasses.replace(options, step=options.validate_step, max_checks=max(left, 1))
-        out += plan(scene, a, path[j], rng, fine).path[1:]
+        out += plan(scene, a, path[j], rng, fine, stop).path[1:]
         i = j
     return out
 
@@ -256,7 +265,13 @@ def shortcut(
         (i, qa), (j, qb) = _point_at(path, s), _point_at(path, t)
         if j <= i:
             continue
-        if not scene.collides(qa) and scene.segment_free(qa, qb, options.step):
+        # qa and qb lie between the configurations their segments were checked at, and the
+        # pieces of those segments left in the path are checked at other configurations than
+        # the whole was: check the pieces too, so that every segment of the result is free at
+        # ``step`` as checked on its own (as a validator checks it)
+        if (scene.segment_free(qa, qb, options.step)
+                and scene.segment_free(path[i], qa, options.step)
+                and scene.segment_free(qb, path[j + 1], options.step)):
             path = [*path[:i + 1], qa, qb, *path[j + 1:]]
             path = _dedupe(path)
     return path

@@ -4,6 +4,7 @@ beside a wall. Paths are checked again on the exact meshes at 0.01 rad per joint
 from __future__ import annotations
 
 import itertools
+from typing import cast
 
 import numpy as np
 import pytest
@@ -97,3 +98,108 @@ def test_never_colliding_pairs_leave_out_pairs_that_do_collide() -> None:
     quiet = never_colliding_pairs(scene, samples=200, seed=1)
     assert quiet  # many distant links never meet
     assert frozenset(("panda_link0", "panda_link1")) not in quiet  # adjacent: never a pair
+
+
+class _Band:
+    """A plane scene: a disc at (0.5, 0.5) and a band thinner than the check step along the
+    first segment of the path, which the checks at 0.05 step over."""
+
+    checks = 0
+
+    def collides(self, q: np.ndarray) -> bool:
+        self.checks += 1
+        return bool(np.hypot(q[0] - 0.5, q[1] - 0.5) < 0.3
+                    or (0.51 < q[0] < 0.53 and abs(q[1]) < 0.02))
+
+    def segment_free(self, a: np.ndarray, b: np.ndarray, step: float) -> bool:
+        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
+        return not any(self.collides(a + (b - a) * k / n) for k in range(1, n + 1))
+
+
+def test_shortcut_never_leaves_a_waypoint_in_collision() -> None:
+    # A shortcut starts and ends at points inside segments of the path, between the
+    # configurations the segment was checked at: both ends, and the pieces of the segments
+    # left in the path, must be checked on their own.
+    from bt_manip.manipulation.rrt_connect import shortcut
+
+    scene = _Band()
+    path = [np.array([0.0, 0.0]), np.array([1.0, 0.0]), np.array([1.0, 1.0])]
+    assert all(scene.segment_free(a, b, 0.05) for a, b in itertools.pairwise(path))
+    for seed in range(40):
+        out = shortcut(cast(CollisionScene, scene), path, np.random.default_rng(seed),
+                       PlanOptions(shortcut_rounds=60))
+        assert not any(scene.collides(q) for q in out), seed
+        assert all(scene.segment_free(a, b, 0.05) for a, b in itertools.pairwise(out)), seed
+
+
+def test_the_hulls_hold_the_meshes() -> None:
+    # Each configuration is checked on the links' convex hulls first and is free when they
+    # are: a hull must contain its mesh, so nothing is nearer to the mesh than to the hull.
+    import coal
+
+    scene = _scene(wall=False)
+    assert scene.mesh_geometry is not None
+    rng = np.random.default_rng(0)
+    ball = coal.Sphere(0.01)
+    here = coal.Transform3s()
+    for hull_obj, mesh_obj in zip(scene.geometry.geometryObjects,
+                                  scene.mesh_geometry.geometryObjects, strict=False):
+        hull, mesh = hull_obj.geometry, mesh_obj.geometry
+        if not isinstance(mesh, coal.BVHModelBase):
+            continue
+        mesh.computeLocalAABB()
+        lo, hi = mesh.aabb_local.min_, mesh.aabb_local.max_
+        for _ in range(150):
+            at = coal.Transform3s(np.eye(3), rng.uniform(lo - 0.02, hi + 0.02))
+            to_hull = coal.distance(hull, here, ball, at, coal.DistanceRequest(),
+                                    coal.DistanceResult())
+            to_mesh = coal.distance(mesh, here, ball, at, coal.DistanceRequest(),
+                                    coal.DistanceResult())
+            assert to_hull <= to_mesh + 1e-6, (hull_obj.name, to_hull, to_mesh)
+
+
+def test_a_stop_callback_ends_the_search() -> None:
+    calls = []
+
+    def stop() -> bool:
+        calls.append(1)
+        return len(calls) > 3
+
+    with pytest.raises(PlanError, match=r"stopped after 3 samples"):
+        plan(_scene(), LEFT, RIGHT, np.random.default_rng(7), stop=stop)
+
+
+class _Plane(_Band):
+    """The band's plane as a planning scene for :func:`plan`."""
+
+    lower = np.array([-2.0, -2.0])
+    upper = np.array([2.0, 2.0])
+    joint_names = ("x", "y")
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        return bool(np.all(np.abs(q) <= 2.0))
+
+    def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
+        return [("point", "band")] if self.collides(q) else []
+
+
+def test_a_direct_move_free_at_the_coarse_step_is_checked_at_the_fine_one() -> None:
+    # The straight move steps over the band at 0.05 rad: it is checked again at 0.01 like
+    # every other path, and planned round the band.
+    scene = _Plane()
+    start, goal = np.array([0.0, 0.0]), np.array([1.0, 0.0])
+    assert scene.segment_free(start, goal, 0.05) and not scene.segment_free(start, goal, 0.01)
+    path = plan(cast(CollisionScene, scene), start, goal, np.random.default_rng(0)).path
+    assert np.array_equal(path[0], start) and np.array_equal(path[-1], goal) and len(path) > 2
+    assert all(scene.segment_free(a, b, 0.01) for a, b in itertools.pairwise(path))
+
+
+def test_the_hull_pass_counts_a_hair_gap_as_a_contact() -> None:
+    # GJK stopping on its tolerance can report a shallow hull contact as a gap of nanometres:
+    # the hull pass asks the meshes below HULL_MARGIN; the meshes' own pass has no margin.
+    from bt_manip.manipulation.collision_scene import HULL_MARGIN
+
+    scene = _scene()
+    assert all(r.security_margin == HULL_MARGIN for r in scene.gdata.collisionRequests)
+    assert all(r.security_margin == 0.0 for r in scene.mesh_gdata.collisionRequests)
+    assert all(r.security_margin == 0.0 for r in _scene(exact=True).gdata.collisionRequests)
