@@ -119,6 +119,13 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
         attributes: dict[str, Any] = {"policy": type(policy).__name__,
                                       "synchronise": policy.synchronise}
         if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnSelected):
+            strangers = [c.name for c in policy.children if c not in originals]
+            if strangers:
+                raise TypeError(
+                    f"cannot convert parallel '{name}': its SuccessOnSelected policy names "
+                    f"{strangers}, which are not its children (py_trees ticks such a parallel "
+                    "to FAILURE)"
+                )
             attributes["selected"] = [originals.index(c) for c in policy.children]
         return ptc.PyTreesParallel(name, children, **attributes)
     if kind not in (py_trees.composites.Sequence, py_trees.composites.Selector):
