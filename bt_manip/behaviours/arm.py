@@ -391,9 +391,17 @@ class MoveJointsSequentially(JointMove):
 class MoveJoints(JointMove):
     """Moves all arm joints together to ``targets`` or to a named arm ``state`` (e.g. tuck).
 
-    - RUNNING while the arm moves (joints are timed to arrive together);
+    With ``planner="auto"`` the move is first checked in the arm's planning scene (the world's
+    bodies near the arm, what it holds) and, when the direct joint move would hit something,
+    planned round it (RRT-Connect; ``rrtconnect`` always plans); ``path_length`` and
+    ``plan_samples`` say what was moved and drawn (robots/README.md, docs/motion-planning.md).
+
+    - RUNNING while the arm moves (joints are timed to arrive together), and while a plan is
+      searched (at most 4000 collision checks per tick, the arm holding still);
     - SUCCESS when every joint is within ``tolerance`` of its target;
-    - FAILURE on an unknown state, targets outside the limits, a time-out, or a collision.
+    - FAILURE on an unknown state, targets outside the limits, a time-out, or a collision; with a
+      planner also when the goal is in collision (naming what touches) or no path is found
+      within the budget (saying how far the search grew).
     Halted: the arm holds where it is.
     """
 
@@ -506,10 +514,17 @@ class MoveToPose(JointMove):
     starts by backing out that far along the tool axis from where the tool is (leaving a grasp or a
     drop the way it came).
 
-    - RUNNING while the arm moves through the joint waypoints;
+    With ``planner="auto"`` (``path="joint"`` only) the IK solution must be free in the arm's
+    planning scene, with its approach: other IK seeds and the tool's other quarter turns about
+    the object are tried; then the joint move is planned round what it would hit, as for
+    MoveJoints.
+
+    - RUNNING while the arm moves through the joint waypoints, and while a plan is searched;
     - SUCCESS when the last waypoint is reached within ``tolerance``;
     - FAILURE when no configuration reaches the pose (the reason says why: beyond reach, joint
-      limits, not converged), on a time-out, or on a collision with walls, furniture or floor.
+      limits, not converged), on a time-out, or on a collision with walls, furniture or floor;
+      with a planner also when every IK solution (or its approach) is in collision, naming what
+      each touches, or when no path is found within the budget.
     Halted: the arm holds where it is.
     """
 
