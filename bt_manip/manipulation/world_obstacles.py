@@ -24,14 +24,6 @@ FLOOR_SLAB = (200.0, 200.0, 0.2)
 """m: the box standing for a plane, its top face on the plane."""
 
 
-def _mesh_points(client: int, body: int, link: int, index: int) -> np.ndarray:
-    try:
-        n, verts = pb.getMeshData(body, link, collisionShapeIndex=index, physicsClientId=client)
-    except pb.error:
-        return np.zeros((0, 3))
-    return np.asarray(verts, dtype=float).reshape(-1, 3) if n else np.zeros((0, 3))
-
-
 def body_obstacles(client: int, body: int, name: str) -> list[Obstacle]:
     """Every collision shape of ``body`` as an obstacle in the world frame."""
     out: list[Obstacle] = []
@@ -61,7 +53,7 @@ def body_obstacles(client: int, body: int, name: str) -> list[Obstacle]:
                 slab[2, 3] = -FLOOR_SLAB[2] / 2.0
                 out.append(Obstacle(label, "box", FLOOR_SLAB, _rows(pose @ slab)))
             elif geom == pb.GEOM_MESH:
-                points = _mesh_points(client, body, link, k)
+                points = pbq.mesh_vertices(client, body, link, k)
                 if len(points) >= 4:  # vertices come in the centre-of-mass frame
                     out.append(Obstacle(label, "convex", (), _rows(com),
                                         tuple(map(tuple, points))))

@@ -21,7 +21,6 @@ link's centre-of-mass frame (``getBasePositionAndOrientation`` / ``getLinkState`
 from __future__ import annotations
 
 import bisect
-import itertools
 import math
 import struct
 from collections.abc import Sequence
@@ -460,24 +459,11 @@ def _shape_outline(
     if geom in (pb.GEOM_CYLINDER, pb.GEOM_CAPSULE):
         return _round_solid(frame, float(dims[0]), float(dims[1]), geom == pb.GEOM_CAPSULE, band)
     if geom == pb.GEOM_MESH:
-        verts = _mesh_vertices(client, body, link, index)
+        verts = pbq.mesh_vertices(client, body, link, index)
         if len(verts) == 0:  # PyBullet gives no vertices: the link's bounding box
             return _aabb_outline(client, body, link, ref_inv, band)
         return _mesh_outline(verts, com, band)
     return _aabb_outline(client, body, link, ref_inv, band)
-
-
-def _mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
-    try:
-        n, verts = pb.getMeshData(body, link, collisionShapeIndex=index, physicsClientId=client)
-    except pb.error:
-        return np.zeros((0, 3))
-    if not n:
-        return np.zeros((0, 3))
-    # the (x, y, z) tuples' floats read in order: numpy's conversion of the nested tuples,
-    # without looking at each tuple as a sequence first
-    flat = np.fromiter(itertools.chain.from_iterable(verts), dtype=float, count=3 * len(verts))
-    return flat.reshape(-1, 3)
 
 
 def _mesh_outline(verts: np.ndarray, com: Frame, band: ZBand) -> Outline | None:

@@ -10,8 +10,10 @@ Names are decoded to text. Every function takes the client id explicitly.
 
 from __future__ import annotations
 
+import itertools
 from typing import NamedTuple
 
+import numpy as np
 import pybullet as pb
 
 Vec3 = tuple[float, float, float]
@@ -248,6 +250,21 @@ def collision_shapes(client: int, body: int, link: int) -> list[ShapeData]:
         ShapeData(s[0], s[1], s[2], tuple(s[3]), _text(s[4]), tuple(s[5]), tuple(s[6]))
         for s in pb.getCollisionShapeData(body, link, physicsClientId=client)
     ]
+
+
+def mesh_vertices(client: int, body: int, link: int, index: int) -> np.ndarray:
+    """The vertices (n, 3) of collision shape ``index`` of one link (``getMeshData``), in the
+    link's centre-of-mass frame with the shape's offset applied; none when PyBullet gives none."""
+    try:
+        n, verts = pb.getMeshData(body, link, collisionShapeIndex=index, physicsClientId=client)
+    except pb.error:
+        return np.zeros((0, 3))
+    if not n:
+        return np.zeros((0, 3))
+    # the (x, y, z) tuples' floats read in order: numpy's conversion of the nested tuples,
+    # without looking at each tuple as a sequence first
+    flat = np.fromiter(itertools.chain.from_iterable(verts), dtype=float, count=3 * len(verts))
+    return flat.reshape(-1, 3)
 
 
 def contacts(client: int, body: int, other: int | None = None) -> list[ContactInfo]:
