@@ -8,12 +8,11 @@ end the move with FAILURE and a reason; the arm then holds where it is.
 
 from __future__ import annotations
 
-import itertools
 import math
 import operator
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from py_trees.common import Status
@@ -166,7 +165,7 @@ class JointMove(RobotAction):
                 line = follow(candidate)
             except cartesian.CartesianError:
                 continue
-            blocked = _first_blocked(scene, [candidate, *line], step)
+            blocked = scene.first_blocked([candidate, *line], step)
             if blocked is None:
                 return candidate, line
             for a, b in scene.contacts(blocked):
@@ -692,20 +691,6 @@ def _with_knobs(reason: str, free_yaw: bool, approach: float, path: str) -> str:
     if SOLVER_KNOBS in reason:
         return reason.replace(SOLVER_KNOBS, text)
     return f"{reason}; {text}"
-
-
-def _first_blocked(scene: Any, waypoints: list[np.ndarray], step: float) -> np.ndarray | None:
-    """The first configuration along ``waypoints`` (the first included) in collision."""
-    first: np.ndarray = waypoints[0]
-    if scene.collides(first):
-        return first
-    for a, b in itertools.pairwise(waypoints):
-        n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
-        for k in range(1, n + 1):
-            q: np.ndarray = a + (b - a) * (k / n)
-            if scene.collides(q):
-                return q
-    return None
 
 
 def _through(path: list[np.ndarray], n: int) -> list[Stage]:

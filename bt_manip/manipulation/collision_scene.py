@@ -334,6 +334,24 @@ class CollisionScene:
                 out.append(named)
         return out
 
+    def first_blocked(self, waypoints: Sequence[np.ndarray], step: float) -> np.ndarray | None:
+        """The first configuration in contact along ``waypoints`` (the first one included),
+        each segment straight in joint space and checked no more than ``step`` rad per joint
+        apart, in path order; None when the whole path is free."""
+        hit = self._hit
+        first = np.asarray(waypoints[0], dtype=float)
+        self.checks += 1
+        if hit(first):
+            return first
+        for a, b in itertools.pairwise(np.asarray(w, dtype=float) for w in waypoints):
+            n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
+            for k in range(1, n + 1):
+                q: np.ndarray = a + (b - a) * (k / n)
+                self.checks += 1
+                if hit(q):
+                    return q
+        return None
+
     def segment_free(self, a: np.ndarray, b: np.ndarray, step: float) -> bool:
         """True when every configuration from ``a`` to ``b`` (straight in joint space, no joint
         moving more than ``step`` rad between two checks) is free; ``a`` itself is not checked.

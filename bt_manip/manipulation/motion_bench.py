@@ -243,9 +243,9 @@ def validate_path(scene: CollisionScene, path: Sequence[np.ndarray], start: np.n
     q = [np.asarray(p, dtype=float) for p in path]
     if not (np.allclose(q[0], start, atol=1e-6) and np.allclose(q[-1], goal, atol=1e-6)):
         return False
-    if not all(scene.within_limits(p) for p in q) or scene.collides(q[0]):
+    if not all(scene.within_limits(p) for p in q):
         return False
-    return all(scene.segment_free(a, b, step) for a, b in itertools.pairwise(q))
+    return scene.first_blocked(q, step) is None
 
 
 def _deadline(limit_s: float | None, every: int = 8) -> Callable[[], bool] | None:
