@@ -178,7 +178,8 @@ class CollisionScene:
         self.obstacles: dict[str, int] = {}
         self.held: dict[str, int] = {}
         self.data = self.model.createData()
-        self._rebuild()
+        self._mesh_data = self.model.createData()
+        self._changed()
         self.checks = 0
         """Configurations checked so far."""
 
@@ -210,23 +211,42 @@ class CollisionScene:
         for geometry in self._geometries():
             geometry.addCollisionPair(pin.CollisionPair(i, j))
 
-    def _rebuild(self) -> None:
-        """Fresh geometry data and broad phase after the shapes or pairs changed. The broad
+    def _changed(self) -> None:
+        """The shapes or pairs changed: the geometry data and broad phase are made again
+        before the next check (once, however many changes came before it)."""
+        self._stale = True
+
+    def _fresh(self) -> None:
+        """Fresh geometry data and broad phase if the shapes or pairs changed. The broad
         phase culls pairs by their bounding boxes before the exact test (about five times fewer
         microseconds per check than testing every pair for the Panda among six boxes)."""
-        self.gdata = pin.GeometryData(self.geometry)
+        if not self._stale:
+            return
+        self._stale = False
+        self._gdata = pin.GeometryData(self.geometry)
         if self.mesh_geometry is not None:
-            for request in self.gdata.collisionRequests:
+            for request in self._gdata.collisionRequests:
                 request.security_margin = HULL_MARGIN
         self._broad = pin.BroadPhaseManager_NaiveCollisionManager(
-            self.model, self.geometry, self.gdata
+            self.model, self.geometry, self._gdata
         )
-        self._mesh_data = self.model.createData()
         if self.mesh_geometry is not None:
-            self.mesh_gdata = pin.GeometryData(self.mesh_geometry)
+            self._mesh_gdata = pin.GeometryData(self.mesh_geometry)
             self._mesh_broad = pin.BroadPhaseManager_NaiveCollisionManager(
-                self.model, self.mesh_geometry, self.mesh_gdata
+                self.model, self.mesh_geometry, self._mesh_gdata
             )
+
+    @property
+    def gdata(self) -> pin.GeometryData:
+        """The geometry data of the first (hull) pass, up to date."""
+        self._fresh()
+        return self._gdata
+
+    @property
+    def mesh_gdata(self) -> pin.GeometryData:
+        """The geometry data of the mesh pass, up to date (a scene with meshes only has none)."""
+        self._fresh()
+        return self._mesh_gdata
 
     def allow(self, pairs: Iterable[frozenset[str]]) -> None:
         """Stop checking these pairs of links (or link and obstacle)."""
@@ -236,7 +256,7 @@ class CollisionScene:
             for pair in list(geometry.collisionPairs):
                 if frozenset((self.link_of[pair.first], self.link_of[pair.second])) in pairs:
                     geometry.removeCollisionPair(pair)
-        self._rebuild()
+        self._changed()
 
     # -- obstacles ----------------------------------------------------------------------------
     def add_obstacle(self, obstacle: Obstacle, padding: float = 0.0) -> None:
@@ -261,7 +281,7 @@ class CollisionScene:
             for i in [*range(self._robot_geoms), *self.held.values()]:
                 if frozenset((self.link_of[i], obstacle.name)) not in allowed:
                     self._add_pair(i, index)
-        self._rebuild()
+        self._changed()
 
     def hold(self, obstacle: Obstacle, link: str, touching: Iterable[str] = ()) -> None:
         """Carry ``obstacle`` with ``link``: its ``pose`` is then in ``link``'s frame, it moves
@@ -285,7 +305,7 @@ class CollisionScene:
         for i in range(self._robot_geoms):
             if self.link_of[i] not in allowed:
                 self._add_pair(i, index)
-        self._rebuild()
+        self._changed()
 
     def clear_obstacles(self) -> None:
         """Remove every obstacle and held object (the robot's own shapes stay)."""
@@ -299,22 +319,24 @@ class CollisionScene:
         self.link_of = self.link_of[: self._robot_geoms]
         self.obstacles = {}
         self.held = {}
-        self._rebuild()
+        self._changed()
 
     def move_obstacle(self, name: str, pose: Sequence[Sequence[float]] | np.ndarray) -> None:
         """Put obstacle ``name`` at ``pose`` (4x4, root frame)."""
         index = self.obstacles[name]
         for geometry in self._geometries():
             geometry.geometryObjects[index].placement = _se3(pose)
-        self._rebuild()
+        self._changed()
 
     # -- checks -------------------------------------------------------------------------------
     def collides(self, q: np.ndarray) -> bool:
         """True when configuration ``q`` puts two shapes in contact (one check)."""
         self.checks += 1
+        self._fresh()
         return self._hit(np.asarray(q, dtype=float))
 
     def _hit(self, q: np.ndarray) -> bool:
+        """Whether ``q`` is in contact (the caller has made the data fresh)."""
         if not pin.computeCollisions(self.model, self.data, self._broad, q, True):
             return False  # the hulls are free: so are the meshes inside them
         if self.mesh_geometry is None:
@@ -323,8 +345,9 @@ class CollisionScene:
 
     def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
         """Every pair of links (or link and obstacle) in contact at ``q``, by name."""
-        geometry, gdata = ((self.mesh_geometry, self.mesh_gdata) if self.mesh_geometry is not None
-                           else (self.geometry, self.gdata))
+        self._fresh()
+        geometry, gdata = ((self.mesh_geometry, self._mesh_gdata)
+                           if self.mesh_geometry is not None else (self.geometry, self._gdata))
         pin.computeCollisions(self.model, self._mesh_data, geometry, gdata,
                               np.asarray(q, dtype=float), False)
         out: list[tuple[str, str]] = []
@@ -338,6 +361,7 @@ class CollisionScene:
         """The first configuration in contact along ``waypoints`` (the first one included),
         each segment straight in joint space and checked no more than ``step`` rad per joint
         apart, in path order; None when the whole path is free."""
+        self._fresh()
         hit = self._hit
         first = np.asarray(waypoints[0], dtype=float)
         self.checks += 1
@@ -359,6 +383,7 @@ class CollisionScene:
         n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
         order = _bisection_order(n)
         configs = a + np.outer(np.asarray(order, dtype=float) / n, b - a)
+        self._fresh()
         hit = self._hit
         for k, q in enumerate(configs):
             if hit(q):
@@ -418,11 +443,12 @@ def never_colliding_pairs(
         if p.first < scene._robot_geoms and p.second < scene._robot_geoms
     ]
     touched = np.zeros(len(pairs), dtype=bool)
+    gdata = scene.gdata
     for _ in range(samples):
         q = rng.uniform(lo, hi)
-        pin.computeCollisions(scene.model, scene.data, scene.geometry, scene.gdata, q, False)
+        pin.computeCollisions(scene.model, scene.data, scene.geometry, gdata, q, False)
         for n, (k, _) in enumerate(pairs):
-            if not touched[n] and scene.gdata.collisionResults[k].isCollision():
+            if not touched[n] and gdata.collisionResults[k].isCollision():
                 touched[n] = True
     return {
         frozenset((scene.link_of[p.first], scene.link_of[p.second]))
