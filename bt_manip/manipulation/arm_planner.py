@@ -56,8 +56,15 @@ PyBullet's contact threshold."""
 
 
 @dataclass(frozen=True)
-class _Key:
-    locked: tuple[tuple[str, float], ...]
+class _World:
+    """The world as a scene takes it: objects carried (in their link's frame, with the link),
+    the other shapes (root frame), the link-shape pairs allowed, the links that may touch what
+    the hand holds."""
+
+    carried: list[tuple[Obstacle, str]]
+    shapes: list[Obstacle]
+    allowed: set[frozenset[str]]
+    touching: set[str]
 
 
 class ArmPlanner:
@@ -67,11 +74,10 @@ class ArmPlanner:
         self.world = world
         self.robot = robot
         self.robot_name = robot_name
-        self._scenes: OrderedDict[_Key, CollisionScene] = OrderedDict()
+        self._scenes: OrderedDict[tuple[tuple[str, float], ...], CollisionScene] = OrderedDict()
         self._quiet: set[frozenset[str]] | None = None
         self.options = PlanOptions(max_checks=60_000)
         self.plans = 0
-        self._movables = True
 
     # -- the scene ----------------------------------------------------------------------------
     def _locked(self) -> dict[str, float]:
@@ -89,7 +95,7 @@ class ArmPlanner:
     def scene(self) -> CollisionScene:
         """The scene for the locked joints as they are now (built on first use)."""
         locked = self._locked()
-        key = _Key(tuple(sorted(locked.items())))
+        key = tuple(sorted(locked.items()))
         scene = self._scenes.get(key)
         if scene is None:
             desc = self.robot.description
@@ -126,18 +132,17 @@ class ArmPlanner:
         move away from what it touches, as a move without a plan may, and come as close to
         what the goal is close to. Without ``movables``, the world's movable objects are left
         out (a goal may brush one, as a move may push one)."""
-        self._movables = movables
-        self._fill(scene, grasping, set(), padding)
+        world = self._gather(scene, grasping, movables)
+        self._place(scene, world, set(), padding)
         touching: set[frozenset[str]] = set()
         for q in ends:
             if scene.collides(np.asarray(q, dtype=float)):
                 touching |= {frozenset(pair) for pair in scene.contacts(np.asarray(q, float))}
         if touching:
-            self._fill(scene, grasping, touching, padding)
+            self._place(scene, world, touching, padding)
 
-    def _fill(self, scene: CollisionScene, grasping: str, extra: set[frozenset[str]],
-              padding: float) -> None:
-        scene.clear_obstacles()
+    def _gather(self, scene: CollisionScene, grasping: str, movables: bool) -> _World:
+        """What of the world goes into ``scene``, in its root frame (see :meth:`sync`)."""
         desc = self.robot.description
         hand = set(desc.gripper.finger_links) | {desc.end_effector, desc.grasp_link
                                                  or desc.grasp_frame}
@@ -149,25 +154,36 @@ class ArmPlanner:
         carrier = desc.grasp_link or desc.grasp_frame
         held += [(name, body, carrier) for name, body in self.world.movable.items()
                  if name not in {h[0] for h in held} and self.robot.is_grasping(body)]
+        carried = []
         for name, body, link in held:
             link_from_world = inverse_matrix(self.robot.link_transform(link))
-            for shape in body_obstacles(self.world.client, body, name):
-                scene.hold(_moved(shape, link_from_world), link, touching)
+            carried += [(_moved(shape, link_from_world), link)
+                        for shape in body_obstacles(self.world.client, body, name)]
         base, reach = self._reach(scene)
         near = (world_from_root @ np.append(base, 1.0))[:3]
         skip = {h[0] for h in held}
-        if not self._movables:
+        if not movables:
             skip |= set(self.world.movable) - {grasping}
         shapes = [_moved(o, root_from_world)
                   for o in world_obstacles(self.world, skip, near, reach)]
         static = {scene.link_of[i] for i in range(scene._robot_geoms)
                   if scene.geometry.geometryObjects[i].parentJoint == 0}
-        allowed = {frozenset((link, o.name)) for o in shapes for link in static} | extra
+        allowed = {frozenset((link, o.name)) for o in shapes for link in static}
         if grasping:
             allowed |= {frozenset((link, o.name)) for o in shapes
                         if o.name == grasping or o.name.startswith(grasping + "#")
                         for link in touching}
-        scene.add_obstacles(shapes, padding, allowed)
+        return _World(carried, shapes, allowed, touching)
+
+    @staticmethod
+    def _place(scene: CollisionScene, world: _World, extra: set[frozenset[str]],
+               padding: float) -> None:
+        """Put ``world`` into ``scene`` (what was there before taken out), ``extra`` pairs
+        allowed besides the world's own."""
+        scene.clear_obstacles()
+        for shape, link in world.carried:
+            scene.hold(shape, link, world.touching)
+        scene.add_obstacles(world.shapes, padding, world.allowed | extra)
 
     # -- plans --------------------------------------------------------------------------------
     def direct_is_free(self, scene: CollisionScene, a: np.ndarray, b: np.ndarray) -> bool:
