@@ -80,6 +80,8 @@ class Stage:
     via: bool = False
     plannable: bool = False
     """A free joint move that may be replaced by a planned, collision-free one."""
+    goal_checked: bool = False
+    """A plannable stage whose command the node already found free in the planning scene."""
     planned: bool = False
     """A waypoint of a planned path: passed within :data:`PLANNED_VIA` rad, so the arm keeps
     to the checked path."""
@@ -191,10 +193,11 @@ class JointMove(RobotAction):
         if planner is None:
             return
         scene = planner.scene()
-        planner.sync(scene, self.grasping(), (start,), movables=False)
-        if scene.collides(goal):  # a goal must be free without padding
-            pairs = ", ".join(f"{a} touches {b}" for a, b in scene.contacts(goal)[:4])
-            raise ActionFailed(f"planning the arm's move: the goal is in collision: {pairs}")
+        if not self.stages[index].goal_checked:  # a goal must be free without padding
+            planner.sync(scene, self.grasping(), (start,), movables=False)
+            if scene.collides(goal):
+                pairs = ", ".join(f"{a} touches {b}" for a, b in scene.contacts(goal)[:4])
+                raise ActionFailed(f"planning the arm's move: the goal is in collision: {pairs}")
         planner.sync(scene, self.grasping(), (start, goal), PADDING)
         if mode == "auto" and planner.direct_is_free(scene, start, goal):
             return
@@ -215,14 +218,12 @@ class JointMove(RobotAction):
             raise ActionFailed(f"planning the arm's move: {exc}") from None
         else:
             return False
-        stage = self.stages[index]
         vias = [Stage(np.asarray(q, dtype=float), list(range(len(q))), via=True, planned=True)
                 for q in result.path[1:-1]]
         self.stages[index:index] = vias
         self.set_output("path_length", path_length(result.path))
         self.set_output("plan_samples", int(result.samples))
         self._planning = None
-        del stage
         return True
 
     def start(self) -> None:
@@ -647,7 +648,8 @@ class MoveToPose(JointMove):
                 return list(cartesian.line(services, tip, first, target, q, free))
 
             q_first, line = self._free_goal(tip, first, q_first, q_now, free, approach_line)
-            stages.append(Stage(q_first, list(range(n)), plannable=True))
+            stages.append(Stage(q_first, list(range(n)), plannable=True,
+                                goal_checked=self._planner() is not None))
             if approach > 0:
                 stages += _through(line, n)
             return stages
