@@ -35,6 +35,8 @@ from typing import Protocol
 import numpy as np
 import pybullet as pb
 
+from bt_manip.sim import pybullet_queries as pbq
+
 __all__ = [
     "MIN_TRAVEL",
     "GripperSurvey",
@@ -106,10 +108,10 @@ class Body:
         """World position and rotation (3x3) of a link frame."""
         index = self.link_index[link]
         if index < 0:
-            pos, quat = pb.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+            pos, quat = pbq.com_pose(self.client, self.body, index)
         else:
-            state = pb.getLinkState(self.body, index, physicsClientId=self.client)
-            pos, quat = state[4], state[5]
+            state = pbq.link_state(self.client, self.body, index)
+            pos, quat = state.frame_position, state.frame_orientation
         rot = np.asarray(pb.getMatrixFromQuaternion(quat), dtype=float).reshape(3, 3)
         return np.asarray(pos, dtype=float), rot
 

@@ -629,7 +629,8 @@ class _Geometry:
                 self.origin = np.asarray(
                     pb.getLinkState(body, yaw_index, physicsClientId=client)[4], dtype=float
                 )
-            self._survey_hand(pb, client, body, names, urdf, opts, explicit or set())
+            joint_index = {info.name: info.index for info in infos}
+            self._survey_hand(client, body, names, joint_index, urdf, opts, explicit or set())
             skipped = []
             for index, link in names.items():
                 lo, hi = pb.getAABB(body, index, physicsClientId=client)
@@ -713,14 +714,10 @@ class _Geometry:
             )
 
     def _survey_hand(
-        self, pb: Any, client: int, body: int, names: dict[int, str], urdf: _Urdf,
-        opts: InitOptions, explicit: set[str],
+        self, client: int, body: int, names: dict[int, str], joint_index: dict[str, int],
+        urdf: _Urdf, opts: InitOptions, explicit: set[str],
     ) -> None:
         """The gripper, the approach axis and any box enclosing the grasp frame."""
-        joint_index = {
-            pb.getJointInfo(body, i, physicsClientId=client)[1].decode(): i
-            for i in range(pb.getNumJoints(body, physicsClientId=client))
-        }
         link_index = {name: index for index, name in names.items()}
         robot = Body(client, body, link_index, joint_index, urdf.below,
                      lambda n: n in urdf.shaped)
