@@ -9,10 +9,10 @@ from typing import Any
 
 import pytest
 
-import bt_manip.bench.pool as pool
 from bt_manip.bench.coverage import COVERAGE_NAME
 from bt_manip.bench.log import LOG_NAME
 from bt_manip.cli import main
+from tests.bench.interrupts import interrupted_when
 
 ROOT = Path(__file__).resolve().parents[2]
 WORLD = str(ROOT / "worlds" / "sawyer_table.yaml")
@@ -99,17 +99,9 @@ def test_one_process_and_two_give_the_same_coverage(benched: Path,
 
 def test_a_resumed_bench_has_the_coverage_of_an_uninterrupted_one(
         benched: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    real_run_one = pool.run_one
-
-    def interrupted_at_seed_3(spec: Any) -> Any:
-        if spec.seed == 3:
-            raise KeyboardInterrupt
-        return real_run_one(spec)
-
-    monkeypatch.setattr(pool, "run_one", interrupted_at_seed_3)
-    assert _bench(benched / "tree.xml", benched / "cut") == 130
+    with interrupted_when(monkeypatch, lambda spec: spec.seed == 3):
+        assert _bench(benched / "tree.xml", benched / "cut") == 130
     assert not (benched / "cut" / COVERAGE_NAME).exists()
-    monkeypatch.setattr(pool, "run_one", real_run_one)
     assert main(["bench", "--resume", str(benched / "cut"), "--jobs", "2"]) == 0
     assert ((benched / "cut" / COVERAGE_NAME).read_text()
             == (benched / "one" / COVERAGE_NAME).read_text())

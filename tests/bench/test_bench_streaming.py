@@ -10,9 +10,9 @@ from typing import Any
 
 import pytest
 
-import bt_manip.bench.pool as pool
 from bt_manip.bench.log import LOG_NAME, read_log
 from bt_manip.cli import main
+from tests.bench.interrupts import interrupted_when
 
 ROOT = Path(__file__).resolve().parents[2]
 SCHEMAS = ROOT / "docs" / "schemas"
@@ -46,22 +46,14 @@ def test_an_interrupted_bench_keeps_its_episodes_and_resume_completes_it(
 ) -> None:
     tree = _tree(tmp_path)
     assert _bench(tree, tmp_path / "whole") == 1  # some seeds draw the failure
-    real_run_one = pool.run_one
-
-    def interrupted_at_seed_3(spec: Any) -> Any:
-        if spec.seed == 3:
-            raise KeyboardInterrupt
-        return real_run_one(spec)
-
-    monkeypatch.setattr(pool, "run_one", interrupted_at_seed_3)
-    assert _bench(tree, tmp_path / "cut") == 130
+    with interrupted_when(monkeypatch, lambda spec: spec.seed == 3):
+        assert _bench(tree, tmp_path / "cut") == 130
     assert "continue with: bt-manip bench --resume" in capsys.readouterr().out
     logged = read_log(tmp_path / "cut")
     assert [r.seed for r in logged.results] == [0, 1, 2]
     assert logged.missing == [3, 4, 5]
     assert not (tmp_path / "cut" / "episodes.json").exists()
 
-    monkeypatch.setattr(pool, "run_one", real_run_one)
     # a line cut short by a crash is dropped, and the bench goes on after the whole lines
     with open(tmp_path / "cut" / LOG_NAME, "a") as fh:
         fh.write('{"kind": "episode", "seed": 3, "sta')
@@ -208,16 +200,9 @@ def test_an_interrupted_sweep_resumes_value_by_value(
     args = ["bench", str(tree), "--world", WORLD, "--runs", "3", "--jobs", "1",
             "--sweep", "step:failure:{0,1}"]
     assert main([*args, "--out", str(tmp_path / "whole")]) == 1
-    real_run_one = pool.run_one
-
-    def interrupted(spec: Any) -> Any:
-        if spec.seed == 1 and spec.inject[-1].probability == 1.0:
-            raise KeyboardInterrupt
-        return real_run_one(spec)
-
-    monkeypatch.setattr(pool, "run_one", interrupted)
-    assert main([*args, "--out", str(tmp_path / "cut")]) == 130
-    monkeypatch.setattr(pool, "run_one", real_run_one)
+    with interrupted_when(
+            monkeypatch, lambda spec: spec.seed == 1 and spec.inject[-1].probability == 1.0):
+        assert main([*args, "--out", str(tmp_path / "cut")]) == 130
     assert main(["bench", "--resume", str(tmp_path / "cut")]) == 1
     for folder in ("00_0", "01_1"):
         assert _outcomes(tmp_path / "cut" / folder) == _outcomes(tmp_path / "whole" / folder)
