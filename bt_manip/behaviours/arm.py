@@ -25,7 +25,7 @@ from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port, count_of
 from bt_manip.geometry import pose_matrix
 from bt_manip.kinematics.reasons import BEYOND_REACH, JOINT_LIMITS, NOT_CONVERGED, SOLVER_KNOBS
 from bt_manip.manipulation import cartesian
-from bt_manip.manipulation.arm_planner import PADDING, PLANNERS, ArmPlanner
+from bt_manip.manipulation.arm_planner import PLANNERS, ArmPlanner
 from bt_manip.manipulation.base_search import object_grasp
 from bt_manip.manipulation.rrt_connect import PlanError, path_length
 from bt_manip.sim.randomize import entity_rng
@@ -63,6 +63,12 @@ PLANNER = Port(
     str, False, "auto: plan round obstacles when the direct joint move would collide (and pick "
     "a collision-free IK solution); rrtconnect: always plan; none: move directly", "none",
     Accepts(choices=PLANNERS),
+)
+PADDING_PORT = Port(
+    float, False, "how much the world's shapes grow when a path is planned (m; goals and "
+    "straight moves are checked without it); unset: the robot descriptor's planning.padding",
+    None,
+    Accepts(0, 0.2),
 )
 PLAN_OUTPUTS: dict[str, PortInformation] = {
     "path_length": PortInformation(float, False, "joint-space length of the move (rad)"),
@@ -198,7 +204,10 @@ class JointMove(RobotAction):
             if scene.collides(goal):
                 pairs = ", ".join(f"{a} touches {b}" for a, b in scene.contacts(goal)[:4])
                 raise ActionFailed(f"planning the arm's move: the goal is in collision: {pairs}")
-        planner.sync(scene, self.grasping(), (start, goal), PADDING)
+        padding = self.get_input("padding", None)
+        if padding is None:
+            padding = self.robot().description.planning.padding
+        planner.sync(scene, self.grasping(), (start, goal), float(padding))
         if mode == "auto" and planner.direct_is_free(scene, start, goal):
             return
         self._planning = (index, planner.steps(scene, start, goal, self.name))
@@ -414,6 +423,7 @@ class MoveJoints(JointMove):
         ),
         "state": PortInformation(str, False, "named arm state of the robot descriptor", ""),
         "planner": PLANNER,
+        "padding": PADDING_PORT,
     }
     OUTPUT_PORTS: dict[str, PortInformation] = dict(PLAN_OUTPUTS)
 
@@ -560,6 +570,7 @@ class MoveToPose(JointMove):
         ),
         "via_tolerance": VIA,
         "planner": PLANNER,
+        "padding": PADDING_PORT,
     }
     OUTPUT_PORTS: dict[str, PortInformation] = dict(PLAN_OUTPUTS)
     PLANS = True

@@ -8,6 +8,7 @@ import argparse
 from pathlib import Path
 
 from bt_manip.cli.args import joint_list
+from bt_manip.manipulation.self_collisions import add_planning_section
 from bt_manip.sim.robot_check import check_robot
 from bt_manip.sim.robot_description import APPROACH_AXES, RobotDescription
 from bt_manip.sim.robot_init import MOBILE_KINDS, InitOptions, init_descriptor
@@ -70,6 +71,7 @@ def cmd_robot_init(args: argparse.Namespace) -> int:
         ),
         notes,
     )
+    desc, allowed = add_planning_section(desc)
     g = desc.gripper
     joints = ", ".join(g.joints[:4]) + (f", ... ({len(g.joints)} joints)" if len(g.joints) > 4
                                         else "")
@@ -83,6 +85,8 @@ def cmd_robot_init(args: argparse.Namespace) -> int:
     )
     for note in notes:
         print(f"  assumed: {note}")
+    print(f"  planning: {len(allowed.never)} link pairs never touch (left out of the arm's "
+          f"collision checks), {len(allowed.default)} touch in a named state (allowed)")
     return 0
 
 

@@ -25,7 +25,6 @@ import json
 from collections import OrderedDict
 from collections.abc import Generator
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -33,26 +32,26 @@ import pinocchio as pin
 import pybullet as pb
 
 from bt_manip.geometry import inverse_matrix
-from bt_manip.manipulation.collision_scene import CollisionScene, Obstacle, never_colliding_pairs
+from bt_manip.manipulation.collision_scene import CollisionScene, Obstacle, srdf_pairs
 from bt_manip.manipulation.rrt_connect import PlanOptions, PlanResult, plan_steps
+from bt_manip.manipulation.self_collisions import (
+    SELF_SAMPLES,
+    AllowedCollisions,
+    find_allowed_collisions,
+)
 from bt_manip.manipulation.world_obstacles import body_obstacles, world_obstacles
 from bt_manip.sim.compose import cache_dir, write_atomic_bytes
 from bt_manip.sim.randomize import entity_rng
+from bt_manip.sim.robot_description import RobotDescription
 
-__all__ = ["PLANNERS", "ArmPlanner"]
+__all__ = ["PLANNERS", "ArmPlanner", "allowed_pairs"]
 
 PLANNERS = ("auto", "rrtconnect", "none")
 """``auto``: plan only when the direct joint move would collide; ``rrtconnect``: always plan
 (a free direct move is the plan); ``none``: move directly, as without a planner."""
 SCENES_KEPT = 4
-SELF_SAMPLES = 1000
-"""Random configurations sampled to find the link pairs that never touch."""
 REACH_MARGIN = 0.5
 """m added to the arm's reach when choosing the bodies near enough to matter."""
-PADDING = 0.02
-"""m the world's shapes are grown by when planning a path (not when checking a goal or a
-straight approach): room for how the arm follows its waypoints under its own weight and for
-PyBullet's contact threshold."""
 
 
 @dataclass(frozen=True)
@@ -101,7 +100,7 @@ class ArmPlanner:
             desc = self.robot.description
             scene = CollisionScene(desc.urdf_path, list(desc.arm.joints), locked=locked)
             if self._quiet is None:
-                self._quiet = _quiet_pairs(scene, desc.urdf_path, desc.arm.joints)
+                self._quiet = allowed_pairs(desc)
             scene.allow(self._quiet)
             self._scenes[key] = scene
             while len(self._scenes) > SCENES_KEPT:
@@ -200,20 +199,27 @@ class ArmPlanner:
                           self.options)
 
 
-def _quiet_pairs(scene: CollisionScene, urdf: Path, joints: tuple[str, ...]
-                 ) -> set[frozenset[str]]:
-    """:func:`never_colliding_pairs` of the robot, found once and kept in the cache folder
-    (keyed by the URDF's bytes and the arm's joints)."""
-    key = hashlib.sha256(urdf.read_bytes() + "\n".join(joints).encode()).hexdigest()[:20]
-    path = cache_dir() / f"quiet-pairs-{key}-{SELF_SAMPLES}.json"
+def allowed_pairs(desc: RobotDescription) -> set[frozenset[str]]:
+    """The pairs of ``desc``'s links the planner leaves out: those its descriptor lists (and its
+    SRDF's), else the ones :func:`find_allowed_collisions` finds, kept in the cache folder
+    (keyed by the URDF's bytes, the arm's joints and its named states)."""
+    extra = srdf_pairs(desc.planning.srdf) if desc.planning.srdf is not None else set()
+    listed = AllowedCollisions.of(desc)
+    if listed is not None:
+        return set(listed.pairs) | extra
+    urdf = desc.urdf_path
+    states = json.dumps(sorted((k, list(v)) for k, v in desc.states.items()))
+    key = hashlib.sha256(urdf.read_bytes() + "\n".join(desc.arm.joints).encode()
+                         + states.encode()).hexdigest()[:20]
+    path = cache_dir() / f"allowed-pairs-{key}-{SELF_SAMPLES}.json"
     if path.is_file():
         try:
-            return {frozenset(pair) for pair in json.loads(path.read_text())}
+            return {frozenset(pair) for pair in json.loads(path.read_text())} | extra
         except (ValueError, TypeError):
             pass  # a damaged file is found again
-    pairs = never_colliding_pairs(scene, SELF_SAMPLES, seed=0)
+    pairs = set(find_allowed_collisions(desc).pairs)
     write_atomic_bytes(path, json.dumps(sorted(sorted(p) for p in pairs)).encode())
-    return pairs
+    return pairs | extra
 
 
 def _hand(scene: CollisionScene) -> set[str]:

@@ -253,9 +253,11 @@ class CollisionScene:
         pairs = set(pairs)
         self.allowed |= pairs
         for geometry in self._geometries():
-            for pair in list(geometry.collisionPairs):
-                if frozenset((self.link_of[pair.first], self.link_of[pair.second])) in pairs:
-                    geometry.removeCollisionPair(pair)
+            # indices copied first: the pairs pinocchio lists are views into its vector, which
+            # shift under them as pairs are removed
+            for i, j in [(p.first, p.second) for p in geometry.collisionPairs]:
+                if frozenset((self.link_of[i], self.link_of[j])) in pairs:
+                    geometry.removeCollisionPair(pin.CollisionPair(i, j))
         self._changed()
 
     # -- obstacles ----------------------------------------------------------------------------

@@ -54,7 +54,13 @@ TOP_KEYS = {
     "gripper",
     "states",
     "footprint",
+    "planning",
 }
+PLANNING_KEYS = {"padding", "allowed_collisions", "srdf"}
+ALLOWED_REASONS = ("default", "never", "user")
+"""The reasons a pair of links may be listed under in ``planning.allowed_collisions``."""
+DEFAULT_PADDING = 0.02
+"""m the world's shapes grow by when an arm path is planned, unless the descriptor says."""
 BASE_KEYS = {
     "type",
     "left_wheels",
@@ -155,6 +161,19 @@ class ArmSpec:
     lower: tuple[float, ...] = ()
     upper: tuple[float, ...] = ()
     position_gain: float = 0.3
+
+
+@dataclass(frozen=True)
+class PlanningSpec:
+    """The arm planner's settings (``planning``): padding, the allowed-collision matrix."""
+
+    padding: float = DEFAULT_PADDING
+    """m the world's shapes grow by when a path is planned (not for goals and straight moves)."""
+    allowed: Mapping[str, frozenset[frozenset[str]]] | None = None
+    """Pairs of links never checked against each other, by reason (``default``, ``never``,
+    ``user``); None when the descriptor lists none (the planner then finds them itself)."""
+    srdf: Path | None = None
+    """An SRDF whose ``disable_collisions`` pairs are allowed too."""
 
 
 @dataclass(frozen=True)
@@ -263,6 +282,8 @@ class RobotDescription:
     """The axis of ``grasp_link`` along which the gripper approaches an object."""
     grasp_link: str = ""
     """The grasp frame as the descriptor names it (a link of the URDF)."""
+    planning: PlanningSpec = PlanningSpec()
+    """The arm planner's settings."""
 
     @classmethod
     def load(cls, name_or_path: str | Path) -> RobotDescription:
@@ -459,6 +480,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             data.line_of("approach_axis"),
             f"approach_axis must be one of {', '.join(APPROACH_AXES)}, got {approach_axis!r}",
         )
+    planning = _planning(f, data, path)
     if f.problems:
         raise InputError(f.problems)
     grasp_frame = grasp_link
@@ -480,8 +502,38 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
         spawn_height,
         approach_axis,
         grasp_link,
+        planning,
     )
     return _check_against_urdf(desc, data, f)
+
+
+def _planning(f: _Fields, data: LineDict, path: Path) -> PlanningSpec:
+    """The ``planning`` section (absent: the defaults)."""
+    p = f.section(data, "planning", PLANNING_KEYS, required=False)
+    padding = f.number(p, "padding", "planning", DEFAULT_PADDING, within=(0.0, 0.2))
+    allowed: dict[str, frozenset[frozenset[str]]] | None = None
+    if "allowed_collisions" in p:
+        raw = p["allowed_collisions"]
+        m = f.mapping(raw, p.line_of("allowed_collisions"), "planning.allowed_collisions")
+        allowed = {}
+        if m is not None:
+            f.unknown_keys(m, set(ALLOWED_REASONS), "planning.allowed_collisions")
+            for reason in ALLOWED_REASONS:
+                pairs: set[frozenset[str]] = set()
+                for item in m.get(reason) or []:
+                    if (not isinstance(item, list) or len(item) != 2
+                            or not all(isinstance(v, str) and v for v in item)):
+                        f.fail(m.line_of(reason), f"planning.allowed_collisions.{reason}: each "
+                               f"entry must be a pair of link names, got {item!r}")
+                        continue
+                    pairs.add(frozenset(item))
+                allowed[reason] = frozenset(pairs)
+    srdf: Path | None = None
+    if "srdf" in p:
+        srdf = (path.parent / f.text(p, "srdf", "planning")).resolve()
+        if not srdf.is_file():
+            f.fail(p.line_of("srdf"), f"planning.srdf: no file {srdf}")
+    return PlanningSpec(DEFAULT_PADDING if padding is None else padding, allowed, srdf)
 
 
 def _with_approach_frame(
@@ -643,6 +695,9 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
     need(desc.gripper.finger_links, links, "gripper", "finger_links")
     need((desc.end_effector,), links, "", "end_effector")
     need((desc.grasp_link,), links, "", "grasp_frame")
+    for pairs in (desc.planning.allowed or {}).values():
+        need(tuple(sorted({n for pair in pairs for n in pair})), links,
+             "planning", "allowed_collisions")
     if f.problems:
         raise InputError(f.problems)
     lower, upper = [], []

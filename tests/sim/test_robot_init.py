@@ -12,6 +12,7 @@ import yaml
 from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.errors import InputError
+from bt_manip.manipulation.self_collisions import add_planning_section
 from bt_manip.sim.assets import example_robot_data_share
 from bt_manip.sim.robot_check import check_robot
 from bt_manip.sim.robot_description import RobotDescription
@@ -60,7 +61,7 @@ def test_panda_descriptor_fields(tmp_path: Path) -> None:
 
 
 def test_committed_panda_descriptor_is_what_init_writes(tmp_path: Path) -> None:
-    init_descriptor(_panda(tmp_path))
+    add_planning_section(init_descriptor(_panda(tmp_path)))  # as robot init writes it
     written = yaml.safe_load((tmp_path / "panda.yaml").read_text())
     committed = yaml.safe_load((ROOT / "robots" / "panda.yaml").read_text())
     assert written == committed
