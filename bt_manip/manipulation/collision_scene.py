@@ -23,9 +23,14 @@ wall time, so their outcomes do not depend on the machine.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import hashlib
 import itertools
 import math
+import os
+import re
+import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,7 +41,7 @@ import numpy as np
 import pinocchio as pin
 
 from bt_manip.cache import Memo, bytes_key
-from bt_manip.sim.compose import composed_urdf
+from bt_manip.sim.compose import cache_dir, composed_urdf, file_stamp
 
 __all__ = ["CollisionScene", "Obstacle", "SceneError", "never_colliding_pairs", "srdf_pairs"]
 
@@ -91,12 +96,24 @@ def _se3(pose: Sequence[Sequence[float]] | np.ndarray) -> pin.SE3:
 
 
 _LOADED: Memo[tuple[pin.Model, pin.GeometryModel]] = Memo(8)
-"""Models and collision geometry read in this process, by URDF bytes (the meshes' hulls are
-built once and shared by every scene made from them)."""
+"""Models and collision geometry read in this process, by URDF bytes."""
+_HULLS: Memo[pin.GeometryModel] = Memo(8)
+"""Collision geometry with each mesh replaced by its convex hull, by URDF bytes."""
+_MESH_FILE = re.compile(rb'filename\s*=\s*"([^"]+)"')
+
+
+def _key(urdf: Path, package_dirs: tuple[str, ...]) -> bytes:
+    """The URDF's bytes, the folders its meshes are looked up in, and each mesh file's stamp:
+    what the geometry read from it depends on."""
+    data = urdf.read_bytes()
+    stamps = [repr(file_stamp(m.decode(errors="replace").removeprefix("file://")))
+              for m in _MESH_FILE.findall(data)]
+    return data + repr(package_dirs).encode() + "".join(stamps).encode()
 
 
 def _loaded(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
-    key = bytes_key(urdf.read_bytes() + repr(package_dirs).encode())
+    """The URDF's model and its collision geometry with the meshes themselves."""
+    key = bytes_key(_key(urdf, package_dirs))
     known = _LOADED.get(key)
     if known is None:
         full = pin.buildModelFromUrdf(str(urdf))
@@ -108,6 +125,52 @@ def _loaded(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.G
         known = (full, geometry)
         _LOADED.put(key, known)
     return known[0], known[1].clone()
+
+
+def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
+    """The URDF's model and its collision geometry with every mesh replaced by its convex
+    hull. Reading meshes and building their bounding-volume trees is most of what a scene
+    costs to make (a quarter of a second for the UR3 on the Husky), and a hull pass needs
+    neither: the hulls are kept in the cache folder and read back in milliseconds; the meshes
+    are read only when a check needs them."""
+    raw = _key(urdf, package_dirs)
+    key = bytes_key(raw)
+    full = pin.buildModelFromUrdf(str(urdf))
+    known = _HULLS.get(key)
+    if known is None:
+        path = cache_dir() / f"hulls-{hashlib.sha256(raw).hexdigest()[:24]}.bin"
+        if path.is_file():
+            known = pin.GeometryModel()
+            try:
+                known.loadFromBinary(str(path))
+            except (RuntimeError, ValueError):
+                known = None  # a damaged file is made again
+        if known is None:
+            _, known = _loaded(urdf, package_dirs)
+            for g in known.geometryObjects:
+                shape = g.geometry
+                if isinstance(shape, coal.BVHModelBase):
+                    # the convex hull itself: buildConvexRepresentation keeps the mesh's
+                    # vertices and faces as they are, whose support search gets stuck on a
+                    # concave mesh and can find it free where the mesh touches
+                    shape.buildConvexHull(True, "Qt")
+                    g.geometry = shape.convex
+            _save(known, path)
+        _HULLS.put(key, known)
+    return full, known.clone()
+
+
+def _save(geometry: pin.GeometryModel, path: Path) -> None:
+    """Write ``geometry`` to ``path`` so that other processes see the whole file or none."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        geometry.saveToBinary(tmp)
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
 
 
 def srdf_pairs(path: Path) -> set[frozenset[str]]:
@@ -136,7 +199,8 @@ class CollisionScene:
         package_dirs: Sequence[str] = (),
     ) -> None:
         urdf = composed_urdf(urdf)  # mesh paths made absolute, as PyBullet loads them
-        full, geometry = _loaded(Path(urdf), tuple(package_dirs))
+        self._source = (Path(urdf), tuple(package_dirs))
+        full, geometry = (_loaded if exact else _hulls)(*self._source)
         names = [full.names[i] for i in range(1, full.njoints)]
         missing = [j for j in joints if j not in names]
         if missing:
@@ -147,6 +211,7 @@ class CollisionScene:
                 jid = full.getJointId(name)
                 q0[full.joints[jid].idx_q] = value
         lock = [full.getJointId(n) for n in names if n not in joints]
+        self._reduce = (full, lock, q0)
         self.model, self.geometry = pin.buildReducedModel(full, geometry, lock, q0)
         self.joint_names = tuple(self.model.names[i] for i in range(1, self.model.njoints))
         order = [self.joint_names.index(j) for j in joints]
@@ -155,20 +220,13 @@ class CollisionScene:
         self.lower = np.asarray(self.model.lowerPositionLimit, dtype=float)
         self.upper = np.asarray(self.model.upperPositionLimit, dtype=float)
         self._robot_geoms = self.geometry.ngeoms
-        self.mesh_geometry = None if exact else self.geometry.clone()
-        """The same shapes with the collision meshes themselves: a configuration the hulls
-        find in contact is confirmed on these, so a check answers for the exact meshes."""
-        for g in self.geometry.geometryObjects:
-            shape = g.geometry
-            if isinstance(shape, coal.BVHModelBase) and not exact:
-                # the convex hull itself (built once per mesh read): buildConvexRepresentation
-                # keeps the mesh's vertices and faces as they are, whose support search gets
-                # stuck on a concave mesh and can find it free where the mesh touches
-                if shape.convex is None:
-                    shape.buildConvexHull(True, "Qt")
-                g.geometry = shape.convex
-            if padding > 0.0 and not isinstance(g.geometry, coal.BVHModelBase):
-                g.geometry = _padded(g.geometry, padding)
+        self.exact = exact
+        """Whether the scene checks the meshes only (no hull pass)."""
+        self._meshes: pin.GeometryModel | None = None
+        if padding > 0.0:
+            for g in self.geometry.geometryObjects:
+                if not isinstance(g.geometry, coal.BVHModelBase):
+                    g.geometry = _padded(g.geometry, padding)
         self.link_of = [self._link_name(g) for g in self.geometry.geometryObjects]
         self.allowed = set(allowed) | self._adjacent()
         for i, j in itertools.combinations(range(self._robot_geoms), 2):
@@ -205,7 +263,28 @@ class CollisionScene:
         return out
 
     def _geometries(self) -> list[pin.GeometryModel]:
-        return [self.geometry] + ([self.mesh_geometry] if self.mesh_geometry is not None else [])
+        """The geometries every change goes to: the first pass's, and the meshes' once read."""
+        return [self.geometry] + ([self._meshes] if self._meshes is not None else [])
+
+    @property
+    def mesh_geometry(self) -> pin.GeometryModel | None:
+        """The same shapes with the collision meshes themselves, where the first pass has their
+        hulls (None for an exact scene, whose first pass has the meshes): a configuration the
+        hulls find in contact is confirmed on these, so a check answers for the exact meshes.
+        Read on first use, with the obstacles, held objects and pairs of the first pass."""
+        if self.exact:
+            return None
+        if self._meshes is None:
+            full, lock, q0 = self._reduce
+            _, meshes = pin.buildReducedModel(full, _loaded(*self._source)[1], lock, q0)
+            for g in list(self.geometry.geometryObjects)[self._robot_geoms:]:
+                meshes.addGeometryObject(pin.GeometryObject(
+                    g.name, g.parentJoint, g.parentFrame, g.placement, g.geometry.clone()))
+            for pair in self.geometry.collisionPairs:
+                meshes.addCollisionPair(pin.CollisionPair(pair.first, pair.second))
+            self._meshes = meshes
+            self._fresh_meshes()
+        return self._meshes
 
     def _add_pair(self, i: int, j: int) -> None:
         for geometry in self._geometries():
@@ -224,17 +303,21 @@ class CollisionScene:
             return
         self._stale = False
         self._gdata = pin.GeometryData(self.geometry)
-        if self.mesh_geometry is not None:
+        if not self.exact:
             for request in self._gdata.collisionRequests:
                 request.security_margin = HULL_MARGIN
         self._broad = pin.BroadPhaseManager_NaiveCollisionManager(
             self.model, self.geometry, self._gdata
         )
-        if self.mesh_geometry is not None:
-            self._mesh_gdata = pin.GeometryData(self.mesh_geometry)
-            self._mesh_broad = pin.BroadPhaseManager_NaiveCollisionManager(
-                self.model, self.mesh_geometry, self._mesh_gdata
-            )
+        if self._meshes is not None:
+            self._fresh_meshes()
+
+    def _fresh_meshes(self) -> None:
+        assert self._meshes is not None
+        self._mesh_gdata = pin.GeometryData(self._meshes)
+        self._mesh_broad = pin.BroadPhaseManager_NaiveCollisionManager(
+            self.model, self._meshes, self._mesh_gdata
+        )
 
     @property
     def gdata(self) -> pin.GeometryData:
@@ -246,6 +329,8 @@ class CollisionScene:
     def mesh_gdata(self) -> pin.GeometryData:
         """The geometry data of the mesh pass, up to date (a scene with meshes only has none)."""
         self._fresh()
+        if self.mesh_geometry is None:
+            raise SceneError("an exact scene has no mesh pass")
         return self._mesh_gdata
 
     def allow(self, pairs: Iterable[frozenset[str]]) -> None:
@@ -341,8 +426,10 @@ class CollisionScene:
         """Whether ``q`` is in contact (the caller has made the data fresh)."""
         if not pin.computeCollisions(self.model, self.data, self._broad, q, True):
             return False  # the hulls are free: so are the meshes inside them
-        if self.mesh_geometry is None:
+        if self.exact:
             return True
+        if self._meshes is None:
+            self.mesh_geometry  # noqa: B018 (read on first use)
         return bool(pin.computeCollisions(self.model, self._mesh_data, self._mesh_broad, q, True))
 
     def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
