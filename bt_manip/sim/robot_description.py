@@ -3,7 +3,8 @@
 :class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
 which URDF (or composition recipe), the base (``skid_steer``, ``holonomic`` or ``fixed``), the
 arm joints in order, the gripper, the end-effector and grasp frames, named arm states and the
-footprint. Every name in it is checked against the robot's URDF. This module is pure data:
+footprint, and the sensors mounted on it (:mod:`bt_manip.sensing.sensors`). Every name in it
+is checked against the robot's URDF. This module is pure data:
 nothing here touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
 """
 
@@ -21,6 +22,7 @@ import defusedxml.ElementTree as SafeET
 from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError
 from bt_manip.input_files import read_bounded
+from bt_manip.sensing.sensors import LidarSpec, read_sensors
 from bt_manip.sim.assets import data_root
 from bt_manip.sim.compose import MAX_URDF_BYTES, Frame, Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
@@ -54,6 +56,7 @@ TOP_KEYS = {
     "gripper",
     "states",
     "footprint",
+    "sensors",
 }
 BASE_KEYS = {
     "type",
@@ -263,6 +266,8 @@ class RobotDescription:
     """The axis of ``grasp_link`` along which the gripper approaches an object."""
     grasp_link: str = ""
     """The grasp frame as the descriptor names it (a link of the URDF)."""
+    sensors: tuple[LidarSpec, ...] = ()
+    """The sensors declared in ``sensors:`` (none by default)."""
 
     @classmethod
     def load(cls, name_or_path: str | Path) -> RobotDescription:
@@ -459,6 +464,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             data.line_of("approach_axis"),
             f"approach_axis must be one of {', '.join(APPROACH_AXES)}, got {approach_axis!r}",
         )
+    sensors = read_sensors(f, data)
     if f.problems:
         raise InputError(f.problems)
     grasp_frame = grasp_link
@@ -480,6 +486,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
         spawn_height,
         approach_axis,
         grasp_link,
+        sensors,
     )
     return _check_against_urdf(desc, data, f)
 
@@ -643,6 +650,10 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
     need(desc.gripper.finger_links, links, "gripper", "finger_links")
     need((desc.end_effector,), links, "", "end_effector")
     need((desc.grasp_link,), links, "", "grasp_frame")
+    for sensor in desc.sensors:
+        if sensor.link not in links:
+            f.fail(sensor.line, f"sensors: '{sensor.name}' is mounted on link '{sensor.link}', "
+                   "which is not in the URDF")
     if f.problems:
         raise InputError(f.problems)
     lower, upper = [], []
