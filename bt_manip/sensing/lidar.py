@@ -112,7 +112,8 @@ class Lidar:
 
     def sensor_pose(self) -> tuple[np.ndarray, float]:
         """The sensor's origin (3,) and heading (rad) in the world, now."""
-        pos, quat = compose_poses(self.robot.link_pose(self.spec.link), self._mount)
+        link_pos, link_quat = self.robot.link_pose(self.spec.link)
+        pos, quat = compose_poses((link_pos.tolist(), link_quat.tolist()), self._mount)
         r = rotation_matrix(quat)
         return np.asarray(pos, dtype=float), math.atan2(r[1, 0], r[0, 0])
 

@@ -70,8 +70,8 @@ def _beam_span(lo: float, span: float, increment: float, beams: int,
     a = lo
     b = lo + span
     for _ in range(2):
-        k0 = max(int(math.ceil(a / increment)), 0)
-        k1 = min(int(math.floor(b / increment)), beams - 1)
+        k0 = max(math.ceil(a / increment), 0)
+        k1 = min(math.floor(b / increment), beams - 1)
         if k1 >= k0:
             first[2 * count] = k0
             first[2 * count + 1] = k1 + 1

@@ -135,12 +135,13 @@ def hull_edges(points: np.ndarray) -> np.ndarray:
         n = min(len(points), 64)
         edges = np.array([(i, j) for i in range(n) for j in range(i + 1, n)], dtype=int)
         edges = edges.reshape(-1, 2)
-    _HULLS.put(key, edges)
-    return edges
+    out = np.asarray(edges, dtype=np.int64)
+    _HULLS.put(key, out)
+    return out
 
 
 def _frame_points(local: np.ndarray, position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    return position + local @ rotation.T
+    return np.asarray(position + local @ rotation.T)
 
 
 def _rim_points(length: float, radius: float) -> np.ndarray:

@@ -191,7 +191,7 @@ def test_moved_object_is_cut_again_only_when_it_moves(room: World) -> None:
                                        physicsClientId=room.client)
     scan = lidar.scan()
     origin, _ = lidar.sensor_pose()
-    beam = int(round(math.degrees(math.atan2(0.3 - origin[1], 1.6 - 0.15 - origin[0])))) + 90
+    beam = round(math.degrees(math.atan2(0.3 - origin[1], 1.6 - 0.15 - origin[0]))) + 90
     face = (1.6 - 0.15 - origin[0]) / math.cos(scan.angles[beam])  # its near face, x = 1.45
     assert scan.ranges[beam] == pytest.approx(face, abs=1e-3)
     room.remove("box_m")
@@ -215,7 +215,7 @@ def test_held_object_is_seen(tmp_path: Path) -> None:
         scan = lidar.scan()
         origin, heading = lidar.sensor_pose()
         offset = bar_xy - origin[:2]
-        beam = int(round(math.degrees(math.atan2(offset[1], offset[0]) - heading))) + 90
+        beam = round(math.degrees(math.atan2(offset[1], offset[0]) - heading)) + 90
         assert scan.ranges[beam] == pytest.approx(np.linalg.norm(offset) - 0.015, abs=0.02)
     finally:
         world.close()
