@@ -3,7 +3,8 @@
 :class:`RobotDescription` is the checked content of a descriptor (format in ``robots/README.md``):
 which URDF (or composition recipe), the base (``skid_steer``, ``holonomic`` or ``fixed``), the
 arm joints in order, the gripper, the end-effector and grasp frames, named arm states and the
-footprint. Every name in it is checked against the robot's URDF. This module is pure data:
+footprint, and the sensors mounted on it (:mod:`bt_manip.sensing.sensors`). Every name in it
+is checked against the robot's URDF. This module is pure data:
 nothing here touches PyBullet (:mod:`bt_manip.sim.robot` spawns and drives a described robot).
 """
 
@@ -21,6 +22,7 @@ import defusedxml.ElementTree as SafeET
 from bt_manip.cache import Memo, bytes_key
 from bt_manip.errors import InputError
 from bt_manip.input_files import read_bounded
+from bt_manip.sensing.sensors import LidarSpec, read_sensors
 from bt_manip.sim.assets import data_root
 from bt_manip.sim.compose import MAX_URDF_BYTES, Frame, Recipe, composed_urdf, parse_recipe
 from bt_manip.sim.yaml_lines import FieldReader, LineDict, load_yaml
@@ -55,6 +57,7 @@ TOP_KEYS = {
     "states",
     "footprint",
     "planning",
+    "sensors",
 }
 PLANNING_KEYS = {"padding", "allowed_collisions", "srdf"}
 ALLOWED_REASONS = ("default", "never", "user")
@@ -284,6 +287,8 @@ class RobotDescription:
     """The grasp frame as the descriptor names it (a link of the URDF)."""
     planning: PlanningSpec = PlanningSpec()
     """The arm planner's settings."""
+    sensors: tuple[LidarSpec, ...] = ()
+    """The sensors declared in ``sensors:`` (none by default)."""
 
     @classmethod
     def load(cls, name_or_path: str | Path) -> RobotDescription:
@@ -481,6 +486,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
             f"approach_axis must be one of {', '.join(APPROACH_AXES)}, got {approach_axis!r}",
         )
     planning = _planning(f, data, path)
+    sensors = read_sensors(f, data)
     if f.problems:
         raise InputError(f.problems)
     grasp_frame = grasp_link
@@ -503,6 +509,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
         approach_axis,
         grasp_link,
         planning,
+        sensors,
     )
     return _check_against_urdf(desc, data, f)
 
@@ -698,6 +705,10 @@ def _check_against_urdf(desc: RobotDescription, data: LineDict, f: _Fields) -> R
     for pairs in (desc.planning.allowed or {}).values():
         need(tuple(sorted({n for pair in pairs for n in pair})), links,
              "planning", "allowed_collisions")
+    for sensor in desc.sensors:
+        if sensor.link not in links:
+            f.fail(sensor.line, f"sensors: '{sensor.name}' is mounted on link '{sensor.link}', "
+                   "which is not in the URDF")
     if f.problems:
         raise InputError(f.problems)
     lower, upper = [], []
