@@ -18,7 +18,7 @@ from bt_manip.localization.kld import bin_keys
 from bt_manip.localization.particles import ParticleSet
 
 MEAN_SHIFT_STEPS = 4
-"""Times the cluster window is moved to the mean of what it holds."""
+"""Most times the cluster window is moved to the mean of what it holds."""
 
 
 @dataclass(frozen=True)
@@ -70,11 +70,13 @@ def best_cluster(
     inside = inverse == heaviest
     centre = _mean(poses[inside], w[inside])
     for _ in range(MEAN_SHIFT_STEPS):
-        inside = _window(poses, centre, radius, half_yaw)
+        window = _window(poses, centre, radius, half_yaw)
+        if np.array_equal(window, inside):
+            break  # the window holds what the mean came from: it would not move
+        inside = window
         if not inside.any() or w[inside].sum() <= 0:
             break
         centre = _mean(poses[inside], w[inside])
-    inside = _window(poses, centre, radius, half_yaw)
     if not inside.any() or w[inside].sum() <= 0:
         inside = np.ones(len(ps), bool)
         centre = _mean(poses, w)

@@ -15,8 +15,9 @@ Each update that is taken (the first one, then one per ``update_min_d`` of trave
 1. moves every particle by a noisy copy of the odometry since the last update
    (:mod:`.motion_model`), so the map -> odom relation is carried by the particles;
 2. weighs each by the likelihood field (:mod:`.likelihood_field`) with ``max_beams`` beams;
-3. updates the slow and fast averages of the weighted mean likelihood (``recovery_alpha_slow``,
-   ``recovery_alpha_fast``);
+3. updates the slow and fast averages of the scan's likelihood (``recovery_alpha_slow``,
+   ``recovery_alpha_fast``): each particle's geometric mean likelihood per beam, averaged with
+   the new weights;
 4. every ``resample_interval`` updates, resamples (:mod:`.resampling`) as many particles as the
    KLD bound asks for (:mod:`.kld`), each replaced with probability ``max(0, 1 - fast/slow)`` by
    a random pose in the free space (recovery from a kidnap).
@@ -125,10 +126,14 @@ class ParticleFilter:
         self._last_odom = new
         ends = self.sensor.beam_ends(scan, o.max_beams)
         logs = self.sensor.log_likelihoods(poses, ends, scan.range_max)
-        w = self._set.weights * np.exp(logs - logs.max())
+        t = logs * o.beam_weight
+        w = self._set.weights * np.exp(t - t.max())
         w /= w.sum()
-        if len(ends):  # the weighted mean of each pose's per-beam geometric mean likelihood
-            self._average_likelihood(float(self._set.weights @ np.exp(logs / len(ends))))
+        if len(ends):
+            # the scan's likelihood: each pose's per-beam geometric mean, averaged with the new
+            # weights, so that it says how well the particles that count explain the scan (the
+            # random particles of the last resampling, nearly all wrong, barely move it)
+            self._average_likelihood(float(w @ np.exp(logs / len(ends))))
         current = pset.ParticleSet(poses, w)
         self._updates += 1
         # the weighted set, before resampling adds its own noise, gives the estimate
@@ -197,7 +202,11 @@ class ParticleFilter:
                                          o.cluster_yaw)
         sx, sy, syaw = (math.sqrt(max(0.0, float(cov[i, i]))) for i in range(3))
         reason = ""
-        if max(sx, sy) > o.lost_std_xy:
+        share = float(ps.weights[inside].sum())
+        if share < o.lost_cluster_weight:
+            reason = (f"the best cluster holds {share:.0%} of the weight, under "
+                      f"lost_cluster_weight {o.lost_cluster_weight:g}")
+        elif max(sx, sy) > o.lost_std_xy:
             reason = (f"position spread {max(sx, sy):.2f} m exceeds lost_std_xy "
                       f"{o.lost_std_xy:g} m")
         elif syaw > o.lost_std_yaw:
@@ -208,5 +217,5 @@ class ParticleFilter:
         return PoseEstimate(
             float(mean[0]), float(mean[1]), float(mean[2]),
             tuple(tuple(float(v) for v in row) for row in cov),
-            float(ps.weights[inside].sum()), len(ps), bool(reason), reason,
+            share, len(ps), bool(reason), reason,
         )

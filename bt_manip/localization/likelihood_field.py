@@ -10,21 +10,26 @@ A beam that ends at ``(x, y)`` has the likelihood
     pz = z_hit * exp(-d^2 / (2 sigma_hit^2)) + z_rand / range_max
 
 where ``d`` is the field's distance at ``(x, y)`` (``laser_likelihood_max_dist`` off the map).
-A pose's weight is ``1 + sum(pz^3)`` over the beams used, the same robust stand-in for a
-product of beam likelihoods as AMCL's: one wrong beam (a person, a door left open) lowers the
-weight a little instead of zeroing it. Readings that are not finite, not positive, or at or
-beyond ``range_max`` say nothing about where the wall is and are left out.
+A pose's log-likelihood is the sum of ``log pz`` over the beams used (the product of the beam
+likelihoods). The ``z_rand`` floor bounds what one wrong beam (a person, a door left open) can
+cost, and the filter tracks the geometric mean per beam (``exp(sum / beams)``) as the scan's
+likelihood for recovery and the "lost" signal, a figure that does not depend on the number of
+beams. (AMCL weighs a pose by ``1 + sum(pz^3)`` instead; that is flatter: a pose 10 cm off keeps
+three quarters of the best weight, so the estimate stays wider.) Readings that are not finite,
+not positive, or at or beyond ``range_max`` say nothing about where the wall is and are left
+out.
 
-:meth:`SensorModel.weights` scores many poses at once: the beams' end points in the base frame
-are worked out once per scan, moved into each particle's frame with numpy, and looked up in a
-table of ``z_hit * exp(...)`` per cell (one border cell around the grid stands for "off the
-map").
+:meth:`SensorModel.log_likelihoods` scores many poses at once: the beams' end points in the base
+frame are worked out once per scan, moved into each particle's frame and looked up in a table of
+``log pz`` per cell (one border cell around the grid stands for "off the map"), in a small
+compiled loop (numba).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from bt_manip.localization.inputs import Scan
@@ -135,14 +140,35 @@ class SensorModel:
     ) -> np.ndarray:
         """``sum(log pz)`` per pose (n, 3) over beam end points ``ends`` (m, 2) in the base
         frame (0 for every pose when there is no beam)."""
-        if ends.shape[0] == 0:
-            return np.zeros(poses.shape[0])
-        c = np.cos(poses[:, 2])[:, None]
-        s = np.sin(poses[:, 2])[:, None]
-        bx = ends[None, :, 0]
-        by = ends[None, :, 1]
-        wx = poses[:, 0, None] + c * bx - s * by
-        wy = poses[:, 1, None] + s * bx + c * by
-        row, col = self.field._index(wx, wy)
-        logs = self._log_table(range_max)[row * self._cols + col]
-        return logs.sum(axis=1, dtype=np.float64)
+        rows, cols = self.field.shape
+        out = np.zeros(poses.shape[0])
+        if ends.shape[0]:
+            _sum_logs(
+                np.ascontiguousarray(poses, dtype=np.float64),
+                np.ascontiguousarray(ends, dtype=np.float64),
+                self._log_table(range_max), self.field.origin[0], self.field.origin[1],
+                1.0 / self.field.resolution, rows, cols, out,
+            )
+        return out
+
+
+@numba.njit(cache=True)
+def _sum_logs(  # pragma: no cover - compiled
+    poses: np.ndarray, ends: np.ndarray, table: np.ndarray, x0: float, y0: float, inv: float,
+    rows: int, cols: int, out: np.ndarray,
+) -> None:
+    """Per pose, the sum over the beam ends of the table's value at the end's cell (the border
+    cell when off the map); the table is the padded grid, flat."""
+    stride = cols + 2
+    for i in range(poses.shape[0]):
+        px, py = poses[i, 0], poses[i, 1]
+        c, s = np.cos(poses[i, 2]), np.sin(poses[i, 2])
+        total = 0.0
+        for j in range(ends.shape[0]):
+            bx, by = ends[j, 0], ends[j, 1]
+            col = np.floor((px + c * bx - s * by - x0) * inv) + 1.0
+            row = np.floor((py + s * bx + c * by - y0) * inv) + 1.0
+            col = min(max(col, 0.0), cols + 1.0)
+            row = min(max(row, 0.0), rows + 1.0)
+            total += table[int(row) * stride + int(col)]
+        out[i] = total

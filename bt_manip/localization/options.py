@@ -9,8 +9,11 @@ Departures from Nav2's defaults, on purpose:
 - ``recovery_alpha_slow`` / ``recovery_alpha_fast`` (Nav2: ``recovery_alpha_slow``,
   ``recovery_alpha_fast``, both 0, which turns random-particle injection off) are 0.001 and 0.1
   here, so that a filter whose robot was carried elsewhere (a kidnap) finds it again. The
-  averages follow the particles' weighted mean likelihood, which does not change with their
-  count, so a KLD resize is not taken for a kidnap.
+  averages follow the scan's likelihood as the newly weighted particles see it (see
+  :mod:`bt_manip.localization.filter`), which depends neither on how many particles there are
+  nor on the random ones just injected: injection stops once the filter has found the robot.
+- ``beam_weight`` (not in Nav2) tempers the product of the beam likelihoods; AMCL's
+  ``1 + sum(pz^3)`` weighs poses more flatly (see :mod:`bt_manip.localization.likelihood_field`).
 - ``sigma_hit`` is 0.1 m (Nav2: 0.2 m): a simulated LiDAR's ranges are good to about a
   centimetre, and the sharper field makes the estimate better than 5 cm on an 11 m route.
 """
@@ -71,6 +74,9 @@ class LocalizationOptions:
     """Distances to the nearest obstacle are capped here (m)."""
     max_beams: int = 60
     """Beams used per update, evenly spaced over the scan."""
+    beam_weight: float = 0.1
+    """Each beam's log-likelihood counts this much (neighbouring beams are not independent
+    evidence: under 1, one scan cannot make the filter sure of a wrong place at once)."""
 
     # -- when to update -------------------------------------------------------------------------
     update_min_d: float = 0.25
@@ -102,8 +108,11 @@ class LocalizationOptions:
     """The filter says it is lost when the estimate's x or y standard deviation exceeds this."""
     lost_std_yaw: float = 0.5
     """... or its yaw standard deviation (rad) exceeds this ..."""
-    lost_likelihood_ratio: float = 0.2
-    """... or the fast average of the likelihood falls under this share of the slow one."""
+    lost_likelihood_ratio: float = 0.8
+    """... or the fast average of the likelihood falls under this share of the slow one ..."""
+    lost_cluster_weight: float = 0.5
+    """... or the estimate's cluster holds less than this share of the weight (the particles
+    back several places)."""
 
     def __post_init__(self) -> None:
         problems = _problems(self)
@@ -112,11 +121,12 @@ class LocalizationOptions:
 
 
 _COUNTS = ("min_particles", "max_particles", "max_beams", "resample_interval")
-_POSITIVE = ("pf_err", "kld_bin_xy", "kld_bin_yaw", "sigma_hit", "laser_likelihood_max_dist",
+_POSITIVE = ("pf_err", "beam_weight", "kld_bin_xy", "kld_bin_yaw", "sigma_hit", "laser_likelihood_max_dist",
              "cluster_radius", "cluster_yaw", "lost_std_xy", "lost_std_yaw")
 _NON_NEGATIVE = ("alpha1", "alpha2", "alpha3", "alpha4", "z_hit", "z_rand", "update_min_d",
                  "update_min_a", "initial_sigma_xy", "initial_sigma_yaw")
-_UNIT = ("recovery_alpha_slow", "recovery_alpha_fast", "lost_likelihood_ratio")
+_UNIT = ("recovery_alpha_slow", "recovery_alpha_fast", "lost_likelihood_ratio",
+         "lost_cluster_weight")
 
 
 def _problems(o: LocalizationOptions) -> list[str]:
