@@ -30,6 +30,7 @@ error (cm), mean yaw error (deg), ms per update (median and mean, wall time), up
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import math
 import subprocess
@@ -138,7 +139,7 @@ def route_poses() -> np.ndarray:
     x, y = ROUTE[0]
     yaw = math.atan2(ROUTE[1][1] - y, ROUTE[1][0] - x)
     out.append((x, y, yaw))
-    for (ax, ay), (bx, by) in zip(ROUTE[:-1], ROUTE[1:], strict=True):
+    for (ax, ay), (bx, by) in itertools.pairwise(ROUTE):
         goal = math.atan2(by - ay, bx - ax)
         turn = (goal - yaw + math.pi) % (2 * math.pi) - math.pi
         for _ in range(int(abs(turn) / (TURN_RATE * DT))):

@@ -57,9 +57,10 @@ class ParticleFilter:
     def __init__(
         self,
         field: LikelihoodField,
-        options: LocalizationOptions = LocalizationOptions(),
+        options: LocalizationOptions | None = None,
         rng: np.random.Generator | None = None,
     ) -> None:
+        options = options if options is not None else LocalizationOptions()
         if not isinstance(options, LocalizationOptions):
             raise TypeError("options must be LocalizationOptions")
         self.field = field
@@ -216,6 +217,11 @@ class ParticleFilter:
                       f"long-run average (lost_likelihood_ratio {o.lost_likelihood_ratio:g})")
         return PoseEstimate(
             float(mean[0]), float(mean[1]), float(mean[2]),
-            tuple(tuple(float(v) for v in row) for row in cov),
+            _rows3(cov),
             share, len(ps), bool(reason), reason,
         )
+
+
+def _rows3(m: np.ndarray) -> tuple[tuple[float, float, float], ...]:
+    """A 3 x 3 array as a tuple of row tuples of floats."""
+    return tuple((float(r[0]), float(r[1]), float(r[2])) for r in m)

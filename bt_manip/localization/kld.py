@@ -25,7 +25,8 @@ def standard_normal_quantile(p: float) -> float:
 
 
 def kld_bound(k: np.ndarray | int, err: float, z: float) -> np.ndarray:
-    """Particles needed for ``k`` occupied bins (1 for k <= 1)."""
+    """Particles needed for ``k`` occupied bins (1 for k <= 1; :func:`kld_prefix` asks for the
+    maximum then)."""
     kk = np.asarray(k, dtype=float)
     km1 = np.maximum(kk - 1.0, 1.0)
     a = 2.0 / (9.0 * km1)
@@ -57,6 +58,8 @@ def kld_prefix(
     new_bin = np.zeros(m, np.int64)
     new_bin[first] = 1
     filled = np.cumsum(new_bin)  # bins filled by the first 1, 2, ... particles
-    need = np.maximum(kld_bound(filled, err, z), min_particles)
+    # one bin says nothing about the spread: as AMCL, draw on until a second bin is filled
+    need = np.where(filled <= 1, max_particles, np.maximum(kld_bound(filled, err, z),
+                                                            min_particles))
     enough = np.nonzero(np.arange(1, m + 1) >= need)[0]
     return int(enough[0]) + 1 if enough.size else m

@@ -83,7 +83,8 @@ class LikelihoodField:
 
     def distance_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The field's distance (m) at world points ``(x, y)`` (any matching shapes)."""
-        return self.distance[self._index(np.asarray(x), np.asarray(y))]
+        out: np.ndarray = self.distance[self._index(np.asarray(x), np.asarray(y))]
+        return out
 
     def _index(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         rows, cols = self.shape

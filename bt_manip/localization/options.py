@@ -121,8 +121,9 @@ class LocalizationOptions:
 
 
 _COUNTS = ("min_particles", "max_particles", "max_beams", "resample_interval")
-_POSITIVE = ("pf_err", "beam_weight", "kld_bin_xy", "kld_bin_yaw", "sigma_hit", "laser_likelihood_max_dist",
-             "cluster_radius", "cluster_yaw", "lost_std_xy", "lost_std_yaw")
+_POSITIVE = ("pf_err", "beam_weight", "kld_bin_xy", "kld_bin_yaw", "sigma_hit",
+             "laser_likelihood_max_dist", "cluster_radius", "cluster_yaw", "lost_std_xy",
+             "lost_std_yaw")
 _NON_NEGATIVE = ("alpha1", "alpha2", "alpha3", "alpha4", "z_hit", "z_rand", "update_min_d",
                  "update_min_a", "initial_sigma_xy", "initial_sigma_yaw")
 _UNIT = ("recovery_alpha_slow", "recovery_alpha_fast", "lost_likelihood_ratio",

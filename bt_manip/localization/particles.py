@@ -39,9 +39,9 @@ def gaussian(
     rng: np.random.Generator,
 ) -> np.ndarray:
     """``n`` poses drawn around ``pose`` with standard deviations ``sigmas`` (x, y, yaw)."""
-    out = np.asarray(pose, dtype=float)[None, :] + rng.standard_normal((n, 3)) * np.asarray(
-        sigmas, dtype=float
-    )
+    out: np.ndarray = np.asarray(pose, dtype=float)[None, :] + rng.standard_normal(
+        (n, 3)
+    ) * np.asarray(sigmas, dtype=float)
     out[:, 2] = (out[:, 2] + math.pi) % (2.0 * math.pi) - math.pi
     return out
 

@@ -4,6 +4,7 @@ odometry along it."""
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Iterator
 
@@ -80,7 +81,7 @@ def drive(route: list[tuple[float, float]], step: float = 0.125,
     x, y = route[0]
     yaw = math.atan2(route[1][1] - y, route[1][0] - x)
     out = [(x, y, yaw)]
-    for (ax, ay), (bx, by) in zip(route[:-1], route[1:], strict=True):
+    for (ax, ay), (bx, by) in itertools.pairwise(route):
         goal = math.atan2(by - ay, bx - ax)
         turn = (goal - yaw + math.pi) % (2 * math.pi) - math.pi
         for _ in range(int(abs(turn) / turn_step)):

@@ -24,7 +24,7 @@ GRID = room_grid()
 FIELD = LikelihoodField.from_grid(GRID)
 
 
-def make(options: LocalizationOptions = LocalizationOptions(), seed: int = 0) -> ParticleFilter:
+def make(options: LocalizationOptions | None = None, seed: int = 0) -> ParticleFilter:
     return ParticleFilter(FIELD, options, np.random.default_rng(seed))
 
 
@@ -67,7 +67,7 @@ def test_global_localisation_finds_the_robot() -> None:
     pf.global_localization()
     assert pf.estimate.lost  # spread over the whole room
     errors = track(pf, truth, 3)
-    k, pos, yaw, lost = errors[-1]
+    _, pos, yaw, lost = errors[-1]
     assert pos < 0.05 and yaw < math.radians(3) and not lost
     # found well before the end of the route, and kept from then on
     assert all(e[1] < 0.1 for e in errors[len(errors) // 2:])
