@@ -24,7 +24,8 @@ particles at most (``--particles``), 60 beams, Nav2's alpha1..4 = 0.2, update ev
 0.2 rad of odometry; each is given every reading and decides itself, or (amcl, which updates
 on every call) is called only when the same travel thresholds are passed. After each update the
 estimate is compared with the true pose. One JSON line per filter: mean / p95 / max position
-error (cm), mean yaw error (deg), ms per update (median and mean, wall time), updates, seeds.
+error (cm), mean yaw error (deg), ms per update (wall time: median and mean; CPU time of the
+process: mean), updates, seeds.
 """
 
 from __future__ import annotations
@@ -248,19 +249,21 @@ def import_amcl() -> tuple[ModuleType | None, str]:
 def run(filters: list[Any], truth: np.ndarray, odom: np.ndarray,
         scan_of: Callable[[np.ndarray], Scan]) -> dict[str, dict[str, list[float]]]:
     """Feed both filters the same readings; errors and update times per filter."""
-    out = {f.name: {"pos": [], "yaw": [], "ms": []} for f in filters}
+    out = {f.name: {"pos": [], "yaw": [], "ms": [], "cpu_ms": []} for f in filters}
     for f in filters:
         f.start(truth[0])
     for k in range(len(truth)):
         scan = scan_of(truth[k])
         for f in filters:
-            began = time.perf_counter()
+            began, cpu = time.perf_counter(), time.process_time()
             est = f.step(odom[k], scan, k * DT)
             ms = (time.perf_counter() - began) * 1e3
+            cpu_ms = (time.process_time() - cpu) * 1e3
             if est is None:
                 continue
             rec = out[f.name]
             rec["ms"].append(ms)
+            rec["cpu_ms"].append(cpu_ms)
             rec["pos"].append(math.hypot(est[0] - truth[k, 0], est[1] - truth[k, 1]))
             rec["yaw"].append(abs((est[2] - truth[k, 2] + math.pi) % (2 * math.pi) - math.pi))
     return out
@@ -292,7 +295,7 @@ def main(argv: list[str] | None = None) -> int:
         if amcl is not None:
             filters.append(Peer(amcl, grid, args.particles))
         for name, rec in run(filters, truth, odom, exact_scan(caster, rng)).items():
-            t = totals.setdefault(name, {"pos": [], "yaw": [], "ms": []})
+            t = totals.setdefault(name, {"pos": [], "yaw": [], "ms": [], "cpu_ms": []})
             for key in t:
                 t[key] += rec[key]
     length = float(np.sum(np.hypot(*np.diff(truth[:, :2], axis=0).T)))
@@ -307,6 +310,7 @@ def main(argv: list[str] | None = None) -> int:
             "mean_yaw_deg": round(math.degrees(float(np.mean(t["yaw"]))), 3),
             "ms_per_update_median": round(float(np.median(ms)), 3),
             "ms_per_update_mean": round(float(ms.mean()), 3),
+            "cpu_ms_per_update_mean": round(float(np.mean(t["cpu_ms"])), 3),
         }))
     if amcl is None:
         print(json.dumps({"filter": "amcl 0.1.2", "skipped": why}))

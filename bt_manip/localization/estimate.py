@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from bt_manip.localization.kld import bin_keys
@@ -44,13 +45,42 @@ class PoseEstimate:
         return (math.sqrt(c[0][0]), math.sqrt(c[1][1]), math.sqrt(c[2][2]))
 
 
-def _window(poses: np.ndarray, centre: np.ndarray, radius: float, half_yaw: float) -> np.ndarray:
-    d = poses[:, :2] - centre[None, :2]
-    dyaw = (poses[:, 2] - centre[2] + math.pi) % (2.0 * math.pi) - math.pi
-    inside: np.ndarray = (np.einsum("ij,ij->i", d, d) <= radius * radius) & (
-        np.abs(dyaw) <= half_yaw
-    )
-    return inside
+@numba.njit(cache=True)
+def _mean_shift(  # pragma: no cover - compiled
+    poses: np.ndarray, w: np.ndarray, centre: np.ndarray, radius: float, half_yaw: float,
+    steps: int, inside: np.ndarray,
+) -> None:
+    """Move ``centre`` (in place) to the weighted mean of the particles in its window up to
+    ``steps`` times, stopping when the window no longer changes; ``inside`` (in place) marks
+    the particles of the last window, all False if it held no weight."""
+    n = poses.shape[0]
+    r2 = radius * radius
+    two_pi = 2.0 * np.pi
+    for step in range(steps + 1):
+        changed = False
+        sw = sx = sy = sc = ss = 0.0
+        for i in range(n):
+            dx = poses[i, 0] - centre[0]
+            dy = poses[i, 1] - centre[1]
+            dyaw = (poses[i, 2] - centre[2] + np.pi) % two_pi - np.pi
+            now = dx * dx + dy * dy <= r2 and abs(dyaw) <= half_yaw
+            if now != inside[i]:
+                changed = True
+                inside[i] = now
+            if now:
+                sw += w[i]
+                sx += w[i] * poses[i, 0]
+                sy += w[i] * poses[i, 1]
+                sc += w[i] * np.cos(poses[i, 2])
+                ss += w[i] * np.sin(poses[i, 2])
+        if sw <= 0.0:
+            inside[:] = False
+            return
+        if step == steps or (step > 0 and not changed):
+            return
+        centre[0] = sx / sw
+        centre[1] = sy / sw
+        centre[2] = np.arctan2(ss, sc)
 
 
 def _mean(poses: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -63,23 +93,20 @@ def best_cluster(
     ps: ParticleSet, bin_xy: float, bin_yaw: float, radius: float, half_yaw: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(mean pose (3,), covariance (3, 3), mask of the cluster's particles)``."""
-    poses, w = ps.poses, ps.weights
+    poses = np.ascontiguousarray(ps.poses, dtype=np.float64)
+    w = np.ascontiguousarray(ps.weights, dtype=np.float64)
     keys = bin_keys(poses, bin_xy, bin_yaw)
     uniq, inverse = np.unique(keys, return_inverse=True)
     heaviest = int(np.argmax(np.bincount(inverse, weights=w, minlength=uniq.size)))
-    inside = inverse == heaviest
-    centre = _mean(poses[inside], w[inside])
-    for _ in range(MEAN_SHIFT_STEPS):
-        window = _window(poses, centre, radius, half_yaw)
-        if np.array_equal(window, inside):
-            break  # the window holds what the mean came from: it would not move
-        inside = window
-        if not inside.any() or w[inside].sum() <= 0:
-            break
+    seed = inverse == heaviest
+    centre = _mean(poses[seed], w[seed]) if w[seed].sum() > 0 else _mean(poses, w + 1.0)
+    inside = np.zeros(len(poses), np.bool_)
+    _mean_shift(poses, w, centre, radius, half_yaw, MEAN_SHIFT_STEPS, inside)
+    if not inside.any():
+        inside[:] = True
+        centre = _mean(poses, w) if w.sum() > 0 else _mean(poses, w + 1.0)
+    else:
         centre = _mean(poses[inside], w[inside])
-    if not inside.any() or w[inside].sum() <= 0:
-        inside = np.ones(len(ps), bool)
-        centre = _mean(poses, w)
     wc = w[inside] / w[inside].sum()
     d = poses[inside] - centre[None, :]
     d[:, 2] = (d[:, 2] + math.pi) % (2.0 * math.pi) - math.pi
