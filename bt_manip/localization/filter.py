@@ -96,8 +96,7 @@ class ParticleFilter:
 
     def global_localization(self) -> None:
         """Start with ``max_particles`` spread uniformly over the map's free cells."""
-        self._start(pset.uniform(self.field.free_xy, self.field.resolution,
-                                 self.options.max_particles, self.rng))
+        self._start(pset.uniform(self.field, self.options.max_particles, self.rng))
 
     def _start(self, poses: np.ndarray) -> None:
         self._set = pset.even(poses)
@@ -171,8 +170,7 @@ class ParticleFilter:
             fresh = self.rng.random(m) < share
             k = int(fresh.sum())
             if k:
-                picked[fresh] = pset.uniform(self.field.free_xy, self.field.resolution, k,
-                                             self.rng)
+                picked[fresh] = pset.uniform(self.field, k, self.rng)
         keys = bin_keys(picked, o.kld_bin_xy, o.kld_bin_yaw)
         n = kld_prefix(keys, o.pf_err, self._z, o.min_particles, o.max_particles)
         return pset.even(picked[:n].copy())

@@ -3,7 +3,7 @@
 A :class:`LikelihoodField` holds, for every cell of an occupancy grid, the distance (m) from
 its centre to the centre of the nearest occupied cell, capped at ``laser_likelihood_max_dist``
 (worked out once per map with :func:`bt_manip.navigation.distance.squared_distances`), plus
-the centres of the free cells (where a global localisation may put particles).
+the free cells (where a global localisation may put particles), as flat indices.
 
 A beam that ends at ``(x, y)`` has the likelihood
 
@@ -52,7 +52,7 @@ class LikelihoodField:
     resolution: float
     distance: np.ndarray  # float32 (rows + 2, cols + 2)
     max_dist: float
-    free_xy: np.ndarray  # float (n, 2): centres of the free cells
+    free: np.ndarray  # int32 or int64 (n,): flat indices (row * cols + col) of the free cells
 
     @classmethod
     def from_grid(cls, grid: OccupancyGrid, max_dist: float = 2.0) -> LikelihoodField:
@@ -69,8 +69,7 @@ class LikelihoodField:
         if d2 is not None:
             inner = np.sqrt(d2.astype(np.float64)) * grid.resolution
             dist[1:-1, 1:-1] = np.minimum(inner, max_dist)
-        rr, cc = np.nonzero(~occ)
-        free = grid.cells_to_world(np.column_stack([rr, cc])) if rr.size else np.zeros((0, 2))
+        free = np.flatnonzero(~occ).astype(np.int32 if occ.size < 2**31 else np.int64)
         dist.flags.writeable = False
         free.flags.writeable = False
         return cls(grid.origin, float(grid.resolution), dist, float(max_dist), free)
@@ -80,6 +79,15 @@ class LikelihoodField:
         """(rows, cols) of the map (without the border)."""
         r, c = self.distance.shape
         return r - 2, c - 2
+
+    def free_points(self, picks: np.ndarray) -> np.ndarray:
+        """Centres (k, 2) of the free cells ``self.free[picks]``."""
+        cols = self.shape[1]
+        flat = self.free[picks].astype(np.int64)
+        out = np.empty((flat.size, 2))
+        out[:, 0] = self.origin[0] + (flat % cols + 0.5) * self.resolution
+        out[:, 1] = self.origin[1] + (flat // cols + 0.5) * self.resolution
+        return out
 
     def distance_at(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
         """The field's distance (m) at world points ``(x, y)`` (any matching shapes)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -46,16 +47,27 @@ def gaussian(
     return out
 
 
-def uniform(
-    free_xy: np.ndarray, resolution: float, n: int, rng: np.random.Generator
-) -> np.ndarray:
-    """``n`` poses at uniformly random points of the free cells centred at ``free_xy`` (m, 2),
-    with uniformly random headings."""
-    if free_xy.shape[0] == 0:
+class FreeSpace(Protocol):
+    """Where particles may be put: a number of free cells of side ``resolution`` and their
+    centres (a :class:`~bt_manip.localization.likelihood_field.LikelihoodField` is one)."""
+
+    @property
+    def resolution(self) -> float: ...
+
+    @property
+    def free(self) -> np.ndarray: ...
+
+    def free_points(self, picks: np.ndarray) -> np.ndarray: ...
+
+
+def uniform(space: FreeSpace, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` poses at uniformly random points of the free cells of ``space``, with uniformly
+    random headings."""
+    if space.free.size == 0:
         raise ValueError("the map has no free cell to put particles in")
-    cell = rng.integers(0, free_xy.shape[0], n)
-    jitter = (rng.random((n, 2)) - 0.5) * resolution
+    centres = space.free_points(rng.integers(0, space.free.size, n))
+    jitter = (rng.random((n, 2)) - 0.5) * space.resolution
     out = np.empty((n, 3))
-    out[:, :2] = free_xy[cell] + jitter
+    out[:, :2] = centres + jitter
     out[:, 2] = rng.random(n) * (2.0 * math.pi) - math.pi
     return out

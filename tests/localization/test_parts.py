@@ -126,7 +126,10 @@ def test_the_likelihood_field_is_the_distance_to_the_nearest_wall() -> None:
     assert field.distance_at(np.array([40.0]), np.array([0.0]))[0] == 1.0  # off the map
     far = field.distance_at(np.array([2.0]), np.array([1.9]))[0]
     assert far == 1.0  # capped
-    assert len(field.free_xy) == int((~grid.occupied).sum())
+    assert len(field.free) == int((~grid.occupied).sum())
+    centres = field.free_points(np.arange(len(field.free)))
+    cells = np.array([grid.world_to_cell(x, y) for x, y in centres])
+    assert not grid.occupied[cells[:, 0], cells[:, 1]].any()
 
 
 def test_the_estimate_is_the_heaviest_cluster() -> None:
