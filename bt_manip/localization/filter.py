@@ -127,8 +127,12 @@ class ParticleFilter:
         ends = self.sensor.beam_ends(scan, o.max_beams)
         logs = self.sensor.log_likelihoods(poses, ends, scan.range_max)
         t = logs * o.beam_weight
-        w = self._set.weights * np.exp(t - t.max())
-        w /= w.sum()
+        like = np.exp(t - t.max())
+        w = self._set.weights * like
+        total = float(w.sum())
+        # the old weights and the new likelihoods may not overlap at all (a long while without
+        # resampling): the scan alone decides then
+        w = w / total if total > 0 else like / like.sum()
         if len(ends):
             # the scan's likelihood: each pose's per-beam geometric mean, averaged with the new
             # weights, so that it says how well the particles that count explain the scan (the

@@ -123,7 +123,8 @@ class SensorModel:
         """``log(pz)`` per cell for scans of ``range_max`` (a few kept)."""
         table = self._log_tables.get(range_max)
         if table is None:
-            table = np.log(self._gauss + self.z_rand / range_max).astype(np.float32)
+            pz = np.maximum(self._gauss + self.z_rand / range_max, 1e-30)  # log stays finite
+            table = np.log(pz).astype(np.float32)
             if len(self._log_tables) >= 4:
                 self._log_tables.clear()
             self._log_tables[range_max] = table
