@@ -24,6 +24,7 @@ from bt_manip.bt.tree import Tree
 from bt_manip.clock import MonotonicClock
 from bt_manip.errors import InputError
 from bt_manip.groot import BtlogWriter, TreeMonitor
+from bt_manip.localization.runtime import localization_for_run
 from bt_manip.plugins import import_modules
 from bt_manip.run.context import RunContext
 from bt_manip.run.faults import FaultInjector, FaultSpec, inject_node_failures, parse_fault
@@ -51,6 +52,9 @@ class EpisodeSpec:
     """User modules that register nodes (``--import``), imported before the tree loads."""
     btlog: str | None = None
     """Write the run's status changes to this .btlog file (Groot2 replays it)."""
+    localize: bool = False
+    """Localise the robots that have a laser and drive on the estimate (``--localize``; a
+    world's ``localization:`` section turns it on too)."""
 
 
 class Episode:
@@ -73,7 +77,10 @@ class Episode:
         try:
             clock = self.world.clock if self.world is not None else MonotonicClock()
             self.faults = FaultInjector(list(spec.inject), seed=spec.seed, clock=clock)
-            self.context = RunContext(clock=clock, world=self.world, faults=self.faults)
+            self.localization = localization_for_run(self.world, spec.seed, spec.localize,
+                                                     self.faults)
+            self.context = RunContext(clock=clock, world=self.world, faults=self.faults,
+                                      localization=self.localization)
             self.tree: Tree = load_tree(
                 spec.tree,
                 tree_id=spec.tree_id,
@@ -116,13 +123,17 @@ class Episode:
                 raise
             watching.insert(0, writer)  # closed first, as soon as the run ends
         opts = options if options is not None else self.spec.options
-        report = Runner(self.tree, self.world, opts, on_tick=watching).run()
+        sensing = [self.localization] if self.localization is not None else []
+        report = Runner(self.tree, self.world, opts, on_tick=watching,
+                        before_tick=sensing).run()
         report.tree = self.spec.tree
         report.world = self.spec.world or ""
         report.seed = self.spec.seed if self.world is not None else None
         if self.spec.inject:
             report.extra["inject"] = [f.text() for f in self.spec.inject]
             report.extra["injected"] = self.faults.report()
+        if self.localization is not None:
+            report.localization = self.localization.report()
         rows = self._as_built()
         if rows is not None:
             report.as_built = rows

@@ -47,7 +47,7 @@ def digest(path: str | None) -> str:
 def spec_to_json(spec: EpisodeSpec) -> dict[str, Any]:
     """What defines the episodes of a bench, as JSON (the seed and .btlog path excepted), with
     the folder that relative paths start from (``cwd``)."""
-    return {
+    data: dict[str, Any] = {
         "cwd": os.getcwd(),
         "tree": spec.tree,
         "world": spec.world,
@@ -58,6 +58,9 @@ def spec_to_json(spec: EpisodeSpec) -> dict[str, Any]:
         "options": asdict(spec.options),
         "imports": list(spec.imports),
     }
+    if spec.localize:  # absent when off: a bench without it writes what it always wrote
+        data["localize"] = True
+    return data
 
 
 def spec_from_json(data: dict[str, Any]) -> EpisodeSpec:
@@ -82,6 +85,7 @@ def spec_from_json(data: dict[str, Any]) -> EpisodeSpec:
         options=options,
         imports=[str(here(m)) if str(m).endswith(".py") else m
                  for m in data.get("imports", [])],
+        localize=bool(data.get("localize", False)),
     )
 
 

@@ -127,6 +127,17 @@ def fault(text: str) -> FaultSpec:
         raise argparse.ArgumentTypeError(exc.problems[0].message) from None
 
 
+def add_localize(parser: argparse.ArgumentParser) -> None:
+    """``--localize``, as ``run`` and ``bench`` take it."""
+    parser.add_argument(
+        "--localize",
+        action="store_true",
+        help="localise the robot with its laser, wheel odometry and a particle filter, and "
+        "drive on the estimate (the world's localization: section, or the defaults); the run "
+        "report adds the estimate's errors",
+    )
+
+
 def add_inject(parser: argparse.ArgumentParser) -> None:
     """``--inject FAULT`` (repeatable), as ``run`` and ``bench`` take it."""
     parser.add_argument(
@@ -138,7 +149,10 @@ def add_inject(parser: argparse.ArgumentParser) -> None:
         help="inject faults, seeded: NAME:failure:P (node NAME fails with probability P), "
         "slip:P (a held object slips), block:P (an obstacle falls on the route), "
         "pose_noise:SIGMA_M[:SIGMA_DEG] (the robot sees each object off by an offset drawn once "
-        "per episode: x, y with sigma SIGMA_M metres, yaw with sigma SIGMA_DEG, default 2 deg)",
+        "per episode: x, y with sigma SIGMA_M metres, yaw with sigma SIGMA_DEG, default 2 deg); "
+        "with --localize: odom_noise:K[:K_ROT] (wheel odometry error), lidar_noise:SIGMA (range "
+        "noise, m), lidar_dropout:P (each beam lost with probability P), kidnap:T (at sim time "
+        "T the robot is carried 0.5-1.5 m away and its localisation is not told)",
     )
 
 

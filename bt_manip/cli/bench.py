@@ -20,6 +20,7 @@ from bt_manip.cli.args import (
     DEFAULT_TICK_HZ,
     TICK_HZ,
     add_inject,
+    add_localize,
     bb_pair,
     positive,
     within,
@@ -34,7 +35,7 @@ DEFAULT_BENCH_OUT = "out/bench"
 DEFINING: dict[str, Any] = {
     "tree": None, "world": None, "runs": 20, "seed": 0, "tree_id": None, "models": [], "bb": [],
     "max_ticks": None, "max_sim_time": DEFAULT_MAX_SIM_TIME, "tick_hz": DEFAULT_TICK_HZ,
-    "inject": [], "imports": [], "sweep": None,
+    "inject": [], "imports": [], "sweep": None, "localize": False,
 }
 """The options that define a bench, with their defaults (``--resume`` refuses them)."""
 
@@ -90,6 +91,7 @@ def add_bench_arguments(bench: argparse.ArgumentParser) -> None:
         help="write DIR/seed-N.btlog for every episode that does not succeed (Groot2 replays it)",
     )
     add_inject(bench)
+    add_localize(bench)
     add_import_flag(bench)
     bench.set_defaults(func=cmd_bench)
 

@@ -25,6 +25,7 @@ from bt_manip.cli.args import (
     REALTIME,
     TICK_HZ,
     add_inject,
+    add_localize,
     address,
     bb_pair,
     groot_port,
@@ -145,6 +146,7 @@ def add_run_arguments(run: argparse.ArgumentParser) -> None:
         help="write the run's status changes as a Groot2 log (FileLogger2 format)",
     )
     add_inject(run)
+    add_localize(run)
     add_import_flag(run)
     run.set_defaults(func=cmd_run)
 
@@ -186,6 +188,7 @@ def episode_spec(args: argparse.Namespace) -> EpisodeSpec:
         options=options,
         imports=list(args.imports),
         btlog=getattr(args, "btlog", None),
+        localize=bool(getattr(args, "localize", False)),
     )
 
 

@@ -27,6 +27,7 @@ from bt_manip.navigation.navigator import Navigator
 from bt_manip.overlay import Overlay, run_overlay
 
 if TYPE_CHECKING:
+    from bt_manip.localization.runtime import Localizer, RunLocalization
     from bt_manip.run.faults import FaultInjector
     from bt_manip.sim.robot import Robot
     from bt_manip.sim.world import World
@@ -59,6 +60,8 @@ class RobotServices:
 
     world: World
     robot: Robot
+    localizer: Localizer | None = None
+    """The robot's localisation when the run localises (None: it drives on ground truth)."""
     _navigator: Navigator | None = field(default=None, init=False, repr=False)
     _arm_iks: dict[str, ArmIK] = field(default_factory=dict, init=False, repr=False)
     arm_planner: Any = field(default=None, init=False, repr=False)
@@ -78,6 +81,14 @@ class RobotServices:
                 self.robot, self.world.obstacle_body_ids(), self.world.movable
             )
         return self._navigator
+
+    def believed_pose(self) -> tuple[float, float, float]:
+        """The pose (x, y, yaw; map frame) the robot believes its base has: the localisation's
+        estimate when the run localises, else the ground truth. Navigation plans, steers and
+        checks its goals on this; physics and reports keep the ground truth."""
+        if self.localizer is not None:
+            return self.localizer.pose()
+        return self.robot.base_pose2d()
 
     def arm_ik(self, tip: str) -> ArmIK:
         """The model and solvers of the robot's arm from its base link to ``tip``, built on
@@ -139,6 +150,8 @@ class RunContext(TreeContext):
     faults: FaultInjector | None = None
     overlay: Overlay = field(default_factory=Overlay)
     running: RunningActions = field(default_factory=RunningActions)
+    localization: RunLocalization | None = None
+    """The run's localisation (:mod:`bt_manip.localization.runtime`); None when off."""
     _robots: dict[str, RobotServices] = field(default_factory=dict, init=False, repr=False)
 
     @classmethod
@@ -152,7 +165,8 @@ class RunContext(TreeContext):
         if services is None:
             if self.world is None:
                 raise KeyError(name)
-            services = RobotServices(self.world, self.world.robots[name])
+            localizer = self.localization.get(name) if self.localization is not None else None
+            services = RobotServices(self.world, self.world.robots[name], localizer)
             self._robots[name] = services
         return services
 

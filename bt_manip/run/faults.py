@@ -14,6 +14,16 @@ Specifications (``--inject``, repeatable):
                     and keep it with :meth:`FaultInjector.defer_block`, and FollowPath drops
                     it when the robot comes within :data:`BLOCK_NEAR` of its place (an obstacle
                     appearing in front of the robot, the case Nav2's recoveries are for).
+``odom_noise:K[:K_ROT]``
+                    (localisation only) the wheel odometry errs: K m of travel error after 1 m
+                    travelled (its variance grows with the distance), K_ROT rad of heading error
+                    per radian turned (default K) and K rad per metre travelled.
+``lidar_noise:SIGMA``
+                    (localisation only) the laser's ranges get Gaussian noise of SIGMA m.
+``lidar_dropout:P`` (localisation only) each beam of each scan is lost with probability P.
+``kidnap:T``        (localisation only) at sim time T the robot, with what it holds, is
+                    carried 0.5-1.5 m and turned up to 0.5 rad to a free pose, and its
+                    localisation is not told (:mod:`bt_manip.localization.runtime`).
 ``pose_noise:SIGMA_M[:SIGMA_DEG]``
                     the pose the robot perceives of each object is off by an offset drawn once
                     per object and episode: x and y normal with sigma SIGMA_M (m), yaw normal
@@ -56,7 +66,19 @@ if TYPE_CHECKING:
 
 WORLD_FAULTS = ("slip", "block")
 POSE_NOISE = "pose_noise"
-EXPECTED = "expected NAME:failure:P, slip:P, block:P or pose_noise:SIGMA_M[:SIGMA_DEG]"
+ODOM_NOISE = "odom_noise"
+LIDAR_NOISE = "lidar_noise"
+LIDAR_DROPOUT = "lidar_dropout"
+KIDNAP = "kidnap"
+LOCALIZATION_FAULTS = (ODOM_NOISE, LIDAR_NOISE, LIDAR_DROPOUT, KIDNAP)
+"""Faults of a robot's sensors and belief: they need localisation (``--localize``)."""
+EXPECTED = ("expected NAME:failure:P, slip:P, block:P or pose_noise:SIGMA_M[:SIGMA_DEG] (with "
+            "--localize also odom_noise:K[:K_ROT], lidar_noise:SIGMA, lidar_dropout:P or "
+            "kidnap:T)")
+MAX_LIDAR_SIGMA = 1.0
+"""Largest range noise (m) of ``lidar_noise``."""
+MAX_KIDNAP_TIME = 86_400.0
+"""Latest sim time (s) a ``kidnap`` may be due at."""
 MAX_SIGMA_M = 0.5
 """Largest position sigma (m) of ``pose_noise``: beyond, the object is not where it was seen."""
 MAX_SIGMA_DEG = 90.0
@@ -93,12 +115,17 @@ class FaultSpec:
     """Position sigma (m), for "pose_noise"."""
     sigma_deg: float = 0.0
     """Yaw sigma (deg), for "pose_noise"."""
+    values: tuple[float, ...] = ()
+    """The numbers of a localisation fault: (K, K_ROT) for "odom_noise", (SIGMA,) for
+    "lidar_noise", (P,) for "lidar_dropout", (T,) for "kidnap"."""
 
     def text(self) -> str:
         if self.kind == "failure":
             return f"{self.target}:failure:{self.probability:g}"
         if self.kind == POSE_NOISE:
             return f"{POSE_NOISE}:{self.sigma_m:g}:{self.sigma_deg:g}"
+        if self.kind in LOCALIZATION_FAULTS:
+            return ":".join([self.kind, *(f"{v:g}" for v in self.values)])
         return f"{self.kind}:{self.probability:g}"
 
 
@@ -112,6 +139,8 @@ def parse_fault(text: str) -> FaultSpec:
 
     if parts[0] == POSE_NOISE:
         return _parse_pose_noise(parts[1:], bad)
+    if parts[0] in LOCALIZATION_FAULTS:
+        return _parse_localization_fault(parts[0], parts[1:], bad)
     if len(parts) == 2 and parts[0] in WORLD_FAULTS:
         kind, target, p_text = parts[0], "", parts[1]
     elif len(parts) == 3 and parts[1] == "failure" and parts[0]:
@@ -119,7 +148,7 @@ def parse_fault(text: str) -> FaultSpec:
     elif len(parts) == 3 and parts[0]:
         raise bad(f"unknown fault kind '{parts[1]}'{_close(parts[1], ['failure'])}")
     elif len(parts) == 2 and parts[0]:
-        hint = _close(parts[0], [*WORLD_FAULTS, POSE_NOISE])
+        hint = _close(parts[0], [*WORLD_FAULTS, POSE_NOISE, *LOCALIZATION_FAULTS])
         if not hint:
             hint = f" (for a node, write {parts[0]}:failure:{parts[1]})"
         raise bad(f"unknown fault kind '{parts[0]}'{hint}")
@@ -149,6 +178,41 @@ def _parse_pose_noise(values: list[str], bad: Callable[[str], InputError]) -> Fa
         sigmas.append(sigma)
     sigma_deg = sigmas[1] if len(sigmas) == 2 else DEFAULT_SIGMA_DEG
     return FaultSpec(POSE_NOISE, 0.0, sigma_m=sigmas[0], sigma_deg=sigma_deg)
+
+
+_LOCALIZATION_SHAPES: dict[str, tuple[str, tuple[tuple[str, float], ...]]] = {
+    ODOM_NOISE: ("takes K and optionally K_ROT", (("K", 1.0), ("K_ROT", 1.0))),
+    LIDAR_NOISE: ("takes a range sigma in metres", (("SIGMA", MAX_LIDAR_SIGMA),)),
+    LIDAR_DROPOUT: ("takes a probability per beam", (("P", 1.0),)),
+    KIDNAP: ("takes the sim time in seconds", (("T", MAX_KIDNAP_TIME),)),
+}
+"""Per localisation fault: what it takes, and each number's name and upper bound."""
+
+
+def _parse_localization_fault(
+    kind: str, values: list[str], bad: Callable[[str], InputError]
+) -> FaultSpec:
+    """The numbers of ``odom_noise``, ``lidar_noise``, ``lidar_dropout`` or ``kidnap``."""
+    what, shape = _LOCALIZATION_SHAPES[kind]
+    if not 1 <= len(values) <= len(shape):
+        raise bad(f"{kind} {what}")
+    out = []
+    for v, (name, top) in zip(values, shape, strict=False):
+        try:
+            x = float(v)
+        except ValueError:
+            raise bad(f"{name} '{v}' is not a number") from None
+        if not 0.0 <= x <= top:  # also refuses nan
+            raise bad(f"{name} {v} is not within 0..{top:g}")
+        out.append(x)
+    if kind == ODOM_NOISE and len(out) == 1:
+        out.append(out[0])
+    return FaultSpec(kind, 0.0, values=tuple(out))
+
+
+def localization_faults(specs: list[FaultSpec]) -> list[FaultSpec]:
+    """The faults of ``specs`` that need localisation."""
+    return [s for s in specs if s.kind in LOCALIZATION_FAULTS]
 
 
 def _close(word: str, choices: list[str]) -> str:

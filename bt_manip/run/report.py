@@ -65,6 +65,10 @@ class RunReport:
     """In a world written by ``bt-manip bim``: each scheduled element's planned and placed pose,
     deviation and status (:mod:`bt_manip.bim.as_built`, added by the episode); None
     elsewhere."""
+    localization: dict[str, float] | None = None
+    """With localisation on: the believed pose's error against the truth over the run
+    (``mean_error_m``, ``p95_error_m``, ``max_error_m``, ``mean_yaw_error_rad``,
+    ``time_over_0_2m_s``); None (not in the JSON) otherwise."""
     notes: list[str] = field(default_factory=list)
     """Text the summary ends with (the episode adds the as-built table); not in the JSON."""
 
@@ -88,6 +92,8 @@ class RunReport:
         data["exit_code"] = self.exit_code
         if self.as_built is None:
             del data["as_built"]
+        if self.localization is None:
+            del data["localization"]
         for node in data["nodes"]:
             if node["counts"] is None:
                 del node["counts"]

@@ -88,8 +88,10 @@ class Runner:
         world: World | None = None,
         options: RunOptions | None = None,
         on_tick: Sequence[RunHook | TickCallback] = (),
+        before_tick: Sequence[TickCallback] = (),
     ) -> None:
         self.tree = tree
+        self.before_tick = list(before_tick)
         self.world = world
         self.options = options or RunOptions()
         self.on_tick = list(on_tick)
@@ -139,6 +141,8 @@ class Runner:
         self.counter = counter
         try:
             while True:
+                for sense in self.before_tick:
+                    sense(self)
                 result = self.tree.tick().name
                 self.ticks += 1
                 for hook in self.on_tick:

@@ -43,10 +43,12 @@ from bt_manip.sim.mesh_check import mesh_problem
 from bt_manip.sim.robot_description import find_descriptor, known_robots
 from bt_manip.sim.world_spec import (
     COLOURS,
+    DEFAULT_INITIAL_SIGMAS,
     WORLD_SCHEMA_VERSION,
     BatterySpec,
     BodySpec,
     DoorSpec,
+    LocalizationSpec,
     Part,
     PhysicsSpec,
     Pose2D,
@@ -71,7 +73,16 @@ TOP_KEYS = {
     "poses",
     "groups",
     "route_graph",
+    "localization",
 }
+LOCALIZATION_KEYS = {"min_particles", "max_particles", "initial_pose", "initial_sigmas",
+                     "update_min_d", "update_min_a"}
+PARTICLE_COUNTS = (1.0, 200_000.0)
+"""Particle counts a ``localization:`` section accepts."""
+INITIAL_SIGMA_BOUNDS = (0.0, 10.0)
+"""Initial standard deviations (m or rad) a ``localization:`` section accepts."""
+UPDATE_BOUNDS = (0.0, 10.0)
+"""Travel (m) and turn (rad) thresholds a ``localization:`` section accepts."""
 PHYSICS_KEYS = {"rate_hz", "gravity", "solver_iterations", "solver_tolerance", "ground_friction"}
 WALL_KEYS = {"name", "from", "to", "thickness", "height", "colour", "color", "doors"}
 DOOR_KEYS = {"at", "width"}
@@ -528,10 +539,53 @@ def _parse_world(path: Path, raw: bytes) -> WorldSpec:
             if not graph.is_file():
                 rd.fail(data.line_of("route_graph"), f"route_graph: no file {graph}")
             spec.route_graph = graph
+    if "localization" in data:
+        spec.localization = _parse_localization(rd, data)
     _check_unique_names(rd, spec)
     if rd.problems:
         raise InputError(rd.problems)
     return spec
+
+
+def _parse_localization(rd: _Reader, data: LineDict) -> LocalizationSpec | None:
+    """The world's ``localization:`` section (every key optional; an empty one means the
+    defaults)."""
+    line = data.line_of("localization")
+    raw = data["localization"]
+    if raw is None:
+        return LocalizationSpec(line=line)
+    d = rd.mapping(raw, line, "localization")
+    if d is None:
+        return None
+    here = "localization"
+    rd.unknown_keys(d, LOCALIZATION_KEYS, here)
+    counts: dict[str, int | None] = {}
+    for key in ("min_particles", "max_particles"):
+        v = rd.number(d, key, here, None, within=PARTICLE_COUNTS) if key in d else None
+        if v is not None and v != int(v):
+            rd.fail(d.line_of(key), f"{here}.{key} must be a whole number, not {v:g}")
+            v = None
+        counts[key] = int(v) if v is not None else None
+    lo, hi = counts["min_particles"], counts["max_particles"]
+    if lo is not None and hi is not None and lo > hi:
+        rd.fail(d.line_of("min_particles"),
+                f"{here}.min_particles ({lo}) must not exceed max_particles ({hi})")
+    pose = None
+    if "initial_pose" in d:
+        pose = rd.pose2d(d["initial_pose"], d.line_of("initial_pose"), f"{here}.initial_pose")
+    sigmas = DEFAULT_INITIAL_SIGMAS
+    if "initial_sigmas" in d:
+        where = f"{here}.initial_sigmas ([sigma_x, sigma_y, sigma_yaw])"
+        vec = rd.vector(d["initial_sigmas"], 3, d.line_of("initial_sigmas"), where)
+        if vec:
+            if all(INITIAL_SIGMA_BOUNDS[0] <= v <= INITIAL_SIGMA_BOUNDS[1] for v in vec):
+                sigmas = (float(vec[0]), float(vec[1]), float(vec[2]))
+            else:
+                rd.fail(d.line_of("initial_sigmas"),
+                        f"{here}.initial_sigmas must each be within 0..10, not {list(vec)}")
+    update_d, update_a = (rd.number(d, k, here, None, within=UPDATE_BOUNDS) if k in d else None
+                          for k in ("update_min_d", "update_min_a"))
+    return LocalizationSpec(lo, hi, pose, sigmas, update_d, update_a, line)
 
 
 def _check_schema_version(path: Path, data: LineDict) -> None:

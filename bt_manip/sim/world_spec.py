@@ -195,6 +195,9 @@ class WorldSpec:
     """Entities moved together by one rigid motion (``groups:``)."""
     route_graph: Path | None = None
     """A route graph in Nav2's GeoJSON format for ComputeRoute (None: one is generated)."""
+    localization: LocalizationSpec | None = None
+    """The ``localization:`` section: a run localises its robot (None: only with
+    ``--localize``, with the defaults)."""
 
     def names_by_kind(self) -> dict[str, set[str]]:
         """What a tree may name in this world, by kind: ``object`` (movable objects and
@@ -210,3 +213,24 @@ class WorldSpec:
 
 WORLD_SCHEMA_VERSION = 1
 """The world format this bt-manip reads (``schema_version`` of a world file; absent means 1)."""
+
+
+DEFAULT_INITIAL_SIGMAS = (0.1, 0.1, 0.1)
+"""Standard deviations (m, m, rad) of the initial pose a run's filter starts from, unless the
+world's ``localization:`` section gives its own (an operator's initial pose is good to about
+10 cm)."""
+
+
+@dataclass(frozen=True)
+class LocalizationSpec(_SharedByCopies):
+    """A world file's ``localization:`` section (every key optional): how a run with
+    ``--localize`` localises its robot. None leaves the filter's default."""
+
+    min_particles: int | None = None
+    max_particles: int | None = None
+    initial_pose: Pose2D | None = None
+    """Where the filter starts (map frame); None: the robot's start pose."""
+    initial_sigmas: tuple[float, float, float] = DEFAULT_INITIAL_SIGMAS
+    update_min_d: float | None = None
+    update_min_a: float | None = None
+    line: int = 0
