@@ -10,6 +10,7 @@ reason in ``feedback_message``, which the console and the run report show.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any, ClassVar, Protocol, cast
 
 import numpy as np
@@ -18,6 +19,7 @@ from py_trees.ports import PortInformation
 
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
 from bt_manip.kinematics.reasons import SOLVER_KNOBS
+from bt_manip.localization.frames import compose, inverse
 from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.manipulation.grasps import grasped_object
 from bt_manip.manipulation.perception import PerceptionError, movable_body, perceived_pose
@@ -161,6 +163,34 @@ class WorldAccess:
         """The run's fault injector, when faults are injected."""
         context = cast(_Node, self).context
         return context.faults if isinstance(context, RunContext) else None
+
+    def believed_pose(self, robot: Robot | None = None) -> tuple[float, float, float]:
+        """The pose (x, y, yaw; map frame) the robot (default: this node's) believes its base
+        has: the localisation's estimate when the run localises, else the ground truth (see
+        :meth:`~bt_manip.run.context.RobotServices.believed_pose`). Navigation decides on this;
+        physics, the arm and reports keep the ground truth."""
+        robot = robot if robot is not None else self.robot()
+        context = cast(_Node, self).context
+        if not isinstance(context, RunContext) or context.localization is None:
+            return robot.base_pose2d()
+        return context.robot_services(self.robot_name_of(robot)).believed_pose()
+
+    def seen_in_map(self, pose: Sequence[float], robot: Robot | None = None) -> list[float]:
+        """A world pose (x, y, yaw, ...) worked out from what the robot perceives around it (an
+        object, as a camera sees it relative to the robot), in the map frame of the robot's
+        belief: ``believed_base * inverse(true_base) * pose``, so that driving to it on the
+        estimate ends where the pose is relative to the object. Unchanged without
+        localisation; values after the yaw are kept."""
+        values = [float(v) for v in pose]
+        if len(values) < 3:
+            return values
+        robot = robot if robot is not None else self.robot()
+        believed = self.believed_pose(robot)
+        truth = robot.base_pose2d()
+        if believed == truth:
+            return values
+        x, y, yaw = compose(compose(believed, inverse(truth)), (values[0], values[1], values[2]))
+        return [x, y, yaw, *values[3:]]
 
     def perceived_pose(self, name: str) -> np.ndarray:
         """The pose (4x4) at which the robot sees the movable object ``name``, for planning:

@@ -100,8 +100,11 @@ class PlanBaseForGrasp(RobotAction):
                 f"no base pose from which the arm reaches {name}: {placement.reason}"
             )
         assert placement.base_pose is not None and placement.grasp is not None
-        self.set_output("base_pose", pose_text(placement.base_pose))
-        self.set_output("staging_pose", pose_text(placement.staging_pose or ()))
+        # worked out from the object as the robot sees it: a pose relative to the object, put
+        # in the map frame of the robot's belief (unchanged without localisation)
+        self.set_output("base_pose", pose_text(self.seen_in_map(placement.base_pose, robot)))
+        self.set_output("staging_pose",
+                        pose_text(self.seen_in_map(placement.staging_pose or (), robot)))
         grasp = placement.grasp
         self.set_output(
             "grasp_pose", pose_text([*grasp[:3, 3], *quat_from_matrix(grasp[:3, :3])])

@@ -129,7 +129,7 @@ class Navigate(RobotAction):
             xy_tolerance=float(self.get_input("xy_tolerance")),
             yaw_tolerance=float(self.get_input("yaw_tolerance")),
         )
-        plan = nav.start(robot.base_pose2d(), goal, follower=follower)
+        plan = nav.start(self.believed_pose(robot), goal, follower=follower)
         if not plan.ok:
             raise ActionFailed(f"no path to {self.get_input('goal')}: {plan.reason}")
         self.nav = nav
@@ -152,7 +152,7 @@ class Navigate(RobotAction):
         if hits:
             robot.stop_base()
             raise ActionFailed("; ".join(hits))
-        status = self.nav.update(robot.base_pose2d(), self.now())
+        status = self.nav.update(self.believed_pose(robot), self.now())
         if status.state is FollowState.SUCCEEDED:
             robot.stop_base()
             return Status.SUCCESS
@@ -161,7 +161,7 @@ class Navigate(RobotAction):
             raise ActionFailed(status.reason)
         if self.elapsed() > self.timeout:
             robot.stop_base()
-            x, y, _ = robot.base_pose2d()
+            x, y, _ = self.believed_pose(robot)
             raise ActionFailed(f"not there after {self.timeout:.0f} s (at x={x:.2f} y={y:.2f})")
         if isinstance(status, HolonomicStatus):
             robot.set_base_velocity(*status.velocity)
@@ -239,7 +239,7 @@ class Reverse(RobotAction):
         self.speed = abs(float(self.get_input("speed")))
         if self.distance <= 0 or self.speed <= 0:
             raise ActionFailed("distance and speed must be positive")
-        self.origin = robot.base_pose2d()
+        self.origin = self.believed_pose(robot)
         self.touching = self._contacts()
 
     def _contacts(self) -> set[str]:
@@ -252,7 +252,7 @@ class Reverse(RobotAction):
         if new:
             robot.stop_base()
             raise ActionFailed("backing up, touched " + ", ".join(f"'{n}'" for n in sorted(new)))
-        x, y, _ = robot.base_pose2d()
+        x, y, _ = self.believed_pose(robot)
         if math.hypot(x - self.origin[0], y - self.origin[1]) >= self.distance:
             robot.stop_base()
             return Status.SUCCESS

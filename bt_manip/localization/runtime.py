@@ -32,6 +32,7 @@ import numpy as np
 from bt_manip.errors import InputError, Problem
 from bt_manip.localization.estimate import PoseEstimate
 from bt_manip.localization.filter import ParticleFilter
+from bt_manip.localization.frames import Pose, compose, inverse, wrap
 from bt_manip.localization.inputs import OdomPose
 from bt_manip.localization.inputs import Scan as FilterScan
 from bt_manip.localization.kidnap import kidnap
@@ -75,25 +76,10 @@ travel error after 1 m, 0.02 rad of heading error per radian turned, 0.01 rad pe
 MIN_RETURN_M = 0.4
 """Returns nearer than this to the laser are left out of what the filter reads (the robot's
 own wheels and bumpers, as a ROS laser filter would leave them out)."""
+SCAN_HALF_BAND = 0.03
+"""The map is cut this far (m) above and below the laser's scan plane."""
 ERROR_THRESHOLD_M = 0.2
 """The report counts the sim seconds the position error spends above this (m)."""
-Pose = tuple[float, float, float]
-
-
-def _wrap(a: float) -> float:
-    return math.atan2(math.sin(a), math.cos(a))
-
-
-def compose(a: Pose, b: Pose) -> Pose:
-    """Planar pose ``a * b`` (b expressed in a's frame)."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], _wrap(a[2] + b[2]))
-
-
-def inverse(a: Pose) -> Pose:
-    """The planar pose ``a`` inverted."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return (-c * a[0] - s * a[1], s * a[0] - c * a[1], _wrap(-a[2]))
 
 
 def options_of(settings: LocalizationSpec) -> LocalizationOptions:
@@ -133,7 +119,7 @@ class ErrorLog:
     def sample(self, time: float, believed: Pose, truth: Pose) -> None:
         err = math.hypot(believed[0] - truth[0], believed[1] - truth[1])
         self.errors.append(err)
-        self.yaw_errors.append(abs(_wrap(believed[2] - truth[2])))
+        self.yaw_errors.append(abs(wrap(believed[2] - truth[2])))
         if self._last is not None and self._last[1]:
             self.time_over += max(0.0, time - self._last[0])
         self._last = (time, err > ERROR_THRESHOLD_M)
@@ -188,7 +174,9 @@ class Localizer:
         self.odometry = WheelOdometry(robot, noise, rng=entity_rng(seed, f"odometry:{name}"),
                                       time=world.time)
         self.options = options_of(settings)
-        grid = map_from_world(world)
+        # the map is cut where the laser sweeps: what stands at its height is a wall to it
+        height = float(self.lidar.sensor_pose()[0][2])
+        grid = map_from_world(world, band=(height - SCAN_HALF_BAND, height + SCAN_HALF_BAND))
         field_ = LikelihoodField.from_grid(grid, self.options.laser_likelihood_max_dist)
         self.filter = ParticleFilter(field_, self.options, entity_rng(seed, f"amcl:{name}"))
         given = settings.initial_pose
@@ -238,7 +226,7 @@ class Localizer:
         if last is None:
             return True
         moved = math.hypot(odom.x - last[0], odom.y - last[1])
-        turned = abs(_wrap(odom.yaw - last[2]))
+        turned = abs(wrap(odom.yaw - last[2]))
         return moved >= self.options.update_min_d or turned >= self.options.update_min_a
 
     def _scan_and_update(self, odom: Odometry, now: float) -> None:

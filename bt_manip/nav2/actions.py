@@ -162,7 +162,7 @@ class PlanAction(Nav2Action):
     def start_pose(self, robot: Any) -> Pose2D:
         """The pose ``start`` names, else the robot's base pose."""
         start_value = self.get_input("start", None)
-        return goal_pose(self.world, start_value) if start_value else robot.base_pose2d()
+        return goal_pose(self.world, start_value) if start_value else self.believed_pose(robot)
 
     def step(self) -> Status:
         return Status.SUCCESS
@@ -309,7 +309,7 @@ class FollowPath(Nav2Action):
                 ControllerError.NO_VALID_CONTROL,
                 "ran into " + ", ".join(f"'{b}'" for b in sorted(bumped)),
             )
-        pose = robot.base_pose2d()
+        pose = self.believed_pose(robot)
         pivot = ahead_of(pose, self.nav.pivot)
         dropped = drop_if_due(self, *pivot)
         if self.watch.due(self.now()) or dropped is not None:
@@ -343,7 +343,7 @@ class _BaseBehavior(Nav2Action):
 
     def begin(self) -> None:
         robot = self.base()
-        self.origin = robot.base_pose2d()
+        self.origin = self.believed_pose(robot)
         self.allowance = float(self.get_input("time_allowance"))
         self.check = not bool(self.get_input("disable_collision_checks"))
         self.touching = contacts(self.world, robot, self.robot_name())
@@ -358,7 +358,7 @@ class _BaseBehavior(Nav2Action):
                     BehaviorError.COLLISION_AHEAD,
                     "collision: touched " + ", ".join(f"'{n}'" for n in sorted(new)),
                 )
-        twist = self.motion(robot.base_pose2d())
+        twist = self.motion(self.believed_pose(robot))
         if twist is None:
             robot.stop_base()
             return Status.SUCCESS

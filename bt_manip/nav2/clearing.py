@@ -101,7 +101,7 @@ class _ClearSquare(_Clear):
     def begin(self) -> None:
         robot = self.base()
         nav = synced_navigator(self, robot)
-        x, y, _ = robot.base_pose2d()
+        x, y, _ = self.believed_pose(robot)
         square = square_round(nav, x, y, float(self.get_input("reset_distance")))
         clear_map(nav, keep=~square if self.INSIDE else square)
 

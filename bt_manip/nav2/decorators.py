@@ -88,7 +88,7 @@ class DistanceController(WorldAccess, DecoratorNode):
 
     def tick_node(self) -> NodeStatus:
         try:
-            x, y, _ = self.robot().base_pose2d()
+            x, y, _ = self.believed_pose()
         except ActionFailed as exc:
             self.feedback_message = str(exc)
             return FAILURE

@@ -95,7 +95,7 @@ class ValidatePath(WorldAccess, SyncActionNode):
         begin, end = 0, len(poses)
         lookahead = float(self.get_input("max_lookahead_distance"))
         if lookahead > 0:
-            begin = nearest_pose(poses, robot.base_pose2d(), 0.0, 0, len(poses))
+            begin = nearest_pose(poses, self.believed_pose(robot), 0.0, 0, len(poses))
             end = first_beyond(_steps(poses), begin, lookahead)
         pts = path.shifted(nav.pivot)[begin:end]
         bad, inside = in_collision(nav, pts)
@@ -148,7 +148,7 @@ class IsGoalNearby(WorldCondition):
         poses = path.poses
         steps = _steps(poses)
         end = first_beyond(steps, self.search_begin, search) if search >= 0 else len(poses)
-        here = nearest_pose(poses, self.robot().base_pose2d(), 0.0, self.search_begin,
+        here = nearest_pose(poses, self.believed_pose(), 0.0, self.search_begin,
                             max(end, self.search_begin + 1))
         if search >= 0:
             self.search_begin = here

@@ -102,7 +102,7 @@ class TruncatePathLocal(WorldAccess, SyncActionNode):
         if given is not None:
             # text may name a pose of the world; a pose tuple needs no world
             return goal_pose(self.world if isinstance(given, str) else None, given)
-        pose: Pose2D = self.robot().base_pose2d()
+        pose: Pose2D = self.believed_pose()
         return pose
 
     def update(self) -> Status:

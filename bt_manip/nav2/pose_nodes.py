@@ -66,7 +66,7 @@ class GetCurrentPose(_PoseAction):
     }
 
     def act(self) -> None:
-        self.set_output("current_pose", tuple(float(v) for v in self.robot().base_pose2d()))
+        self.set_output("current_pose", tuple(float(v) for v in self.believed_pose()))
 
 
 @registry.register

@@ -44,7 +44,7 @@ class GoalReached(WorldCondition):
 
     def check(self) -> tuple[bool, str]:
         goal = goal_pose(self.world, self.get_input("goal"))
-        x, y, _ = self.robot().base_pose2d()
+        x, y, _ = self.believed_pose()
         d = math.hypot(goal[0] - x, goal[1] - y)
         return d <= GOAL_REACHED_TOLERANCE, f"{d:.2f} m from the goal"
 
@@ -99,7 +99,7 @@ class DistanceTraveled(_Every):
     }
 
     def mark(self) -> tuple[float, float]:
-        x, y, _ = self.robot().base_pose2d()
+        x, y, _ = self.believed_pose()
         return (x, y)
 
     def since(self, start: Any, now: Any) -> tuple[float, float]:
@@ -146,7 +146,7 @@ class IsPathValid(WorldCondition):
         nav = synced_navigator(self, robot)
         nav.refresh()
         pts = path.shifted(nav.pivot)
-        x, y, yaw = robot.base_pose2d()
+        x, y, yaw = self.believed_pose(robot)
         here = np.array([x + nav.pivot * math.cos(yaw), y + nav.pivot * math.sin(yaw)])
         nearest = int(np.argmin(np.hypot(*(pts - here).T)))
         ahead = pts[nearest:]

@@ -142,7 +142,7 @@ class ComputeRoute(PlanAction):
             return ids
         try:
             start: Pose2D = (goal_pose(self.world, self.get_input("start"))
-                             if bool(self.get_input("use_start")) else robot.base_pose2d())
+                             if bool(self.get_input("use_start")) else self.believed_pose(robot))
             goal = goal_pose(self.world, self.get_input("goal"))
         except (ActionFailed, PortError) as exc:
             self.fail(RouteError.INDETERMINANT_NODES_ON_GRAPH, str(exc))

@@ -173,7 +173,7 @@ class RemovePassedGoals(WorldAccess, SyncActionNode):
     def update(self) -> Status:
         try:
             goals = goals_list(self.world, self.get_input("input_goals"))
-            x, y, _ = self.robot().base_pose2d()
+            x, y, _ = self.believed_pose()
             statuses = statuses_of(self.get_input("input_waypoint_statuses", None))
         except (ActionFailed, PortError) as exc:
             self.feedback_message = str(exc)

@@ -148,7 +148,8 @@ def parse_fault(text: str) -> FaultSpec:
     elif len(parts) == 3 and parts[0]:
         raise bad(f"unknown fault kind '{parts[1]}'{_close(parts[1], ['failure'])}")
     elif len(parts) == 2 and parts[0]:
-        hint = _close(parts[0], [*WORLD_FAULTS, POSE_NOISE, *LOCALIZATION_FAULTS])
+        hint = (_close(parts[0], [*WORLD_FAULTS, POSE_NOISE])
+                or _close(parts[0], list(LOCALIZATION_FAULTS)))
         if not hint:
             hint = f" (for a node, write {parts[0]}:failure:{parts[1]})"
         raise bad(f"unknown fault kind '{parts[0]}'{hint}")
