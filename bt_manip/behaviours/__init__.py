@@ -9,6 +9,7 @@
 - Placing: Place (the held object to a target pose), Fasten (fix it to the structure).
 - Conditions: IsAttached, IsHolding, ObjectInRegion, ObjectAbove, CarriedClear, ObjectUpright.
 - World: SpawnModel, DeleteModel. Regions: DropPoint.
+- Localisation: IsLocalized, SetInitialPose.
 """
 
 from bt_manip.behaviours import (
@@ -20,6 +21,7 @@ from bt_manip.behaviours import (
     fasten,
     get_clear,
     gripper,
+    localization,
     navigate,
     place,
     place_base,
@@ -37,6 +39,7 @@ __all__ = [
     "fasten",
     "get_clear",
     "gripper",
+    "localization",
     "navigate",
     "place",
     "place_base",

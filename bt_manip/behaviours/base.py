@@ -175,6 +175,21 @@ class WorldAccess:
             return robot.base_pose2d()
         return context.robot_services(self.robot_name_of(robot)).believed_pose()
 
+    def odom_pose(self, robot: Robot | None = None) -> tuple[float, float, float]:
+        """The robot's pose in its odometry frame when the run localises it (continuous: it
+        never jumps when the filter corrects itself), else the ground truth. Motions measured
+        from where they started (Spin, BackUp, Reverse) use this, as Nav2's behaviour server
+        works in the ``odom`` frame."""
+        robot = robot if robot is not None else self.robot()
+        context = cast(_Node, self).context
+        if not isinstance(context, RunContext) or context.localization is None:
+            return robot.base_pose2d()
+        loc = context.robot_services(self.robot_name_of(robot)).localizer
+        if loc is None:
+            return robot.base_pose2d()
+        o = loc.odometry.reading()
+        return (o.x, o.y, o.yaw)
+
     def seen_in_map(self, pose: Sequence[float], robot: Robot | None = None) -> list[float]:
         """A world pose (x, y, yaw, ...) worked out from what the robot perceives around it (an
         object, as a camera sees it relative to the robot), in the map frame of the robot's

@@ -239,7 +239,7 @@ class Reverse(RobotAction):
         self.speed = abs(float(self.get_input("speed")))
         if self.distance <= 0 or self.speed <= 0:
             raise ActionFailed("distance and speed must be positive")
-        self.origin = self.believed_pose(robot)
+        self.origin = self.odom_pose(robot)
         self.touching = self._contacts()
 
     def _contacts(self) -> set[str]:
@@ -252,7 +252,7 @@ class Reverse(RobotAction):
         if new:
             robot.stop_base()
             raise ActionFailed("backing up, touched " + ", ".join(f"'{n}'" for n in sorted(new)))
-        x, y, _ = self.believed_pose(robot)
+        x, y, _ = self.odom_pose(robot)
         if math.hypot(x - self.origin[0], y - self.origin[1]) >= self.distance:
             robot.stop_base()
             return Status.SUCCESS

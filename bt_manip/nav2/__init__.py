@@ -24,7 +24,8 @@ Importing this package registers the nodes (Nav2's IDs, ports and semantics):
   GetCurrentPose, GetPoseFromPath, ArePosesNear, ConcatenatePaths, GetNextFewGoals,
   AppendGoalPoseToGoals (:mod:`.pose_nodes`); the route server's ComputeRoute,
   ExtractRouteNodesAsGoals and WouldARouteRecoveryHelp (:mod:`.route`) on the world's route
-  graph (:mod:`.route_graph`).
+  graph (:mod:`.route_graph`); ReinitializeGlobalLocalization on the run's particle filter
+  (:mod:`.localization`).
 
 The TreeNodesModel names the ports' types as Nav2 does (:mod:`.model_types`).
 
@@ -44,6 +45,7 @@ from bt_manip.nav2 import (
     decorators,
     frames,
     goal_updater,
+    localization,
     path_checks,
     path_local,
     path_nodes,
@@ -60,6 +62,6 @@ apply_model_types(registry)
 
 __all__ = [
     "actions", "battery", "cancel", "clearing", "conditions", "controls", "decorators",
-    "frames", "goal_updater", "path_checks", "path_local", "path_nodes", "pose_nodes", "progress",
-    "route", "selectors", "smoothing", "through_poses",
+    "frames", "goal_updater", "localization", "path_checks", "path_local", "path_nodes",
+    "pose_nodes", "progress", "route", "selectors", "smoothing", "through_poses",
 ]

@@ -343,7 +343,7 @@ class _BaseBehavior(Nav2Action):
 
     def begin(self) -> None:
         robot = self.base()
-        self.origin = self.believed_pose(robot)
+        self.origin = self.odom_pose(robot)
         self.allowance = float(self.get_input("time_allowance"))
         self.check = not bool(self.get_input("disable_collision_checks"))
         self.touching = contacts(self.world, robot, self.robot_name())
@@ -358,7 +358,7 @@ class _BaseBehavior(Nav2Action):
                     BehaviorError.COLLISION_AHEAD,
                     "collision: touched " + ", ".join(f"'{n}'" for n in sorted(new)),
                 )
-        twist = self.motion(self.believed_pose(robot))
+        twist = self.motion(self.odom_pose(robot))
         if twist is None:
             robot.stop_base()
             return Status.SUCCESS
