@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -45,10 +45,20 @@ class EpisodeResult:
     coverage: dict[str, list[int]] = field(default_factory=dict)
     """Per node ticked in the episode (by path): its counts, in the order of
     :data:`bt_manip.run.node_counts.COUNT_FIELDS` (ticks, success, failure, skipped, halted)."""
+    localization: dict[str, float] | None = None
+    """With localisation on, the run report's ``localization`` errors; None (left out of the
+    JSON) otherwise."""
 
     @property
     def success(self) -> bool:
         return self.status == "SUCCESS"
+
+    def to_json(self) -> dict[str, Any]:
+        """The record as JSON (``localization`` only when the episode localised)."""
+        data = asdict(self)
+        if self.localization is None:
+            del data["localization"]
+        return data
 
 
 def run_one(spec: EpisodeSpec) -> EpisodeResult:
@@ -89,6 +99,7 @@ def run_one(spec: EpisodeSpec) -> EpisodeResult:
         leaf_failures=dict(leaf_failures),
         coverage={n.path: [n.counts[k] for k in COUNT_FIELDS]
                   for n in report.nodes if n.counts and n.counts["ticks"]},
+        localization=dict(report.localization) if report.localization is not None else None,
     )
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 from bt_manip.bench.episodes import SCHEMA_VERSION, EpisodeResult
-from bt_manip.bench.stats import BenchSummary
+from bt_manip.bench.stats import LOCALIZATION_FIELDS, BenchSummary
 from bt_manip.outputs import make_folder
 
 STATUS_COLOURS = {
@@ -29,20 +29,26 @@ STATUS_COLOURS = {
 def write_outputs(results: list[EpisodeResult], summary: BenchSummary, out: Path) -> None:
     """episodes.json, episodes.csv, summary.json and outcomes.png in ``out``."""
     make_folder(out)
-    episodes = {"schema_version": SCHEMA_VERSION, "episodes": [asdict(r) for r in results]}
+    episodes = {"schema_version": SCHEMA_VERSION, "episodes": [r.to_json() for r in results]}
     (out / "episodes.json").write_text(json.dumps(episodes, indent=2) + "\n")
     names = sorted({k for r in results for k in r.metrics})
+    # the localisation's errors, after the metrics, only in a bench that localised
+    located = [k for k in LOCALIZATION_FIELDS if any(r.localization for r in results)]
     with open(out / "episodes.csv", "w", newline="") as fh:
         w = csv.writer(fh)
         head = ["schema_version", "seed", "status", "sim_time", "wall_time", "ticks",
                 "failed_node", "reason"]
-        w.writerow([*head, "injected", *names])
+        w.writerow([*head, "injected", *names, *located])
         for r in results:
             row = [SCHEMA_VERSION, r.seed, r.status, f"{r.sim_time:.3f}", f"{r.wall_time:.3f}",
                    r.ticks]
             row += [r.failed_node, r.reason, len(r.injected)]
-            w.writerow(row + [r.metrics.get(k, "") for k in names])
+            loc = r.localization or {}
+            w.writerow(row + [r.metrics.get(k, "") for k in names]
+                       + [loc.get(k, "") for k in located])
     summary_json = {"schema_version": SCHEMA_VERSION, **asdict(summary)}
+    if summary.localization is None:
+        del summary_json["localization"]
     (out / "summary.json").write_text(json.dumps(summary_json, indent=2) + "\n")
     _plot(results, summary, out / "outcomes.png")
 

@@ -137,7 +137,7 @@ class BenchLog:
 
     def append(self, result: EpisodeResult) -> None:
         """Write one finished episode and flush it to the file."""
-        self._fh.write(json.dumps({"kind": "episode", **asdict(result)}) + "\n")
+        self._fh.write(json.dumps({"kind": "episode", **result.to_json()}) + "\n")
         self._fh.flush()
 
     def close(self) -> None:

@@ -19,6 +19,9 @@ from bt_manip.bench.episodes import EpisodeResult
 if TYPE_CHECKING:
     from bt_manip.episode import EpisodeSpec
 
+LOCALIZATION_FIELDS = ("mean_error_m", "p95_error_m", "max_error_m", "mean_yaw_error_rad",
+                       "time_over_0_2m_s")
+"""The run report's localisation errors, each summed up over the episodes that localised."""
 LEAVES_SHOWN = 12
 """Leaves listed in the text summary (summary.json has them all)."""
 
@@ -55,6 +58,9 @@ class BenchSummary:
     world: str = ""
     first_seed: int = 0
     inject: list[str] = field(default_factory=list)
+    localization: dict[str, dict[str, float]] | None = None
+    """With localisation on: per error of the run reports' ``localization`` (mean_error_m,
+    ...), its statistics over the episodes; None (left out of summary.json) otherwise."""
 
     def text(self) -> str:
         lo, hi = self.ci95
@@ -70,6 +76,13 @@ class BenchSummary:
         for name, st in sorted(self.metrics.items()):
             lines.append(
                 f"blackboard {name}: mean {st['mean']:g}, min {st['min']:g}, max {st['max']:g}"
+            )
+        if self.localization is not None:
+            err, p95 = self.localization["mean_error_m"], self.localization["p95_error_m"]
+            yaw = self.localization["mean_yaw_error_rad"]
+            lines.append(
+                f"localisation error: mean {err['mean'] * 100:.1f} cm (episodes' p95 "
+                f"{p95['mean'] * 100:.1f} cm on average), mean yaw error {yaw['mean']:.4f} rad"
             )
         if self.injected:
             lines.append(
@@ -131,4 +144,14 @@ def summarise(results: list[EpisodeResult], base: EpisodeSpec) -> BenchSummary:
         world=base.world or "",
         first_seed=base.seed,
         inject=[f.text() for f in base.inject],
+        localization=_localization_stats(results),
     )
+
+
+def _localization_stats(results: list[EpisodeResult]) -> dict[str, dict[str, float]] | None:
+    """Statistics of each localisation error over the episodes that localised (None when
+    none did)."""
+    located = [r.localization for r in results if r.localization]
+    if not located:
+        return None
+    return {k: _stats([loc[k] for loc in located if k in loc]) for k in LOCALIZATION_FIELDS}
