@@ -3,6 +3,7 @@ the localisation nodes, the faults and the switches that need it."""
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -10,7 +11,10 @@ from typing import Any
 
 import pytest
 
+from bt_manip.bench.episodes import EpisodeResult
+from bt_manip.bench.files import write_outputs
 from bt_manip.bench.log import spec_to_json
+from bt_manip.bench.stats import LOCALIZATION_FIELDS, summarise
 from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec, load_tree_with_nodes
 from bt_manip.errors import InputError
@@ -190,3 +194,47 @@ def test_the_world_section_is_checked_with_its_lines(tmp_path: Path) -> None:
     assert section is not None and section.max_particles == 800
     assert tuple(section.initial_pose or ()) == (1.0, 2.0, 0.5)
     assert runtime.options_of(section).max_particles == 800
+
+
+def _validator(name: str) -> Any:
+    jsonschema = pytest.importorskip("jsonschema")
+    from referencing import Registry, Resource
+
+    schemas = [json.loads(p.read_text()) for p in (ROOT / "docs" / "schemas").glob("*.json")]
+    registry: Registry = Registry().with_resources(
+        (s["$id"], Resource.from_contents(s)) for s in schemas)
+    schema = json.loads((ROOT / "docs" / "schemas" / name).read_text())
+    return jsonschema.Draft202012Validator(schema, registry=registry)
+
+
+def test_localised_outputs_follow_their_schemas(tmp_path: Path) -> None:
+    report, _ = _node_run(tmp_path, localize=True)
+    data = report.to_json()
+    assert set(data["localization"]) == set(LOCALIZATION_FIELDS)
+    _validator("run-report.schema.json").validate(data)
+    bad = {**data, "localization": {**data["localization"], "surprise": 1}}
+    with pytest.raises(Exception, match="surprise"):
+        _validator("run-report.schema.json").validate(bad)
+
+    def episode(seed: int, err: float | None) -> EpisodeResult:
+        loc = None if err is None else {k: err for k in LOCALIZATION_FIELDS}
+        return EpisodeResult(seed, "SUCCESS", "", 10.0, 2.0, 200, localization=loc)
+
+    spec = _spec()
+    located = [episode(0, 0.02), episode(1, 0.04)]
+    write_outputs(located, summarise(located, spec), tmp_path / "on")
+    summary = json.loads((tmp_path / "on" / "summary.json").read_text())
+    assert summary["localization"]["mean_error_m"]["mean"] == pytest.approx(0.03)
+    assert summary["localization"]["max_error_m"]["max"] == pytest.approx(0.04)
+    _validator("bench-summary.schema.json").validate(summary)
+    episodes = json.loads((tmp_path / "on" / "episodes.json").read_text())
+    _validator("bench-episodes.schema.json").validate(episodes)
+    assert episodes["episodes"][1]["localization"]["p95_error_m"] == 0.04
+    head = (tmp_path / "on" / "episodes.csv").read_text().splitlines()[0].split(",")
+    assert head[-5:] == list(LOCALIZATION_FIELDS)
+
+    plain = [episode(0, None)]
+    write_outputs(plain, summarise(plain, spec), tmp_path / "off")
+    for name in ("summary.json", "episodes.json", "episodes.csv"):
+        text = (tmp_path / "off" / name).read_text()
+        assert "localization" not in text and "error_m" not in text
