@@ -81,6 +81,9 @@ class Episode:
                                                      self.faults)
             self.context = RunContext(clock=clock, world=self.world, faults=self.faults,
                                       localization=self.localization)
+            if self.localization is not None:  # the viewer and the replay draw what it sees
+                for loc in self.localization.localizers.values():
+                    loc.overlay = self.context.overlay
             self.tree: Tree = load_tree(
                 spec.tree,
                 tree_id=spec.tree_id,

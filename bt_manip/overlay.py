@@ -6,6 +6,7 @@ Behaviours do not know whether anyone is watching. They write to the overlay of 
 
     overlay.show_path("base_plan", [(x0, y0), (x1, y1), ...])
     overlay.show_frame("ik_target", T_world_target)   # 4x4
+    overlay.show_points("laser_scan", [(x0, y0), ...], z=0.25)
     overlay.clear("ik_target")
 
 An overlay only stores the latest item under each name and counts changes; the live viewer and
@@ -35,6 +36,15 @@ class PathItem:
 
 
 @dataclass(frozen=True)
+class PointsItem:
+    """Points in the world frame, rows (x, y, z), each drawn as a dot ``size`` metres wide."""
+
+    points: np.ndarray
+    rgba: tuple[float, float, float, float] = PATH_COLOUR
+    size: float = 0.04
+
+
+@dataclass(frozen=True)
 class FrameItem:
     """A triad (x red, y green, z blue) at a 4x4 pose, axes ``size`` metres long."""
 
@@ -46,7 +56,7 @@ class FrameItem:
 class Overlay:
     """Named paths and frames to draw, the latest of each; ``version`` counts changes."""
 
-    items: dict[str, PathItem | FrameItem] = field(default_factory=dict)
+    items: dict[str, PathItem | FrameItem | PointsItem] = field(default_factory=dict)
     version: int = 0
 
     def show_path(
@@ -64,6 +74,23 @@ class Overlay:
             self.clear(name)
             return
         self.items[name] = PathItem(np.array(rows), rgba)
+        self.version += 1
+
+    def show_points(
+        self,
+        name: str,
+        xy_points: Any,
+        z: float = PATH_HEIGHT,
+        rgba: tuple[float, float, float, float] = PATH_COLOUR,
+        size: float = 0.04,
+    ) -> None:
+        """Draw points (rows x, y) at height ``z``: a laser's returns, a filter's particles."""
+        xy = np.asarray(xy_points, dtype=float).reshape(-1, 2)
+        if len(xy) == 0:
+            self.clear(name)
+            return
+        points = np.column_stack([xy, np.full(len(xy), float(z))])
+        self.items[name] = PointsItem(points, rgba, float(size))
         self.version += 1
 
     def show_frame(self, name: str, matrix: Any, size: float = 0.15) -> None:

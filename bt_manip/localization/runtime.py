@@ -39,6 +39,7 @@ from bt_manip.localization.kidnap import kidnap
 from bt_manip.localization.likelihood_field import LikelihoodField
 from bt_manip.localization.map_from_world import map_from_world
 from bt_manip.localization.options import LocalizationOptions
+from bt_manip.overlay import Overlay
 from bt_manip.run.faults import (
     KIDNAP,
     LIDAR_DROPOUT,
@@ -78,6 +79,10 @@ MIN_RETURN_M = 0.4
 own wheels and bumpers, as a ROS laser filter would leave them out)."""
 SCAN_HALF_BAND = 0.03
 """The map is cut this far (m) above and below the laser's scan plane."""
+PARTICLES_DRAWN = 400
+"""Most particles drawn on the overlay (every k-th of the set)."""
+SCAN_COLOUR = (0.9, 0.1, 0.1, 1.0)
+PARTICLE_COLOUR = (0.2, 0.35, 0.95, 1.0)
 ERROR_THRESHOLD_M = 0.2
 """The report counts the sim seconds the position error spends above this (m)."""
 
@@ -190,6 +195,9 @@ class Localizer:
         self.kidnapped_at: float | None = None
         self._last_update: Pose | None = None
         """Odometry pose of the filter's last update (None: it takes the next scan)."""
+        self.overlay: Overlay | None = None
+        """Where the scan, the particles and the estimate are drawn after each filter update
+        (the run's overlay, which the viewer and the replay read); None draws nothing."""
 
     def _odom(self) -> Pose:
         o = self.odometry.reading()
@@ -241,6 +249,31 @@ class Localizer:
             self.map_to_odom = compose((est.x, est.y, est.yaw),
                                        inverse((odom.x, odom.y, odom.yaw)))
             self._last_update = (odom.x, odom.y, odom.yaw)
+            if self.overlay is not None:
+                self.draw(self.overlay, scan)
+
+    def draw(self, overlay: Overlay, scan: Scan) -> None:
+        """Draw on ``overlay``: the scan's returns where the robot believes it is (red, at the
+        scan plane), the particles (blue, at most :data:`PARTICLES_DRAWN`) and the estimate
+        (a frame at the believed pose; the robot itself is drawn at its true pose)."""
+        x, y, yaw = self.pose()
+        sx, sy, syaw = scan.sensor_pose
+        ox, oy, oyaw = compose((x, y, yaw), (sx, sy, syaw))
+        pts = scan.points()
+        c, s = math.cos(oyaw), math.sin(oyaw)
+        world = np.column_stack([ox + c * pts[:, 0] - s * pts[:, 1],
+                                 oy + s * pts[:, 0] + c * pts[:, 1]])
+        height = float(self.lidar.sensor_pose()[0][2])
+        overlay.show_points(f"{self.name}_laser_scan", world, z=height, rgba=SCAN_COLOUR,
+                            size=0.05)
+        poses = self.filter.particles.poses
+        step = max(1, len(poses) // PARTICLES_DRAWN)
+        overlay.show_points(f"{self.name}_particles", poses[::step, :2], z=0.05,
+                            rgba=PARTICLE_COLOUR, size=0.04)
+        frame = np.eye(4)
+        frame[:2, :2] = [[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]
+        frame[:3, 3] = (x, y, 0.05)
+        overlay.show_frame(f"{self.name}_pose_estimate", frame, size=0.4)
 
     def reset(self, pose: Pose, sigmas: Pose | None = None) -> None:
         """Start the filter again from ``pose`` (SetInitialPose); the belief jumps there."""

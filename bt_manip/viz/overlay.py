@@ -1,5 +1,6 @@
-"""Drawing overlay items (:mod:`bt_manip.overlay`: planned paths, target frames) as three.js
-objects, for the live viewer and the replay recorder."""
+"""Drawing overlay items (:mod:`bt_manip.overlay`: planned paths, target frames, point sets
+such as a laser's returns and a filter's particles) as three.js objects, for the live viewer
+and the replay recorder."""
 
 from __future__ import annotations
 
@@ -8,16 +9,26 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.overlay import FrameItem, PathItem
+from bt_manip.overlay import FrameItem, PathItem, PointsItem
 from bt_manip.viz.scene import colour_int, column_major
 
 
-def item_json(item: PathItem | FrameItem) -> dict[str, Any]:
+def item_json(item: PathItem | FrameItem | PointsItem) -> dict[str, Any]:
     """A three.js object JSON (plain lists, no binary) drawing an overlay item."""
     geom_id, mat_id = str(uuid.uuid4()), str(uuid.uuid4())
-    if isinstance(item, PathItem):
+    attributes: dict[str, Any]
+    if isinstance(item, PointsItem):
         positions = item.points.astype(np.float32).flatten().tolist()
-        attributes: dict[str, Any] = {
+        attributes = {
+            "position": {"itemSize": 3, "type": "Float32Array", "array": positions,
+                         "normalized": False}
+        }
+        material = {"uuid": mat_id, "type": "PointsMaterial", "color": colour_int(item.rgba),
+                    "size": item.size, "sizeAttenuation": True, "vertexColors": 0}
+        kind, matrix = "Points", np.eye(4)
+    elif isinstance(item, PathItem):
+        positions = item.points.astype(np.float32).flatten().tolist()
+        attributes = {
             "position": {"itemSize": 3, "type": "Float32Array", "array": positions,
                          "normalized": False}
         }

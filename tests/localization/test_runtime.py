@@ -19,11 +19,13 @@ from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec, load_tree_with_nodes
 from bt_manip.errors import InputError
 from bt_manip.localization import runtime
+from bt_manip.overlay import FrameItem, PointsItem
 from bt_manip.run.context import RunContext
 from bt_manip.run.faults import parse_fault
 from bt_manip.run.runner import Runner, RunOptions
 from bt_manip.sim.world import World
 from bt_manip.sim.world_reader import parse_world
+from bt_manip.viz.overlay import item_json
 
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = str(ROOT / "worlds" / "tb3_house.yaml")
@@ -107,6 +109,14 @@ def _node_run(tmp_path: Path, localize: bool) -> tuple[Any, Any]:
     with Episode(spec) as episode:
         report = episode.run()
         pose = episode.tree.blackboard.get("pose") if localize else None
+        drawn = episode.context.overlay.items
+        if localize:  # the viewer and the replay are given the scan, particles and estimate
+            assert isinstance(drawn["husky_laser_scan"], PointsItem)
+            assert isinstance(drawn["husky_particles"], PointsItem)
+            assert isinstance(drawn["husky_pose_estimate"], FrameItem)
+            assert item_json(drawn["husky_laser_scan"])["object"]["type"] == "Points"
+        else:
+            assert not any(name.startswith("husky_") for name in drawn)
     return report, pose
 
 
