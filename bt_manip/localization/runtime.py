@@ -36,9 +36,9 @@ from bt_manip.localization.frames import Pose, compose, inverse, wrap
 from bt_manip.localization.inputs import OdomPose
 from bt_manip.localization.inputs import Scan as FilterScan
 from bt_manip.localization.kidnap import kidnap
-from bt_manip.localization.likelihood_field import LikelihoodField
-from bt_manip.localization.map_from_world import map_from_world
+from bt_manip.localization.map_from_world import map_from_world, static_outlines
 from bt_manip.localization.options import LocalizationOptions
+from bt_manip.localization.surface import surface_field
 from bt_manip.overlay import Overlay
 from bt_manip.run.faults import (
     KIDNAP,
@@ -77,6 +77,8 @@ travel error after 1 m, 0.02 rad of heading error per radian turned, 0.01 rad pe
 MIN_RETURN_M = 0.4
 """Returns nearer than this to the laser are left out of what the filter reads (the robot's
 own wheels and bumpers, as a ROS laser filter would leave them out)."""
+MAP_RESOLUTION = 0.05
+"""Cell side (m) of the localisation map."""
 SCAN_HALF_BAND = 0.03
 """The map is cut this far (m) above and below the laser's scan plane."""
 PARTICLES_DRAWN = 400
@@ -181,8 +183,10 @@ class Localizer:
         self.options = options_of(settings)
         # the map is cut where the laser sweeps: what stands at its height is a wall to it
         height = float(self.lidar.sensor_pose()[0][2])
-        grid = map_from_world(world, band=(height - SCAN_HALF_BAND, height + SCAN_HALF_BAND))
-        field_ = LikelihoodField.from_grid(grid, self.options.laser_likelihood_max_dist)
+        band = (height - SCAN_HALF_BAND, height + SCAN_HALF_BAND)
+        grid = map_from_world(world, resolution=MAP_RESOLUTION, band=band)
+        field_ = surface_field(grid, static_outlines(world, band),
+                               self.options.laser_likelihood_max_dist)
         self.filter = ParticleFilter(field_, self.options, entity_rng(seed, f"amcl:{name}"))
         given = settings.initial_pose
         start: Pose = ((given.x, given.y, given.yaw) if given is not None
