@@ -111,6 +111,13 @@ class RunReport:
             f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
             f"({rtf_text}), {self.ticks} ticks",
         ]
+        if self.localization is not None:
+            loc = self.localization
+            lines.append(
+                f"  localisation error: mean {loc['mean_error_m'] * 100:.1f} cm, p95 "
+                f"{loc['p95_error_m'] * 100:.1f} cm, max {loc['max_error_m'] * 100:.1f} cm, "
+                f"mean yaw {loc['mean_yaw_error_rad']:.4f} rad, "
+                f"{loc['time_over_0_2m_s']:.1f} s over 0.2 m")
         cause = self.cause.get("path")
         failed = [n for n in self.nodes if "FAILURE" in (n.status, n.last_status) and n.reason]
         failed.sort(key=lambda n: n.path != cause)  # the failure that ended the run first

@@ -13,7 +13,7 @@ import pytest
 
 from bt_manip.bench.episodes import EpisodeResult
 from bt_manip.bench.files import write_outputs
-from bt_manip.bench.log import spec_to_json
+from bt_manip.bench.log import spec_from_json, spec_to_json
 from bt_manip.bench.stats import LOCALIZATION_FIELDS, summarise
 from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec, load_tree_with_nodes
@@ -68,6 +68,9 @@ def test_off_runs_the_path_of_a_run_without_localisation(monkeypatch: pytest.Mon
     assert _comparable(report) == _comparable(plain)
     assert "localize" not in spec_to_json(spec)
     assert spec_to_json(replace(spec, localize=True))["localize"] is True
+    # --resume and the Ray backend run what the bench log says
+    assert spec_from_json(spec_to_json(replace(spec, localize=True))).localize is True
+    assert spec_from_json(spec_to_json(spec)).localize is False
 
 
 def _localised_run(seed: int) -> tuple[dict[str, float], tuple[float, float, float], float]:
@@ -123,13 +126,14 @@ def _node_run(tmp_path: Path, localize: bool) -> tuple[Any, Any]:
 def test_the_localisation_nodes(tmp_path: Path) -> None:
     report, pose = _node_run(tmp_path, localize=True)
     assert report.status == "SUCCESS", report.reason
+    assert "localisation error: mean" in report.summary()
     # the robot believes what it was told, and the filter is sure of it until spread
     assert pose == pytest.approx((1.5, -0.5, 0.3))
     lost = next(n for n in report.nodes if n.path.endswith("/lost"))
     assert lost.last_status == "FAILURE" and "spread" in lost.reason
 
     off, _ = _node_run(tmp_path, localize=False)
-    assert off.status == "FAILURE"
+    assert off.status == "FAILURE" and "localisation" not in off.summary()
     assert off.cause["name"] == "set" and "--localize" in off.cause["reason"]
 
 
