@@ -190,6 +190,21 @@ class WorldAccess:
         o = loc.odometry.reading()
         return (o.x, o.y, o.yaw)
 
+    def map_to_world(self, target: Sequence[float],
+                     robot: Robot | None = None) -> tuple[float, float, float]:
+        """Where a map-frame target (x, y, yaw) lies in the world for the robot's belief:
+        ``true_base * inverse(believed_base) * target`` (unchanged without localisation). A
+        node that acts on a map-frame target with the arm (Place) aims there: the target
+        carries the localisation's error, as it does for a base driven to it on the
+        estimate."""
+        x, y, yaw = (float(v) for v in target[:3])
+        robot = robot if robot is not None else self.robot()
+        believed = self.believed_pose(robot)
+        truth = robot.base_pose2d()
+        if believed == truth:
+            return (x, y, yaw)
+        return compose(compose(truth, inverse(believed)), (x, y, yaw))
+
     def seen_in_map(self, pose: Sequence[float], robot: Robot | None = None) -> list[float]:
         """A world pose (x, y, yaw, ...) worked out from what the robot perceives around it (an
         object, as a camera sees it relative to the robot), in the map frame of the robot's

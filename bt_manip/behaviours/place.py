@@ -175,7 +175,11 @@ class Place(JointMove):
         services = self.services()
         n = len(q_now)
         reasons = []
-        for frame in place_frames(self.target, object_in_grasp, hand):
+        # the target is in the map frame: the arm aims where the robot believes it is, so the
+        # localisation's error carries over (none without localisation)
+        x, y, yaw = self.map_to_world((self.target.x, self.target.y, self.target.yaw))
+        aim = Target(x, y, self.target.z, yaw)
+        for frame in place_frames(aim, object_in_grasp, hand):
             goal = lifted(frame, gap)
             pre = lifted(goal, approach)
             self.overlay.show_frame("ik_target", goal)

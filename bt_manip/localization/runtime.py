@@ -291,11 +291,6 @@ class Localizer:
         self.filter.global_localization()
         self._last_update = None
 
-    def to_map(self, target: Pose) -> Pose:
-        """Where a map-frame ``target`` lies in the world for this robot's belief:
-        ``true_base * inverse(believed_base) * target`` (the localisation error carried)."""
-        return compose(compose(self.robot.base_pose2d(), inverse(self.pose())), target)
-
 
 class RunLocalization:
     """The localisers of a run, one per robot with a laser, stepped before every tick
