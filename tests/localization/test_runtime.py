@@ -15,6 +15,7 @@ from bt_manip.bench.episodes import EpisodeResult
 from bt_manip.bench.files import write_outputs
 from bt_manip.bench.log import spec_from_json, spec_to_json
 from bt_manip.bench.stats import LOCALIZATION_FIELDS, summarise
+from bt_manip.bench.sweep import sweep_points
 from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec, load_tree_with_nodes
 from bt_manip.errors import InputError
@@ -159,6 +160,9 @@ def test_localisation_faults_parse_and_print() -> None:
     assert parse_fault("odom_noise:0.05:0.1").values == (0.05, 0.1)
     assert parse_fault("lidar_noise:0.02").text() == "lidar_noise:0.02"
     assert parse_fault("kidnap:8").values == (8.0,)
+    swept = sweep_points(_spec(localize=True), "kidnap:{4,8}")
+    assert [[f.text() for f in p.spec.inject] for p in swept] == [["kidnap:4"], ["kidnap:8"]]
+    assert all(p.spec.localize for p in swept)
     for bad, why in [("lidar_dropout:1.5", "not within 0..1"), ("kidnap", "takes the sim time"),
                      ("odom_noise:x", "is not a number"), ("kidnap:nan", "not within")]:
         with pytest.raises(InputError, match=why):
