@@ -61,7 +61,7 @@ CHECKS_PER_TICK = 4000
 """Collision checks a planning node spends per tick at most (plus one search round)."""
 PLANNER = Port(
     str, False, "auto: plan round obstacles when the direct joint move would collide (and pick "
-    "a collision-free IK solution); rrtconnect: always plan; none: move directly", "none",
+    "a collision-free IK solution); rrtconnect: always plan; none: move directly", "auto",
     Accepts(choices=PLANNERS),
 )
 PADDING_PORT = Port(

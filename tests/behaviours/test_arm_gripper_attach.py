@@ -79,7 +79,9 @@ def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
     with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
         # facing the west wall of the workshop, 25 cm from it, arm unfolding towards it
         place_robot(world, "husky", -2.25, -2.0, np.pi)
-        report, _ = run_xml(world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3"/>')
+        # without a planner the arm moves and stops on the contact
+        report, _ = run_xml(
+            world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3" planner="none"/>')
         assert report.status == "FAILURE"
         why = reasons(report)["MoveJoints"]
         assert "touched 'wall_x_m3'" in why
@@ -87,6 +89,19 @@ def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
         q = world.robots["husky"].arm_positions()
         world.step(240)
         assert np.allclose(world.robots["husky"].arm_positions(), q, atol=0.02)
+
+
+def test_the_planner_refuses_a_goal_inside_a_wall_before_the_arm_moves() -> None:
+    from bhelpers import ROOT
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        place_robot(world, "husky", -2.25, -2.0, np.pi)
+        q0 = world.robots["husky"].arm_positions()
+        report, _ = run_xml(world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3"/>')
+        assert report.status == "FAILURE"
+        why = reasons(report)["MoveJoints"]
+        assert "the goal is in collision" in why and "wall_x_m3" in why
+        assert np.allclose(world.robots["husky"].arm_positions(), q0, atol=0.02)
 
 
 def test_close_on_nothing_reports_not_holding(table: World) -> None:

@@ -32,9 +32,14 @@ def test_husky_tuck_folds_the_arm_onto_itself_and_the_descriptor_allows_it() -> 
     listed = desc.planning.allowed
     assert listed is not None and touching <= listed["default"]
     assert not _tuck_scene(desc, allowed_pairs(desc)).collides(tuck)
-    # found again from the URDF and the states, the same pairs as shipped
+
+
+@pytest.mark.parametrize("robot", ["husky_ur3", "sawyer", "panda", "omni_sawyer", "tiago"])
+def test_every_shipped_descriptor_lists_what_robot_init_finds(robot: str) -> None:
+    desc = RobotDescription.load(robot)
     found = find_allowed_collisions(desc)
-    assert found.default == listed["default"] and found.never == listed["never"]
+    assert desc.planning.allowed == {"default": found.default, "never": found.never,
+                                     "user": frozenset()}
 
 
 def test_never_pairs_stay_apart_in_other_configurations() -> None:
