@@ -123,6 +123,9 @@ class Episode:
         if self.spec.inject:
             report.extra["inject"] = [f.text() for f in self.spec.inject]
             report.extra["injected"] = self.faults.report()
+        planning = self.context.arm_planning()
+        if planning:  # wall time: in the report, never on the blackboard
+            report.extra["arm_planning"] = planning
         rows = self._as_built()
         if rows is not None:
             report.as_built = rows

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import operator
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -28,6 +29,7 @@ from bt_manip.manipulation import cartesian
 from bt_manip.manipulation.arm_planner import PLANNERS, ArmPlanner
 from bt_manip.manipulation.base_search import object_grasp
 from bt_manip.manipulation.rrt_connect import PlanError, path_length
+from bt_manip.manipulation.trajectory import Trajectory, time_parameterise
 from bt_manip.sim.randomize import entity_rng
 
 if TYPE_CHECKING:
@@ -57,6 +59,14 @@ PLANNED_VIA = 0.01
 """rad: how close each joint passes a planned waypoint."""
 IK_GOAL_TRIES = 12
 """Other IK seeds tried when the first solution for a pose is in collision."""
+ARM_PATH_COLOUR = (0.95, 0.45, 0.1, 1.0)
+"""The colour the viewer and the replay draw a planned arm path in."""
+DEFAULT_LOOKAHEAD = 0.05
+"""s: how far ahead of now a trajectory's position is given before the second tick (one tick at
+the default 20 Hz); from then on, the time since the previous tick."""
+MIN_LOOKAHEAD = 0.01
+TRACK_MARGIN = 1.25
+"""A joint following a trajectory may move this many times the trajectory's speed, to catch up."""
 CHECKS_PER_TICK = 4000
 """Collision checks a planning node spends per tick at most (plus one search round)."""
 PLANNER = Port(
@@ -91,6 +101,9 @@ class Stage:
     planned: bool = False
     """A waypoint of a planned path: passed within :data:`PLANNED_VIA` rad, so the arm keeps
     to the checked path."""
+    trajectory: Trajectory | None = None
+    """A planned path to this stage's command, timed within the joints' limits: the arm is
+    given the trajectory's position a tick ahead, tick after tick, then the command."""
 
 
 def to_radians(values: list[float], units: str) -> np.ndarray:
@@ -217,7 +230,10 @@ class JointMove(RobotAction):
         """One tick of planning; True when the plan is ready (its stages spliced in)."""
         assert self._planning is not None
         index, steps = self._planning
+        planner = self._planner()
+        assert planner is not None
         spent = 0
+        began = time.perf_counter()
         try:
             while spent < CHECKS_PER_TICK:
                 spent = next(steps)
@@ -227,13 +243,25 @@ class JointMove(RobotAction):
             raise ActionFailed(f"planning the arm's move: {exc}") from None
         else:
             return False
-        vias = [Stage(np.asarray(q, dtype=float), list(range(len(q))), via=True, planned=True)
-                for q in result.path[1:-1]]
-        self.stages[index:index] = vias
+        finally:
+            planner.wall_time += time.perf_counter() - began
+        planner.samples += int(result.samples)
+        self._draw(planner, result.path)
+        arm = self.robot().description.arm
+        stage = self.stages[index]
+        stage.trajectory = time_parameterise(
+            result.path, [v * self.speed for v in arm.velocity_limits],
+            [a * self.speed for a in arm.acceleration_limits])
+        stage.joints = list(range(len(stage.command)))
         self.set_output("path_length", path_length(result.path))
         self.set_output("plan_samples", int(result.samples))
         self._planning = None
         return True
+
+    def _draw(self, planner: ArmPlanner, path: list[np.ndarray]) -> None:
+        """Draw the grasp frame's way along the planned ``path`` (drawn when a viewer or a
+        recording is on)."""
+        self.overlay.show_path("arm_plan", planner.tool_path(path), rgba=ARM_PATH_COLOUR)
 
     def start(self) -> None:
         robot = self.robot()
@@ -267,6 +295,8 @@ class JointMove(RobotAction):
         self.command = q_now.copy()
         self._command = q_now.tolist()
         self.stage = -1
+        self._follow: tuple[Trajectory, float] | None = None
+        self._last_tick = -1.0
         # each joint's allowed speed, and the least it may correct at, fixed for the move
         vmax = np.asarray(arm.velocity_limits, dtype=float) * self.speed
         self._vmax: list[float] = vmax.tolist()
@@ -285,14 +315,45 @@ class JointMove(RobotAction):
         if self.stage >= len(self.stages):
             return
         stage = self.stages[self.stage]
-        target, joints = stage.command, stage.joints
+        target = stage.command
         self.command = target.copy()
         self._command = target.tolist()
+        if stage.trajectory is not None and stage.trajectory.duration > 0.0:
+            self._follow = (stage.trajectory, self.now())
+            self._track(robot)
+            return
+        self._settle_on(robot, q)
+
+    def _settle_on(self, robot: Robot, q: list[float]) -> None:
+        """Send the stage's command from the joint positions ``q`` (rad)."""
+        joints = self.stages[self.stage].joints
         # joints moved together arrive together: scale each speed to the slowest travel time
         command, vmax = self._command, self._vmax
         travel = [abs(command[j] - q[j]) for j in joints]
         t = _largest([d / vmax[j] for d, j in zip(travel, joints, strict=True)]) if joints else 0.0
         self._send(robot, joints, travel, t)
+
+    def _track(self, robot: Robot) -> bool:
+        """Follow the stage's trajectory: give the arm its position a tick ahead, at no more
+        than the speed it has there (plus the correction margin). False once it has run out
+        (the stage's command is then sent, and the stage's time-out starts)."""
+        assert self._follow is not None
+        trajectory, t0 = self._follow
+        now = self.now()
+        ahead = max(now - self._last_tick, MIN_LOOKAHEAD) if self._last_tick >= 0 else (
+            DEFAULT_LOOKAHEAD)
+        self._last_tick = now
+        t = now - t0
+        if t >= trajectory.duration:
+            self._follow = None
+            self.stage_started = now
+            self._settle_on(robot, robot.arm_motion()[0])
+            return False
+        target = trajectory.position(t + ahead)
+        speed = np.maximum(np.abs(trajectory.velocity(t)), np.abs(trajectory.velocity(t + ahead)))
+        caps = np.maximum(speed * TRACK_MARGIN, self._floor)
+        robot.set_arm_targets(target, max_velocity=caps.tolist())
+        return True
 
     def _send(self, robot: Robot, joints: list[int], travel: list[float], t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
@@ -324,6 +385,8 @@ class JointMove(RobotAction):
                 raise ActionFailed(self._where() + ": " + "; ".join(hits))
         if self.stage >= len(self.stages):
             return Status.SUCCESS
+        if self._follow is not None and self._track(robot):
+            return Status.RUNNING
         # every joint, not only the moving ones, must be where it was told to be: a load can
         # push a holding joint away, and the move is not done until it is back
         q, qd = robot.arm_motion()
