@@ -133,6 +133,8 @@ class JointMove(RobotAction):
 
     PLANS = False
     """Whether the node has a ``planner`` port (its plannable stages may be planned)."""
+    SWEEPS = False
+    """Whether each stage's sweep is checked in the planning scene before the arm moves."""
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         """The stages of the move."""
@@ -322,7 +324,40 @@ class JointMove(RobotAction):
             self._follow = (stage.trajectory, self.now())
             self._track(robot)
             return
+        if self.SWEEPS and self.check:
+            self._check_sweep(np.asarray(q, dtype=float), stage)
         self._settle_on(robot, q)
+
+    def _check_sweep(self, q: np.ndarray, stage: Stage) -> None:
+        """ActionFailed naming what the arm (or what it carries) would touch of the walls,
+        furniture and floor on its way from ``q`` to the stage's command, checked in the
+        planning scene before it moves (what it touches at ``q`` already may stay)."""
+        services = self.services()
+        if services.arm_planner is None:
+            robot = self.robot()
+            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
+        planner: ArmPlanner = services.arm_planner
+        scene = planner.scene()
+        planner.sync(scene, "", (q,), movables=False)
+        step = planner.options.validate_step
+        n = max(1, math.ceil(float(np.max(np.abs(stage.command - q))) / step))
+        hits: list[tuple[str, str]] = []
+        for k in range(1, n + 1):
+            here = q + (stage.command - q) * (k / n)
+            if scene.collides(here):
+                # the arm against itself is not checked while it moves, nor here: only the
+                # walls, furniture and floor
+                hits = [p for p in scene.contacts(here)
+                        if p[0] in scene.obstacles or p[1] in scene.obstacles]
+                if hits:
+                    break
+        if not hits:
+            return
+        pairs = ", ".join(f"{a} touches {b}" for a, b in hits[:4])
+        joints = self.robot().description.arm.joints
+        moving = ", ".join(f"{j} ({joints[j]})" for j in stage.joints)
+        self.robot().hold_arm()
+        raise ActionFailed(f"joint {moving} would collide on its way: {pairs}")
 
     def _settle_on(self, robot: Robot, q: list[float]) -> None:
         """Send the stage's command from the joint positions ``q`` (rad)."""
@@ -426,9 +461,14 @@ class MoveJointsSequentially(JointMove):
     - SUCCESS when every joint named in ``order`` has reached its target within ``tolerance``;
     - FAILURE when a target is outside its joint limits, a joint does not arrive within
       ``joint_timeout`` s, or the arm (or what it carries) comes into contact with a wall,
-      furniture or the floor (contacts it already had when it started do not count).
+      furniture or the floor (contacts it already had when it started do not count); with
+      ``check_collisions``, each joint's sweep is checked in the arm's planning scene before
+      the joint moves, and one that would meet a wall, furniture or the floor ends the node
+      with FAILURE naming what would touch, the arm unmoved.
     Halted: the arm holds where it is.
     """
+
+    SWEEPS = True
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
