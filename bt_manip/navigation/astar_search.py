@@ -26,6 +26,10 @@ it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cel
 improved, one byte per cell. Each search records, per row, the columns of ``g`` it wrote, and
 a search asked to clean up sets them back to zero before it returns, so the next search can
 reuse the same memory without touching the rest of the grid.
+
+The bucket search's loop (:func:`_bucket_rounds`, :func:`_relax`) is compiled without numba's
+runtime: it allocates nothing and counts no references, and its eight moves are written out
+one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool.
 """
 
 from __future__ import annotations
