@@ -48,6 +48,10 @@ PASSAGE_HEIGHT = 1.5
 """An opening from the floor at least this high (m) is a passage for the robot."""
 FLOOR_TOLERANCE = 0.05
 """An opening or wall within this height (m) of the floor starts at the floor."""
+RAISED_FLOOR = 0.6
+"""When every door of the storey starts higher than the storey's elevation, by at most this
+much (m), the doors stand on a finished floor laid on the structure the walls start from: they
+are passages from there."""
 MAX_WALLS = 5000
 MAX_OPENINGS = 10000
 MAX_SPACES = 2000
@@ -176,7 +180,15 @@ class Building:
             f"'{self.storey.Name or self.storey.id()}'"
         )
         if self.skipped:
-            text += "; skipped: " + "; ".join(f"{e} ({why})" for e, why in self.skipped)
+            groups: dict[str, list[str]] = {}
+            for label, why in self.skipped:
+                groups.setdefault(re.sub(r" \(from [^)]*\)|, the band ends at [0-9.]+ m", "",
+                                         why), []).append(label)
+            parts = []
+            for why, labels in groups.items():
+                named = ", ".join(labels) if len(labels) <= 3 else f"{len(labels)} elements"
+                parts.append(f"{named} ({why})")
+            text += "; skipped: " + "; ".join(parts)
         return text
 
 
@@ -245,6 +257,7 @@ def read_building(
             out.walls.append(w)
             xs += [w.start[0], w.end[0]]
             ys += [w.start[1], w.end[1]]
+    _doors_on_a_raised_floor(out)
     for cls, key in (("IfcDoor", "doors"), ("IfcWindow", "windows")):
         counts[key] = sum(1 for el in _by_type(model, cls) if on_storey(el))
     done: set[int] = set(exclude)
@@ -328,6 +341,25 @@ def read_building(
     return out
 
 
+def _doors_on_a_raised_floor(building: Building) -> None:
+    """Doors all starting a little above the walls' foot are passages (see RAISED_FLOOR)."""
+    doors = [o for w in building.walls for o in w.openings if o.kind == "door"]
+    if not doors or any(o.passage for o in doors):
+        return
+    floor = min(o.bottom - w.bottom for w in building.walls for o in w.openings
+                if o.kind == "door")
+    if not FLOOR_TOLERANCE < floor <= RAISED_FLOOR:
+        return
+    for w in building.walls:
+        for o in w.openings:
+            if o.bottom - w.bottom <= floor + FLOOR_TOLERANCE and o.top - w.bottom >= min(
+                floor + PASSAGE_HEIGHT, w.top - w.bottom - FLOOR_TOLERANCE
+            ):
+                o.passage = True
+    building.notes.append(f"the doors start {floor:.2f} m above the foot of the walls, on a "
+                          "finished floor: they are passages from there")
+
+
 def _shift(box: Box, floor_z: float) -> Box:
     x, y, z = box.centre
     return Box((x, y, z - floor_z), box.size, box.yaw)
@@ -352,8 +384,8 @@ def _footprint(pts: Any, element: Any, building: Building, names: Names,
         building.skip(element, "at or below the floor")
         return None
     if bottom >= building.band_top:
-        building.skip(element, f"above the robot's height band (from {bottom:.2f} m, the band "
-                               f"ends at {building.band_top:.2f} m)")
+        building.skip(element, f"above the robot's height band, which ends at "
+                               f"{building.band_top:.2f} m (from {bottom:.2f} m)")
         return None
     bottom = max(bottom, 0.0)
     parts = hull_boxes(pts, bottom + building.floor_z, top + building.floor_z,
@@ -384,8 +416,8 @@ def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Buil
         building.skip(wall, "below the floor")
         return []
     if box.bottom >= building.band_top:
-        building.skip(wall, f"above the robot's height band (from {box.bottom:.2f} m, the band "
-                            f"ends at {building.band_top:.2f} m)")
+        building.skip(wall, f"above the robot's height band, which ends at "
+                            f"{building.band_top:.2f} m (from {box.bottom:.2f} m)")
         return []
     box_like = is_box_like(solid, box)
     if box.bottom > FLOOR_TOLERANCE:

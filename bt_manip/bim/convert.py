@@ -46,7 +46,6 @@ from bt_manip.bim.schedule import (
 )
 from bt_manip.bim.shapes import ShapeReader, UnsupportedGeometry, footprint_box, is_box_like
 from bt_manip.bim.shapes import placement_yaw as _placement_yaw
-from bt_manip.bim.storeys import StoreyChoice, choose_storey, storey_elevation, storey_of
 from bt_manip.bim.stock import (
     Slot,
     StockPose,
@@ -59,6 +58,7 @@ from bt_manip.bim.stock import (
     stock_group,
     stock_poses,
 )
+from bt_manip.bim.storeys import StoreyChoice, choose_storey, storey_elevation, storey_of
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_folder, make_folder
@@ -367,7 +367,7 @@ def robot_checks(source: IfcSource, elements: list[InstallElement], options: Bim
             out.append((entity, f"{e.mass:.2f} kg ({e.mass_source}), heavier than the "
                                 f"{payload:g} kg the robot can carry ({where}): not to be "
                                 "installed by it"))
-        length, thickness, height = e.size
+        thickness, height = e.size[1], e.size[2]
         place_top = e.target["z"] + height / 2
         for label, top in (("where it is placed", place_top), ("in its stand", height)):
             if not fit.top_edge_reached(top, height):
@@ -375,9 +375,10 @@ def robot_checks(source: IfcSource, elements: list[InstallElement], options: Bim
                                     f"out of the {options.robot}'s reach for a grasp from above "
                                     f"(top edges at {fit.reach_text()})"))
         if not fit.grips(thickness):
+            opening = fit.max_opening * 100
             out.append((entity, f"{thickness * 100:.1f} cm thick, too thick for the "
-                                f"{options.robot}'s gripper, which opens {fit.max_opening * 100:.1f}"
-                                " cm (1 cm of it kept free)"))
+                                f"{options.robot}'s gripper, which opens {opening:.1f} cm (1 cm "
+                                "of it kept free)"))
     return out
 
 

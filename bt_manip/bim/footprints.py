@@ -14,6 +14,7 @@ height) that no triangle covers are its openings.
 
 from __future__ import annotations
 
+import itertools
 import math
 from typing import Any
 
@@ -54,7 +55,7 @@ def hull_boxes(points: np.ndarray, bottom: float, top: float,
     n = min(MAX_STRIPS, max(2, math.ceil(box.size[0] / STRIP)))
     edges = np.linspace(-box.size[0] / 2, box.size[0] / 2, n + 1)
     out: list[Box] = []
-    for u0, u1 in zip(edges[:-1], edges[1:], strict=True):
+    for u0, u1 in itertools.pairwise(edges):
         part = hull.intersection(rect(u0, -box.size[1], u1, box.size[1]))
         if part.is_empty:
             continue

@@ -155,8 +155,8 @@ def _grasp_heights(robot: RobotDescription) -> tuple[tuple[float, float], ...]:
             if not reached[i] and solves(x, float(z)) and solves(x, float(z) + APPROACH):
                 reached[i] = True
     out: list[tuple[float, float]] = []
-    for i in np.flatnonzero(reached):
-        z = round(float(heights[i]), 3)
+    for index in np.flatnonzero(reached):
+        z = round(float(heights[index]), 3)
         if out and math.isclose(out[-1][1] + HEIGHT_STEP, z, abs_tol=1e-6):
             out[-1] = (out[-1][0], z)
         else:
@@ -182,7 +182,7 @@ def _tucked_top(robot: RobotDescription) -> float:
                 if name in joints:
                     p.resetJointState(body, joints[name], value, physicsClientId=client)
         links = range(-1, p.getNumJoints(body, physicsClientId=client))
-        return round(max(p.getAABB(body, link, physicsClientId=client)[1][2] for link in links),
-                     3)
+        top = max(float(p.getAABB(body, link, physicsClientId=client)[1][2]) for link in links)
+        return round(top, 3)
     finally:
         p.disconnect(client)

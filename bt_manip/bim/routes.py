@@ -45,11 +45,12 @@ def floor_grid(building: Building) -> FloorGrid:
                 cx, cy = wall.point_at((o.start + o.end) / 2)
                 grid.mark_door(Rect(cx, cy, o.width, wall.thickness + 0.1, yaw), door_index)
                 door_index += 1
-    top = building.band_top or PASSAGE_HEIGHT
+    band_top = building.band_top or PASSAGE_HEIGHT
     for f in building.raised + building.curtain_walls + building.obstacles + building.furniture:
-        for b in f.boxes:
-            if b.bottom < top:
-                grid.block(Rect(b.centre[0], b.centre[1], b.size[0], b.size[1], b.yaw))
+        for box in f.boxes:
+            if box.bottom < band_top:
+                grid.block(Rect(box.centre[0], box.centre[1], box.size[0], box.size[1],
+                                box.yaw))
     return grid
 
 

@@ -11,9 +11,10 @@ roof) is read as its uncut first operand: the cut only lowers its top.
 directly from extrusions, clipped bodies, mapped items (each mapped representation read once and
 kept for the next element that maps it), faceted breps and face sets, and from the kernel only
 for anything else (curved sweeps, revolved solids). :meth:`ShapeReader.mesh` gives the kernel's
-triangles, for a wall whose holes matter. :func:`footprint_box` fits the upright box of least footprint around the points: its
-centre, size (length along its yaw, width, height) and yaw; a body whose volume is much less
-than that box's is not box-like (a curved or L-shaped wall, a tilted element).
+triangles, for a wall whose holes matter. :func:`footprint_box` fits the upright box of least
+footprint around the points: its centre, size (length along its yaw, width, height) and yaw; a
+body whose volume is much less than that box's is not box-like (a curved or L-shaped wall, a
+tilted element).
 """
 
 from __future__ import annotations
@@ -160,8 +161,8 @@ class ShapeReader:
             parts = [self._item_points(item) for item in rep.Items]
             if parts and all(p is not None and len(p) for p in parts):
                 local = np.vstack([p for p in parts if p is not None])
-                pts = local @ world[:3, :3].T + world[:3, 3]
-                return pts * self.scale
+                pts: np.ndarray = (local @ world[:3, :3].T + world[:3, 3]) * self.scale
+                return pts
         return self.mesh(element)[0]
 
     def _source_points(self, representation: Any) -> np.ndarray | None:
@@ -203,18 +204,20 @@ class ShapeReader:
             if norm < 1e-12 or len(direction) != 3:
                 return None
             base = np.column_stack([profile, np.zeros(len(profile))])
-            pts = np.vstack([base, base + direction / norm * float(item.Depth)])
-            return pts @ local[:3, :3].T + local[:3, 3]
+            prism = np.vstack([base, base + direction / norm * float(item.Depth)])
+            out: np.ndarray = prism @ local[:3, :3].T + local[:3, 3]
+            return out
         if item.is_a("IfcMappedItem"):
             source = item.MappingSource
             key = int(source.id())
             if key not in self._mapped:
                 self._mapped[key] = self._source_points(source.MappedRepresentation)
-            pts = self._mapped[key]
-            if pts is None:
+            mapped = self._mapped[key]
+            if mapped is None:
                 return None
             m = np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
-            return pts @ m[:3, :3].T + m[:3, 3]
+            moved: np.ndarray = mapped @ m[:3, :3].T + m[:3, 3]
+            return moved
         if item.is_a("IfcTessellatedFaceSet"):
             return np.asarray(item.Coordinates.CoordList, dtype=float)
         if item.is_a() in _POINT_SETS and self.model is not None:
@@ -373,7 +376,8 @@ def hull_xy(xy: np.ndarray) -> np.ndarray:
     if len(pts) < 3:
         return pts
     try:
-        return pts[ConvexHull(pts).vertices]
+        corners: np.ndarray = pts[ConvexHull(pts).vertices]
+        return corners
     except QhullError:
         return pts
 
