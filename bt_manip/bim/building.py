@@ -29,6 +29,8 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from bt_manip.bim.footprints import hull_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
@@ -36,6 +38,7 @@ from bt_manip.bim.shapes import (
     ShapeReader,
     UnsupportedGeometry,
     footprint_box,
+    hull_xy,
     is_box_like,
     placement_yaw,
 )
@@ -388,12 +391,14 @@ def _footprint(pts: Any, element: Any, building: Building, names: Names,
                                f"{building.band_top:.2f} m (from {bottom:.2f} m)")
         return None
     bottom = max(bottom, 0.0)
-    parts = hull_boxes(pts, bottom + building.floor_z, top + building.floor_z,
-                       placement_yaw(element))
-    parts = [_shift(b, building.floor_z) for b in parts]
+    yaw = placement_yaw(element)
+    corners = hull_xy(pts[:, :2])
+    flat = np.column_stack([corners, np.zeros(len(corners))])
+    parts = [_shift(b, building.floor_z) for b in
+             hull_boxes(flat, bottom + building.floor_z, top + building.floor_z, yaw)]
     fallback = {"furniture": "furniture", "curtain wall": "curtain", "raised wall": "wall"}
     name = names.make(element.Name, f"{fallback.get(kind, 'obstacle')}_{element.id()}")
-    box = _shift(footprint_box(pts, placement_yaw(element)), building.floor_z)
+    box = footprint_box(flat, yaw)
     box = Box((box.centre[0], box.centre[1], (bottom + top) / 2), (box.size[0], box.size[1],
               top - bottom), box.yaw)
     return Furniture(element, name, box, parts if len(parts) > 1 else [], kind)

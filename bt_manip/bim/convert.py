@@ -184,13 +184,6 @@ def convert(options: BimOptions) -> Conversion:
     descriptor = find_descriptor(options.robot)
     if descriptor is None:
         raise InputError.single("--robot", None, f"unknown robot '{options.robot}'")
-    robot = RobotDescription.load(descriptor)
-    fp = robot.footprint
-    robot_width = 2 * fp.radius if fp.is_circle else fp.width
-    robot_radius = fp.circumradius
-
-    fit = robot_fit(robot)
-
     source = open_ifc(options.ifc)
     if options.schedule is not None:
         planned = schedule_from_csv(source, options.schedule)
@@ -203,6 +196,12 @@ def convert(options: BimOptions) -> Conversion:
             str(source.path), None,
             f"{len(planned)} elements to install, more than the limit of {MAX_ELEMENTS}",
         )
+    robot = RobotDescription.load(descriptor)
+    fp = robot.footprint
+    robot_width = 2 * fp.radius if fp.is_circle else fp.width
+    robot_radius = fp.circumradius
+
+    fit = robot_fit(robot)
     choice = choose_storey(source, options.storey)
     storey = choice.storey
     floor_z = storey_elevation(source, storey)
@@ -261,10 +260,14 @@ def convert(options: BimOptions) -> Conversion:
     if elements:
         poses["stock"] = [r(v) for v in apron]
     poses.update(door_poses({c.door for cs in cross.values() for c in cs}, building))
-    half = robot_width / 2 + CLEARANCE
     for space in sorted(building.spaces, key=lambda s: s.entity.id()):
-        spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
-                                  within=_space_rect(space))
+        spot = None
+        # room to turn on the spot there (a Navigate goal), else room to stand
+        for half in (robot_radius + CLEARANCE, robot_width / 2 + CLEARANCE):
+            spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
+                                      within=_space_rect(space))
+            if spot is not None:
+                break
         if spot is not None:
             space.key = _pose_key(space.name, poses)
             poses[space.key] = [r(spot[0]), r(spot[1]), 0.0]

@@ -74,6 +74,25 @@ class ShapeReader:
         self.model = model
         self._settings: Any = None
         self._mapped: dict[int, np.ndarray | None] = {}
+        self._placements: dict[int, np.ndarray] = {}
+
+    def placement(self, placement: Any) -> np.ndarray:
+        """The 4x4 matrix (file units) of an object placement, each placement of a chain
+        computed once per reader (elements share their storey's and building's)."""
+        import ifcopenshell.util.placement as util
+
+        key = int(placement.id())
+        found = self._placements.get(key)
+        if found is None:
+            parent = getattr(placement, "PlacementRelTo", None)
+            if placement.is_a("IfcLocalPlacement") and parent is not None:
+                local = np.asarray(util.get_axis2placement(placement.RelativePlacement),
+                                   dtype=float)
+                found = self.placement(parent) @ local
+            else:
+                found = np.asarray(util.get_local_placement(placement), dtype=float)
+            self._placements[key] = found
+        return found
 
     def solid(self, element: Any) -> Solid:
         """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
@@ -92,7 +111,7 @@ class ShapeReader:
             return None
         if element.ObjectPlacement is None:
             return None
-        world = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+        world = self.placement(element.ObjectPlacement)
         all_points: list[np.ndarray] = []
         volume = 0.0
         for item in items:
@@ -151,13 +170,12 @@ class ShapeReader:
     def points(self, element: Any) -> np.ndarray:
         """The points (N x 3, metres, world) of the element's body, read directly where the
         items allow it, else from the kernel; UnsupportedGeometry when there is no body."""
-        import ifcopenshell.util.placement as placement
 
         rep = body_representation(element)
         if rep is None:
             raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
         if element.ObjectPlacement is not None:
-            world = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+            world = self.placement(element.ObjectPlacement)
             parts = [self._item_points(item) for item in rep.Items]
             if parts and all(p is not None and len(p) for p in parts):
                 local = np.vstack([p for p in parts if p is not None])
