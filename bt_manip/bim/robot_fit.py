@@ -26,7 +26,9 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.kinematics.arm_model import ArmModel
 from bt_manip.kinematics.compiled import cache_dir
+from bt_manip.kinematics.ik import IKOptions, IKSolver
 from bt_manip.manipulation.grasps import GRASP_DEPTH, OPENING_MARGIN
 from bt_manip.sim.robot_description import RobotDescription
 
@@ -128,9 +130,6 @@ def _survey(robot: RobotDescription) -> RobotFit:
 def _grasp_heights(robot: RobotDescription) -> tuple[tuple[float, float], ...]:
     """Heights reached (see the module docstring), as merged intervals."""
     import pinocchio as pin
-
-    from bt_manip.kinematics.arm_model import ArmModel
-    from bt_manip.kinematics.ik import IKOptions, IKSolver
 
     model = pin.buildModelFromUrdf(str(robot.urdf_path))
     root = next(f.name for f in model.frames if f.type == pin.FrameType.BODY)
