@@ -4,9 +4,17 @@
 coordinates and metres. Simple bodies (extrusions of a rectangle or a polygon, the form walls,
 slabs, plates and openings usually take) are read directly from their placement and profile;
 anything else (meshes, mapped items, booleans, sweeps) goes through ifcopenshell's geometry
-kernel. :func:`footprint_box` fits the upright box of least footprint around the points: its
-centre, size (length along its yaw, width, height) and yaw; a body whose volume is much less
-than that box's is not box-like (a curved or L-shaped wall, a tilted element).
+kernel. A body clipped by half-spaces (IfcBooleanClippingResult: a wall cut under a sloped
+roof) is read as its uncut first operand: the cut only lowers its top.
+
+:meth:`ShapeReader.points` gives an obstacle's points only (its footprint is their hull): read
+directly from extrusions, clipped bodies, mapped items (each mapped representation read once and
+kept for the next element that maps it), faceted breps and face sets, and from the kernel only
+for anything else (curved sweeps, revolved solids). :meth:`ShapeReader.mesh` gives the kernel's
+triangles, for a wall whose holes matter. :func:`footprint_box` fits the upright box of least
+footprint around the points: its centre, size (length along its yaw, width, height) and yaw; a
+body whose volume is much less than that box's is not box-like (a curved or L-shaped wall, a
+tilted element).
 """
 
 from __future__ import annotations
@@ -61,9 +69,30 @@ class Box:
 class ShapeReader:
     """Reads element bodies of one IFC file; ``scale`` converts file lengths to metres."""
 
-    def __init__(self, scale: float) -> None:
+    def __init__(self, scale: float, model: Any = None) -> None:
         self.scale = scale
+        self.model = model
         self._settings: Any = None
+        self._mapped: dict[int, np.ndarray | None] = {}
+        self._placements: dict[int, np.ndarray] = {}
+
+    def placement(self, placement: Any) -> np.ndarray:
+        """The 4x4 matrix (file units) of an object placement, each placement of a chain
+        computed once per reader (elements share their storey's and building's)."""
+        import ifcopenshell.util.placement as util
+
+        key = int(placement.id())
+        found = self._placements.get(key)
+        if found is None:
+            parent = getattr(placement, "PlacementRelTo", None)
+            if placement.is_a("IfcLocalPlacement") and parent is not None:
+                local = np.asarray(util.get_axis2placement(placement.RelativePlacement),
+                                   dtype=float)
+                found = self.placement(parent) @ local
+            else:
+                found = np.asarray(util.get_local_placement(placement), dtype=float)
+            self._placements[key] = found
+        return found
 
     def solid(self, element: Any) -> Solid:
         """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
@@ -77,12 +106,12 @@ class ShapeReader:
     def _extrusions(self, element: Any, rep: Any) -> Solid | None:
         import ifcopenshell.util.placement as placement
 
-        items = list(rep.Items)
+        items = [_uncut(item) for item in rep.Items]
         if not items or any(not item.is_a("IfcExtrudedAreaSolid") for item in items):
             return None
         if element.ObjectPlacement is None:
             return None
-        world = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+        world = self.placement(element.ObjectPlacement)
         all_points: list[np.ndarray] = []
         volume = 0.0
         for item in items:
@@ -110,8 +139,18 @@ class ShapeReader:
 
     # -- anything else, through the geometry kernel -----------------------------------------
     def _kernel(self, element: Any) -> Solid:
+        verts, faces = self.mesh(element)
+        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+        volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6.0)
+        return Solid(verts, volume)
+
+    def mesh(self, element: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The kernel's triangles of the element's body: vertices (N x 3, metres, world) and
+        faces (M x 3 indices); openings are not subtracted."""
         import ifcopenshell.geom
 
+        if body_representation(element) is None:
+            raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
         if self._settings is None:
             settings = ifcopenshell.geom.settings()
             settings.set("use-world-coords", True)
@@ -125,14 +164,106 @@ class ShapeReader:
         faces = np.asarray(shape.geometry.faces, dtype=int).reshape(-1, 3)
         if len(verts) == 0 or len(faces) == 0:
             raise UnsupportedGeometry("its body geometry is empty")
-        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
-        volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6.0)
-        return Solid(verts, volume)
+        return verts, faces
+
+    # -- points only, for obstacles ------------------------------------------------------------
+    def points(self, element: Any) -> np.ndarray:
+        """The points (N x 3, metres, world) of the element's body, read directly where the
+        items allow it, else from the kernel; UnsupportedGeometry when there is no body."""
+
+        rep = body_representation(element)
+        if rep is None:
+            raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
+        if element.ObjectPlacement is not None:
+            world = self.placement(element.ObjectPlacement)
+            parts = [self._item_points(item) for item in rep.Items]
+            if parts and all(p is not None and len(p) for p in parts):
+                local = np.vstack([p for p in parts if p is not None])
+                pts: np.ndarray = (local @ world[:3, :3].T + world[:3, 3]) * self.scale
+                return pts
+        return self.mesh(element)[0]
+
+    def _source_points(self, representation: Any) -> np.ndarray | None:
+        """A mapped representation's points, read once per file: directly, else from the
+        kernel's mesh of the representation itself (not of each element mapping it); only
+        the corners of their footprint's hull are kept, at the lowest and highest z."""
+        parts = [self._item_points(i) for i in representation.Items]
+        if parts and all(p is not None and len(p) for p in parts):
+            pts = np.vstack([p for p in parts if p is not None])
+        else:
+            import ifcopenshell.geom
+
+            try:
+                shape: Any = ifcopenshell.geom.create_shape(ifcopenshell.geom.settings(),
+                                                            representation)
+            except Exception:  # the kernel raises RuntimeError and others
+                return None
+            verts = getattr(shape, "verts", None)
+            if verts is None:
+                verts = shape.geometry.verts
+            pts = np.asarray(verts, dtype=float).reshape(-1, 3) / self.scale
+            if len(pts) == 0:
+                return None
+        return hull_prism(pts)
+
+    def _item_points(self, item: Any) -> np.ndarray | None:
+        """Points of one representation item in its representation's frame (file units)."""
+        import ifcopenshell.util.placement as placement
+
+        item = _uncut(item)
+        if item.is_a("IfcExtrudedAreaSolid"):
+            profile = _profile_points(item.SweptArea)
+            if profile is None:
+                return None
+            local = (np.asarray(placement.get_axis2placement(item.Position), dtype=float)
+                     if item.Position is not None else np.eye(4))
+            direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
+            norm = float(np.linalg.norm(direction))
+            if norm < 1e-12 or len(direction) != 3:
+                return None
+            base = np.column_stack([profile, np.zeros(len(profile))])
+            prism = np.vstack([base, base + direction / norm * float(item.Depth)])
+            out: np.ndarray = prism @ local[:3, :3].T + local[:3, 3]
+            return out
+        if item.is_a("IfcMappedItem"):
+            source = item.MappingSource
+            key = int(source.id())
+            if key not in self._mapped:
+                self._mapped[key] = self._source_points(source.MappedRepresentation)
+            mapped = self._mapped[key]
+            if mapped is None:
+                return None
+            m = np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+            moved: np.ndarray = mapped @ m[:3, :3].T + m[:3, 3]
+            return moved
+        if item.is_a("IfcTessellatedFaceSet"):
+            return np.asarray(item.Coordinates.CoordList, dtype=float)
+        if item.is_a() in _POINT_SETS and self.model is not None:
+            coords = [p.Coordinates for p in self.model.traverse(item)
+                      if p.is_a("IfcCartesianPoint")]
+            if not coords or any(len(c) != 3 for c in coords):
+                return None
+            return np.asarray(coords, dtype=float)
+        return None
 
 
 NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Reference",
             "Clearance", "CoG", "Surface", "Lighting"}
 """Representation identifiers that are not an element's body."""
+
+
+_POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurfaceModel",
+               "IfcShellBasedSurfaceModel"}
+"""Items whose points are their polygon loops' points (no curved faces)."""
+
+
+def _uncut(item: Any) -> Any:
+    """The first operand under half-space clippings (the body before the cut)."""
+    for _ in range(64):
+        if not item.is_a("IfcBooleanClippingResult"):
+            return item
+        item = item.FirstOperand
+    return item
 
 
 def body_representation(element: Any) -> Any:
@@ -158,6 +289,11 @@ def _profile_points(profile: Any) -> np.ndarray | None:
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
         hx, hy = float(profile.XDim) / 2, float(profile.YDim) / 2
         pts = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    elif profile.is_a("IfcCircleProfileDef") and not profile.is_a("IfcCircleHollowProfileDef"):
+        # the 32-gon round the circle, its sides tangent to it (and four of them upright)
+        angles = (np.arange(32) + 0.5) * (2 * math.pi / 32)
+        radius = float(profile.Radius) / math.cos(math.pi / 32)
+        pts = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
     elif profile.is_a("IfcArbitraryClosedProfileDef") and not profile.is_a(
         "IfcArbitraryProfileDefWithVoids"
     ):
@@ -237,6 +373,31 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
         return [math.atan2(d[1], d[0])]
     edges = np.roll(hull, -1, axis=0) - hull
     return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+
+
+def hull_prism(points: np.ndarray) -> np.ndarray:
+    """The corners of the hull of the points' footprint, each at their lowest and highest z:
+    the points an upright obstacle's footprint and height depend on (as long as it is only
+    turned about z)."""
+    xy = hull_xy(points[:, :2])
+    z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
+    return np.vstack([np.column_stack([xy, np.full(len(xy), z0)]),
+                      np.column_stack([xy, np.full(len(xy), z1)])])
+
+
+def hull_xy(xy: np.ndarray) -> np.ndarray:
+    """The corners of the convex hull of 2D points (the points themselves when they are
+    fewer than three or collinear)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = np.unique(np.round(xy, 9), axis=0)
+    if len(pts) < 3:
+        return pts
+    try:
+        corners: np.ndarray = pts[ConvexHull(pts).vertices]
+        return corners
+    except QhullError:
+        return pts
 
 
 def placement_yaw(element: Any) -> float | None:
