@@ -135,6 +135,10 @@ class JointMove(RobotAction):
     """Whether the node has a ``planner`` port (its plannable stages may be planned)."""
     SWEEPS = False
     """Whether each stage's sweep is checked in the planning scene before the arm moves."""
+    LINE_CHECK = False
+    """Whether the node's straight moves are checked in the planning scene before it starts."""
+    LINE_NAME = "the straight move"
+    """How a failed line check names the move."""
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         """The stages of the move."""
@@ -306,6 +310,8 @@ class JointMove(RobotAction):
         # contacts the arm already has may stay (it can then move away from them); only new
         # ones end the move
         self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
+        if self.LINE_CHECK and self.check:
+            self._check_lines(q_now, stages)
         self._start_planning(robot, q_now)
         if self._planning is None:
             self._next_stage(robot, robot.arm_motion()[0])
@@ -332,6 +338,35 @@ class JointMove(RobotAction):
         """ActionFailed naming what the arm (or what it carries) would touch of the walls,
         furniture and floor on its way from ``q`` to the stage's command, checked in the
         planning scene before it moves (what it touches at ``q`` already may stay)."""
+        hits = self._world_hits(q, [stage.command])
+        if hits:
+            joints = self.robot().description.arm.joints
+            moving = ", ".join(f"{j} ({joints[j]})" for j in stage.joints)
+            self.robot().hold_arm()
+            raise ActionFailed(f"joint {moving} would collide on its way: {hits}")
+
+    def _check_lines(self, q_now: np.ndarray, stages: list[Stage]) -> None:
+        """ActionFailed naming what the arm (or what it carries) would touch of the walls,
+        furniture and floor along the straight moves of ``stages`` (the runs of stages that
+        are not planned: a planned stage's way is the planner's), before the arm moves."""
+        runs: list[list[np.ndarray]] = [[q_now]]
+        for st in stages:
+            if st.plannable:
+                runs.append([st.command])
+            else:
+                runs[-1].append(st.command)
+        for run in runs:
+            if len(run) > 1:
+                hits = self._world_hits(run[0], run[1:])
+                if hits:
+                    raise ActionFailed(f"{self.LINE_NAME} would collide: {hits}")
+
+    def _world_hits(self, q: np.ndarray, waypoints: list[np.ndarray]) -> str:
+        """What of the walls, furniture and floor the arm (or what it carries) would touch on
+        the straight joint moves from ``q`` through ``waypoints`` ("" for nothing), checked in
+        the planning scene at the planner's validation step. The arm against itself is not
+        checked (nor is it while it moves), nor are movable objects (it may push them); what it
+        touches at ``q`` already may stay."""
         services = self.services()
         if services.arm_planner is None:
             robot = self.robot()
@@ -340,24 +375,18 @@ class JointMove(RobotAction):
         scene = planner.scene()
         planner.sync(scene, "", (q,), movables=False)
         step = planner.options.validate_step
-        n = max(1, math.ceil(float(np.max(np.abs(stage.command - q))) / step))
-        hits: list[tuple[str, str]] = []
-        for k in range(1, n + 1):
-            here = q + (stage.command - q) * (k / n)
-            if scene.collides(here):
-                # the arm against itself is not checked while it moves, nor here: only the
-                # walls, furniture and floor
-                hits = [p for p in scene.contacts(here)
-                        if p[0] in scene.obstacles or p[1] in scene.obstacles]
-                if hits:
-                    break
-        if not hits:
-            return
-        pairs = ", ".join(f"{a} touches {b}" for a, b in hits[:4])
-        joints = self.robot().description.arm.joints
-        moving = ", ".join(f"{j} ({joints[j]})" for j in stage.joints)
-        self.robot().hold_arm()
-        raise ActionFailed(f"joint {moving} would collide on its way: {pairs}")
+        here_from = q
+        for there in waypoints:
+            n = max(1, math.ceil(float(np.max(np.abs(there - here_from))) / step))
+            for k in range(1, n + 1):
+                here = here_from + (there - here_from) * (k / n)
+                if scene.collides(here):
+                    hits = [p for p in scene.contacts(here)
+                            if p[0] in scene.obstacles or p[1] in scene.obstacles]
+                    if hits:
+                        return ", ".join(f"{a} touches {b}" for a, b in hits[:4])
+            here_from = there
+        return ""
 
     def _settle_on(self, robot: Robot, q: list[float]) -> None:
         """Send the stage's command from the joint positions ``q`` (rad)."""
@@ -562,9 +591,13 @@ class Lift(JointMove):
 
     - RUNNING while moving; SUCCESS when the arm is at the last target within ``tolerance``;
     - FAILURE when a target is outside the limits or unreachable, on a time-out, or on a
-      collision.
+      collision; before the arm moves, when the lift would bring the arm or what it carries
+      against a wall, furniture or the floor (checked in the arm's planning scene), naming what.
     Halted: the arm holds where it is.
     """
+
+    LINE_CHECK = True
+    LINE_NAME = "the lift"
 
     REQUIRED_ONE_OF = (("deltas", "height"),)
     INPUT_PORTS: dict[str, PortInformation] = {
@@ -637,9 +670,13 @@ class MoveToPose(JointMove):
     - FAILURE when no configuration reaches the pose (the reason says why: beyond reach, joint
       limits, not converged), on a time-out, or on a collision with walls, furniture or floor;
       with a planner also when every IK solution (or its approach) is in collision, naming what
-      each touches, or when no path is found within the budget.
+      each touches, or when no path is found within the budget; before the arm moves, when a
+      straight part of the move (the retreat, a ``path="line"`` move, the approach) would bring
+      the arm or what it carries against a wall, furniture or the floor, naming what.
     Halted: the arm holds where it is.
     """
+
+    LINE_CHECK = True
 
     REQUIRED_ONE_OF = (("position", "object"),)
     INPUT_PORTS: dict[str, PortInformation] = {
