@@ -176,6 +176,9 @@ def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.Ge
 
 
 _EXACT_REQUEST = coal.CollisionRequest()
+PAIRWISE_CONFIRMS = 16
+"""Hull contacts a scene confirms pair by pair, reading only the meshes involved, before it
+reads every mesh of the robot and confirms through the broad phase."""
 _MESHES: Memo[coal.BVHModelOBBRSS] = Memo(64)
 """Collision meshes read in this process, by file, stamp and scale."""
 
@@ -266,6 +269,7 @@ class CollisionScene:
         self.exact = exact
         """Whether the scene checks the meshes only (no hull pass)."""
         self._meshes: pin.GeometryModel | None = None
+        self._confirms = 0
         # per robot shape, what the exact pass tests: the primitive as the URDF gives it, or
         # the mesh a hull stands for (read when first needed)
         self._exact_shape: list[coal.CollisionGeometry | None] = [
@@ -478,12 +482,22 @@ class CollisionScene:
             return False  # the hulls are free: so are the meshes inside them
         if self.exact:
             return True
+        if self._meshes is not None:
+            return bool(pin.computeCollisions(self.model, self._mesh_data, self._mesh_broad, q,
+                                              True))
+        self._confirms += 1
+        if self._confirms > PAIRWISE_CONFIRMS:
+            self.mesh_geometry  # noqa: B018 (read now: many confirms to come)
+            return self._hit(q)
         return self._confirmed(q)
 
     def _confirmed(self, q: np.ndarray) -> bool:
         """After the hulls touched at ``q``: whether the shapes themselves do. A mesh lies
         inside its hull, so only the pairs whose hulls touch can touch; each is tested again
-        with the robot's meshes (each read the first time it is needed) and primitives."""
+        with the robot's meshes (each read the first time it is needed) and primitives. (Once
+        a scene has confirmed :data:`PAIRWISE_CONFIRMS` contacts, it reads every mesh and
+        confirms on all of them through the broad phase, which is faster when contacts are
+        many, as in a planner's search.)"""
         gdata = self._gdata
         pin.computeCollisions(self.model, self.data, self.geometry, gdata, q, False)
         results = gdata.collisionResults
