@@ -254,8 +254,11 @@ class CollisionScene:
         q0 = pin.neutral(full)
         for name, value in (locked or {}).items():
             if name in names:
-                jid = full.getJointId(name)
-                q0[full.joints[jid].idx_q] = value
+                joint = full.joints[full.getJointId(name)]
+                if joint.nq == 2:  # a continuous joint: its angle as (cos, sin)
+                    q0[joint.idx_q:joint.idx_q + 2] = (math.cos(value), math.sin(value))
+                else:
+                    q0[joint.idx_q] = value
         lock = [full.getJointId(n) for n in names if n not in joints]
         self._reduce = (full, lock, q0)
         self.model, self.geometry = pin.buildReducedModel(full, geometry, lock, q0)

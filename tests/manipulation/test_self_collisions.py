@@ -92,3 +92,19 @@ def test_bad_planning_sections_name_file_and_line(
         load_description(path)
     text = str(err.value)
     assert f"{path}:{line}" in text and message in text
+
+
+def test_a_continuous_joint_is_locked_at_its_angle() -> None:
+    """The holonomic base's yaw is a continuous joint (cos, sin in Pinocchio): locked at 0.7
+    rad it turns the arm by 0.7 rad, and leaves the arm's own links where they were."""
+    import pinocchio as pin
+
+    desc = RobotDescription.load("omni_sawyer")
+    tuck = np.asarray(desc.state("tuck"))
+    turned = CollisionScene(desc.urdf_path, list(desc.arm.joints),
+                            locked={"base_yaw": 0.7}, allowed=allowed_pairs(desc))
+    assert not turned.collides(tuck)
+    data = turned.model.createData()
+    pin.framesForwardKinematics(turned.model, data, tuck)
+    base = data.oMf[turned.model.getFrameId("right_arm_base_link")].rotation
+    assert np.arctan2(base[1, 0], base[0, 0]) == pytest.approx(0.7, abs=1e-9)
