@@ -112,27 +112,26 @@ def _key(urdf: Path, package_dirs: tuple[str, ...]) -> bytes:
 
 
 def _loaded(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
-    """The URDF's model and its collision geometry with the meshes themselves (the geometry
-    kept in the cache folder: read back in a sixth of the time the meshes take to read and
-    index)."""
-    raw = _key(urdf, package_dirs)
-    key = bytes_key(raw)
+    """The URDF's model and its collision geometry with the meshes themselves."""
+    key = bytes_key(_key(urdf, package_dirs))
     known = _LOADED.get(key)
     if known is None:
         full = pin.buildModelFromUrdf(str(urdf))
-        path = cache_dir() / f"meshes-{hashlib.sha256(raw).hexdigest()[:24]}.bin"
-        geometry = _read(path)
-        if geometry is None:
-            dirs = [str(urdf.resolve().parent), *package_dirs]
-            try:
-                geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION,
-                                                 package_dirs=dirs)
-            except (ValueError, RuntimeError) as exc:
-                raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
-            _save(geometry, path)
+        dirs = [str(urdf.resolve().parent), *package_dirs]
+        try:
+            geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION, package_dirs=dirs)
+        except (ValueError, RuntimeError) as exc:
+            raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
         known = (full, geometry)
         _LOADED.put(key, known)
     return known[0], known[1].clone()
+
+
+def _age(path: Path) -> float:
+    try:
+        return path.stat().st_mtime
+    except OSError:
+        return 0.0
 
 
 def _read(path: Path) -> pin.GeometryModel | None:
@@ -206,9 +205,19 @@ def _mesh(path: str, scale: tuple[float, ...]) -> coal.BVHModelOBBRSS:
     return known
 
 
+CACHE_FILES_KEPT = 64
+"""Files of each kind (hulls, meshes) kept in the cache folder; the oldest go first."""
+
+
 def _save(geometry: pin.GeometryModel | coal.CollisionGeometry, path: Path) -> None:
-    """Write ``geometry`` to ``path`` so that other processes see the whole file or none."""
+    """Write ``geometry`` to ``path`` so that other processes see the whole file or none; the
+    oldest files of its kind beyond :data:`CACHE_FILES_KEPT` are removed."""
     path.parent.mkdir(parents=True, exist_ok=True)
+    kind = path.name.split("-", 1)[0]
+    others = sorted(path.parent.glob(f"{kind}-*.bin"), key=_age)
+    for old in others[: max(0, len(others) - CACHE_FILES_KEPT + 1)]:
+        with contextlib.suppress(OSError):
+            old.unlink()
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
