@@ -83,6 +83,8 @@ BAND_MARGIN = 0.1
 """Added (m) to the top of the robot's height band."""
 ROUTE_ROUNDS = 4
 """Stock placements tried, refusing the elements without a route each time, at most."""
+_DUMPER: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+"""libyaml's emitter when installed (the same text as PyYAML's, several times faster)."""
 
 
 @dataclass(frozen=True)
@@ -309,7 +311,8 @@ def convert(options: BimOptions) -> Conversion:
         "# furniture and spaces, the elements to install waiting in stands at the stock\n"
         "# (their order and target poses are in schedule.json), and the robot.\n"
     )
-    text = header + yaml.safe_dump(world, sort_keys=False, default_flow_style=None, width=100)
+    text = header + yaml.dump(world, Dumper=_DUMPER, sort_keys=False, default_flow_style=None,
+                              width=100)
     world_path.write_text(text)
     conversion = Conversion(
         source.path, source.schema, str(storey.Name or f"#{storey.id()}"), building, elements,

@@ -94,6 +94,12 @@ class ShapeReader:
             self._placements[key] = found
         return found
 
+    def yaw(self, element: Any) -> float | None:
+        """:func:`placement_yaw` of ``element`` from the placements computed once per reader."""
+        if getattr(element, "ObjectPlacement", None) is None:
+            return None
+        return _yaw_of(self.placement(element.ObjectPlacement))
+
     def solid(self, element: Any) -> Solid:
         """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
         rep = body_representation(element)
@@ -239,8 +245,10 @@ class ShapeReader:
         if item.is_a("IfcTessellatedFaceSet"):
             return np.asarray(item.Coordinates.CoordList, dtype=float)
         if item.is_a() in _POINT_SETS and self.model is not None:
-            coords = [p.Coordinates for p in self.model.traverse(item)
-                      if p.is_a("IfcCartesianPoint")]
+            coords = _loop_points(item)
+            if coords is None:  # not polygon loops only: every point the item refers to
+                coords = [p.Coordinates for p in self.model.traverse(item)
+                          if p.is_a("IfcCartesianPoint")]
             if not coords or any(len(c) != 3 for c in coords):
                 return None
             return np.asarray(coords, dtype=float)
@@ -255,6 +263,31 @@ NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Refere
 _POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurfaceModel",
                "IfcShellBasedSurfaceModel"}
 """Items whose points are their polygon loops' points (no curved faces)."""
+
+
+def _loop_points(item: Any) -> list[Any] | None:
+    """The coordinates of the polygon loops of a faceted brep or face-based surface model
+    (each point as often as loops use it); None when a face is bounded by anything else."""
+    if item.is_a("IfcFacetedBrep"):
+        shells = [item.Outer, *(getattr(item, "Voids", None) or ())]
+    elif item.is_a("IfcFaceBasedSurfaceModel"):
+        shells = list(item.FbsmFaces)
+    elif item.is_a("IfcShellBasedSurfaceModel"):
+        shells = list(item.SbsmBoundary)
+    else:
+        return None
+    coords: list[Any] = []
+    for shell in shells:
+        faces = getattr(shell, "CfsFaces", None)
+        if faces is None:
+            return None
+        for face in faces:
+            for bound in face.Bounds:
+                loop = bound.Bound
+                if not loop.is_a("IfcPolyLoop"):
+                    return None
+                coords.extend(p.Coordinates for p in loop.Polygon)
+    return coords
 
 
 def _uncut(item: Any) -> Any:
@@ -330,18 +363,22 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
     """
     xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
-    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
-    for angle in _candidate_angles(xy):
-        c, s = math.cos(angle), math.sin(angle)
-        u = xy @ np.array([c, s])
-        v = xy @ np.array([-s, c])
-        lo = np.array([u.min(), v.min()])
-        hi = np.array([u.max(), v.max()])
-        area = float(np.prod(hi - lo))
-        if best is None or area < best[0] - 1e-9:
-            best = (area, angle, lo, hi)
-    assert best is not None
-    _, angle, lo, hi = best
+    angles = _candidate_angles(xy)
+    # every candidate at once: the points' coordinates along (u) and across (v) each angle
+    c = np.array([math.cos(a) for a in angles])
+    s = np.array([math.sin(a) for a in angles])
+    x, y = xy[:, :1], xy[:, 1:2]
+    u = x * c + y * s
+    v = y * c - x * s
+    lows = np.stack([u.min(axis=0), v.min(axis=0)], axis=1)
+    highs = np.stack([u.max(axis=0), v.max(axis=0)], axis=1)
+    areas = (highs[:, 0] - lows[:, 0]) * (highs[:, 1] - lows[:, 1])
+    pick = 0
+    for k in range(1, len(angles)):  # the first of the least, as 1e-9 apart
+        if areas[k] < areas[pick] - 1e-9:
+            pick = k
+    angle, lo, hi = angles[pick], lows[pick], highs[pick]
+    best = (float(areas[pick]), angle)
     length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
     if width > length:
         angle += math.pi / 2
@@ -406,7 +443,12 @@ def placement_yaw(element: Any) -> float | None:
 
     if getattr(element, "ObjectPlacement", None) is None:
         return None
-    m = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+    return _yaw_of(np.asarray(placement.get_local_placement(element.ObjectPlacement),
+                              dtype=float))
+
+
+def _yaw_of(m: np.ndarray) -> float | None:
+    """Heading of a placement matrix's x axis, None when it is vertical."""
     x = m[:3, 0]
     if math.hypot(x[0], x[1]) < 1e-6:
         return None

@@ -38,11 +38,26 @@ class StoreyChoice:
                 f"storeys by elevation: {listed})")
 
 
-def storey_of(element: Any) -> Any:
-    """The IfcBuildingStorey containing ``element`` (through spaces and aggregates), or None."""
+def storey_of(element: Any, memo: dict[int, Any] | None = None) -> Any:
+    """The IfcBuildingStorey containing ``element`` (through spaces and aggregates), or None.
+
+    With ``memo`` (one dict per file), the storey found above each container is kept: the
+    elements of a storey share their containers, so the climb is made once per container."""
     import ifcopenshell.util.element as util
 
     current = util.get_container(element) or util.get_aggregate(element)
+    if memo is None or current is None:
+        return _climb(current)
+    key = int(current.id())
+    if key not in memo:
+        memo[key] = _climb(current)
+    return memo[key]
+
+
+def _climb(current: Any) -> Any:
+    """The first storey from ``current`` up its containers and aggregates (16 steps at most)."""
+    import ifcopenshell.util.element as util
+
     for _ in range(16):
         if current is None or current.is_a("IfcBuildingStorey"):
             return current
