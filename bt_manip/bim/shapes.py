@@ -75,6 +75,7 @@ class ShapeReader:
         self._settings: Any = None
         self._mapped: dict[int, np.ndarray | None] = {}
         self._placements: dict[int, np.ndarray] = {}
+        self._axes: dict[int, np.ndarray] = {}
 
     def placement(self, placement: Any) -> np.ndarray:
         """The 4x4 matrix (file units) of an object placement, each placement of a chain
@@ -86,12 +87,22 @@ class ShapeReader:
         if found is None:
             parent = getattr(placement, "PlacementRelTo", None)
             if placement.is_a("IfcLocalPlacement") and parent is not None:
-                local = np.asarray(util.get_axis2placement(placement.RelativePlacement),
-                                   dtype=float)
-                found = self.placement(parent) @ local
+                found = self.placement(parent) @ self.axis(placement.RelativePlacement)
             else:
                 found = np.asarray(util.get_local_placement(placement), dtype=float)
             self._placements[key] = found
+        return found
+
+    def axis(self, placement: Any) -> np.ndarray:
+        """The 4x4 matrix of an IfcAxis2Placement, computed once per reader (items and
+        mapping origins often share theirs)."""
+        import ifcopenshell.util.placement as util
+
+        key = int(placement.id())
+        found = self._axes.get(key)
+        if found is None:
+            found = np.asarray(util.get_axis2placement(placement), dtype=float)
+            self._axes[key] = found
         return found
 
     def yaw(self, element: Any) -> float | None:
@@ -110,7 +121,6 @@ class ShapeReader:
 
     # -- simple extrusions, read directly -------------------------------------------------
     def _extrusions(self, element: Any, rep: Any) -> Solid | None:
-        import ifcopenshell.util.placement as placement
 
         items = [_uncut(item) for item in rep.Items]
         if not items or any(not item.is_a("IfcExtrudedAreaSolid") for item in items):
@@ -121,14 +131,10 @@ class ShapeReader:
         all_points: list[np.ndarray] = []
         volume = 0.0
         for item in items:
-            profile = _profile_points(item.SweptArea)
+            profile = _profile_points(item.SweptArea, self.axis)
             if profile is None:
                 return None
-            local = (
-                np.asarray(placement.get_axis2placement(item.Position), dtype=float)
-                if item.Position is not None
-                else np.eye(4)
-            )
+            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
             direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
             norm = float(np.linalg.norm(direction))
             if norm < 1e-12 or len(direction) != 3:
@@ -212,17 +218,28 @@ class ShapeReader:
                 return None
         return hull_prism(pts)
 
+    def _mapping(self, item: Any) -> np.ndarray:
+        """The transformation of a mapped item (as ifcopenshell.util.placement's
+        get_mappeditem_transformation, its mapping origin's matrix kept per reader)."""
+        import ifcopenshell.util.placement as placement
+
+        origin = self.axis(item.MappingSource.MappingOrigin)
+        target = item.MappingTarget
+        if target.is_a("IfcCartesianTransformationOperator3D"):
+            found: np.ndarray = np.asarray(
+                placement.get_cartesiantransformationoperator3d(target) @ origin, dtype=float)
+            return found
+        return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+
     def _item_points(self, item: Any) -> np.ndarray | None:
         """Points of one representation item in its representation's frame (file units)."""
-        import ifcopenshell.util.placement as placement
 
         item = _uncut(item)
         if item.is_a("IfcExtrudedAreaSolid"):
-            profile = _profile_points(item.SweptArea)
+            profile = _profile_points(item.SweptArea, self.axis)
             if profile is None:
                 return None
-            local = (np.asarray(placement.get_axis2placement(item.Position), dtype=float)
-                     if item.Position is not None else np.eye(4))
+            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
             direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
             norm = float(np.linalg.norm(direction))
             if norm < 1e-12 or len(direction) != 3:
@@ -239,7 +256,7 @@ class ShapeReader:
             mapped = self._mapped[key]
             if mapped is None:
                 return None
-            m = np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+            m = self._mapping(item)
             moved: np.ndarray = mapped @ m[:3, :3].T + m[:3, 3]
             return moved
         if item.is_a("IfcTessellatedFaceSet"):
@@ -277,16 +294,17 @@ def _loop_points(item: Any) -> list[Any] | None:
     else:
         return None
     coords: list[Any] = []
+    # by attribute index (several times faster than by name): IfcConnectedFaceSet.CfsFaces,
+    # IfcFace.Bounds, IfcFaceBound.Bound, IfcPolyLoop.Polygon, IfcCartesianPoint.Coordinates
     for shell in shells:
-        faces = getattr(shell, "CfsFaces", None)
-        if faces is None:
+        if not shell.is_a("IfcConnectedFaceSet"):
             return None
-        for face in faces:
-            for bound in face.Bounds:
-                loop = bound.Bound
+        for face in shell[0]:
+            for bound in face[0]:
+                loop = bound[0]
                 if not loop.is_a("IfcPolyLoop"):
                     return None
-                coords.extend(p.Coordinates for p in loop.Polygon)
+                coords.extend(p[0] for p in loop[0])
     return coords
 
 
@@ -315,8 +333,9 @@ def body_representation(element: Any) -> Any:
     return None
 
 
-def _profile_points(profile: Any) -> np.ndarray | None:
-    """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise."""
+def _profile_points(profile: Any, axis: Any = None) -> np.ndarray | None:
+    """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise.
+    ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without)."""
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
@@ -345,7 +364,8 @@ def _profile_points(profile: Any) -> np.ndarray | None:
         return None
     position = getattr(profile, "Position", None)
     if position is not None:
-        m = np.asarray(placement.get_axis2placement(position), dtype=float)
+        m = (axis(position) if axis is not None
+             else np.asarray(placement.get_axis2placement(position), dtype=float))
         pts = pts @ m[:2, :2].T + m[:2, 3]
     return pts
 
