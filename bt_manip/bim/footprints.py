@@ -36,7 +36,6 @@ def hull_boxes(points: np.ndarray, bottom: float, top: float,
                hint_yaw: float | None = None) -> list[Box]:
     """The boxes (from ``bottom`` to ``top``, m) covering the hull of ``points``' footprint."""
     import shapely
-    from shapely.geometry import MultiPoint
 
     corners = hull_xy(points[:, :2])
     box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), hint_yaw)
@@ -49,7 +48,7 @@ def hull_boxes(points: np.ndarray, bottom: float, top: float,
     c, s = math.cos(box.yaw), math.sin(box.yaw)
     xy = corners - np.array(box.centre[:2])
     uv = np.column_stack([xy @ np.array([c, s]), xy @ np.array([-s, c])])
-    hull = MultiPoint([tuple(p) for p in uv]).convex_hull
+    hull = shapely.convex_hull(shapely.multipoints(uv))
     if hull.area >= HULL_FILL * area:
         return [whole]
     n = min(MAX_STRIPS, max(2, math.ceil(box.size[0] / STRIP)))

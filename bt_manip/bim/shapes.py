@@ -299,12 +299,12 @@ def _loop_points(item: Any) -> list[Any] | None:
     for shell in shells:
         if not shell.is_a("IfcConnectedFaceSet"):
             return None
-        for face in shell[0]:
-            for bound in face[0]:
-                loop = bound[0]
+        for face in shell.get_argument(0):
+            for bound in face.get_argument(0):
+                loop = bound.get_argument(0)
                 if not loop.is_a("IfcPolyLoop"):
                     return None
-                coords.extend(p[0] for p in loop[0])
+                coords.extend(p.get_argument(0) for p in loop.get_argument(0))
     return coords
 
 
@@ -417,7 +417,7 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     """Edge directions of the convex hull of ``xy`` (one of them bounds the least box)."""
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = np.unique(np.round(xy, 6), axis=0)
+    pts = unique_rows(np.round(xy, 6))
     if len(pts) < 3:
         if len(pts) == 2:
             d = pts[1] - pts[0]
@@ -430,6 +430,18 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
         return [math.atan2(d[1], d[0])]
     edges = np.roll(hull, -1, axis=0) - hull
     return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+
+
+def unique_rows(xy: np.ndarray) -> np.ndarray:
+    """The distinct rows of an N x 2 array, sorted by x then y (``np.unique(xy, axis=0)``,
+    without its structured-array round trip)."""
+    if len(xy) == 0:
+        return np.empty((0, 2), dtype=float)
+    ordered = xy[np.lexsort((xy[:, 1], xy[:, 0]))]
+    keep = np.ones(len(ordered), dtype=bool)
+    keep[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    out: np.ndarray = ordered[keep]
+    return out
 
 
 def hull_prism(points: np.ndarray) -> np.ndarray:
@@ -447,7 +459,7 @@ def hull_xy(xy: np.ndarray) -> np.ndarray:
     fewer than three or collinear)."""
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = np.unique(np.round(xy, 9), axis=0)
+    pts = unique_rows(np.round(xy, 9))
     if len(pts) < 3:
         return pts
     try:
