@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.bim.footprints import hull_boxes, wall_gaps
+from bt_manip.bim.footprints import strip_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
     Box,
@@ -393,11 +393,12 @@ def _footprint(pts: Any, element: Any, building: Building, names: Names,
     bottom = max(bottom, 0.0)
     corners = hull_xy(pts[:, :2])
     flat = np.column_stack([corners, np.zeros(len(corners))])
+    box = footprint_box(flat, yaw)
+    # the hull of the corners is the corners themselves, and their least box this one
     parts = [_shift(b, building.floor_z) for b in
-             hull_boxes(flat, bottom + building.floor_z, top + building.floor_z, yaw)]
+             strip_boxes(corners, box, bottom + building.floor_z, top + building.floor_z)]
     fallback = {"furniture": "furniture", "curtain wall": "curtain", "raised wall": "wall"}
     name = names.make(element.Name, f"{fallback.get(kind, 'obstacle')}_{element.id()}")
-    box = footprint_box(flat, yaw)
     box = Box((box.centre[0], box.centre[1], (bottom + top) / 2), (box.size[0], box.size[1],
               top - bottom), box.yaw)
     return Furniture(element, name, box, parts if len(parts) > 1 else [], kind)

@@ -35,10 +35,16 @@ MIN_GAP = 0.05
 def hull_boxes(points: np.ndarray, bottom: float, top: float,
                hint_yaw: float | None = None) -> list[Box]:
     """The boxes (from ``bottom`` to ``top``, m) covering the hull of ``points``' footprint."""
-    import shapely
-
     corners = hull_xy(points[:, :2])
     box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), hint_yaw)
+    return strip_boxes(corners, box, bottom, top)
+
+
+def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> list[Box]:
+    """:func:`hull_boxes` of a footprint whose hull ``corners`` (N x 2) and least box ``box``
+    (:func:`~bt_manip.bim.shapes.footprint_box` of the corners) are known already."""
+    import shapely
+
     height = top - bottom
     z = (bottom + top) / 2
     whole = Box((box.centre[0], box.centre[1], z), (box.size[0], box.size[1], height), box.yaw)
