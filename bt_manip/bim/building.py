@@ -41,7 +41,7 @@ from bt_manip.bim.shapes import (
     hull_xy,
     is_box_like,
 )
-from bt_manip.bim.storeys import choose_storey, storey_elevation, storey_of
+from bt_manip.bim.storeys import choose_storey, direct_containers, storey_elevation, storey_of
 
 __all__ = ["Building", "Furniture", "Names", "Opening", "Space", "Wall", "choose_storey",
            "read_building", "storey_elevation", "storey_of"]
@@ -226,11 +226,12 @@ def read_building(
     model = source.model
     single = len(model.by_type("IfcBuildingStorey")) == 1
     climbed: dict[int, Any] = {}
+    contained = {} if single else direct_containers(model)
 
     def on_storey(el: Any) -> bool:
         if single:
             return True
-        s = storey_of(el, climbed)
+        s = storey_of(el, climbed, contained)
         return s is not None and s.id() == storey.id()
 
     reader = ShapeReader(source.scale, model)
