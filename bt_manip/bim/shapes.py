@@ -101,7 +101,9 @@ class ShapeReader:
         key = int(placement.id())
         found = self._axes.get(key)
         if found is None:
-            found = np.asarray(util.get_axis2placement(placement), dtype=float)
+            found = _axis_matrix(placement)
+            if found is None:
+                found = np.asarray(util.get_axis2placement(placement), dtype=float)
             self._axes[key] = found
         return found
 
@@ -280,6 +282,30 @@ NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Refere
 _POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurfaceModel",
                "IfcShellBasedSurfaceModel"}
 """Items whose points are their polygon loops' points (no curved faces)."""
+
+
+def _axis_matrix(placement: Any) -> np.ndarray | None:
+    """An IfcAxis2Placement3D's matrix, the same numbers as ifcopenshell.util.placement's
+    ``get_axis2placement`` (the same operations in the same order, the cross product written
+    out); None for any other placement."""
+    if not placement.is_a("IfcAxis2Placement3D"):
+        return None
+    origin = getattr(placement.Location, "Coordinates", None)
+    if not origin:
+        return None
+    axis, ref = placement.Axis, placement.RefDirection
+    z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
+    x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    x = x / np.linalg.norm(x)
+    z = z / np.linalg.norm(z)
+    y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
+                  z[0] * x[1] - z[1] * x[0]])
+    y = y / np.linalg.norm(y)
+    m = np.eye(4)
+    m[:-1, :-1] = x, y, z
+    m[-1, :-1] = origin
+    out: np.ndarray = m.T
+    return out
 
 
 def _loop_points(item: Any) -> list[Any] | None:
