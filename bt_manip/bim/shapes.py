@@ -15,6 +15,9 @@ triangles, for a wall whose holes matter. :func:`footprint_box` fits the upright
 footprint around the points: its centre, size (length along its yaw, width, height) and yaw; a
 body whose volume is much less than that box's is not box-like (a curved or L-shaped wall, a
 tilted element).
+
+A reader computes each placement once (object placements up their chains, the
+IfcAxis2Placements of items and mapping origins), as elements share them.
 """
 
 from __future__ import annotations
@@ -24,6 +27,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from bt_manip.bim.hulls import hull_xy, unique_rows
+
+__all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
+           "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
 
 BOX_FILL = 0.9
 """A body is box-like when its volume is at least this share of its upright bounding box's
@@ -458,47 +466,6 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
 
 
-SMALL_HULL = 256
-"""Hulls of at most this many distinct points are found in Python (:func:`_monotone_chain`),
-larger ones by Qhull: for a few points, Qhull's setup costs far more than the hull."""
-
-
-def _monotone_chain(pts: np.ndarray) -> np.ndarray:
-    """The corners (counter-clockwise) of the convex hull of distinct points sorted by x then
-    y (Andrew's monotone chain); points on an edge, or within the rounding of one, are left
-    out, as Qhull leaves them (the two may differ on a point within about 1e-15 of the
-    coordinates' size of an edge)."""
-    rows = pts.tolist()
-    # a turn this small is rounding, not a corner: about where Qhull draws the line
-    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
-
-    def half(points: list[list[float]]) -> list[list[float]]:
-        out: list[list[float]] = []
-        for p in points:
-            while len(out) >= 2:
-                (ax, ay), (bx, by) = out[-2], out[-1]
-                if (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax) > eps:
-                    break
-                out.pop()
-            out.append(p)
-        return out
-
-    lower, upper = half(rows), half(rows[::-1])
-    return np.array(lower[:-1] + upper[:-1], dtype=float).reshape(-1, 2)
-
-
-def unique_rows(xy: np.ndarray) -> np.ndarray:
-    """The distinct rows of an N x 2 array, sorted by x then y (``np.unique(xy, axis=0)``,
-    without its structured-array round trip)."""
-    if len(xy) == 0:
-        return np.empty((0, 2), dtype=float)
-    ordered = xy[np.lexsort((xy[:, 1], xy[:, 0]))]
-    keep = np.ones(len(ordered), dtype=bool)
-    keep[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
-    out: np.ndarray = ordered[keep]
-    return out
-
-
 def hull_prism(points: np.ndarray) -> np.ndarray:
     """The corners of the hull of the points' footprint, each at their lowest and highest z:
     the points an upright obstacle's footprint and height depend on (as long as it is only
@@ -507,24 +474,6 @@ def hull_prism(points: np.ndarray) -> np.ndarray:
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
     return np.vstack([np.column_stack([xy, np.full(len(xy), z0)]),
                       np.column_stack([xy, np.full(len(xy), z1)])])
-
-
-def hull_xy(xy: np.ndarray) -> np.ndarray:
-    """The corners of the convex hull of 2D points (the points themselves when they are
-    fewer than three or collinear)."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    pts = unique_rows(np.round(xy, 9))
-    if len(pts) < 3:
-        return pts
-    if len(pts) <= SMALL_HULL:
-        chain = _monotone_chain(pts)
-        return chain if len(chain) >= 3 else pts
-    try:
-        corners: np.ndarray = pts[ConvexHull(pts).vertices]
-        return corners
-    except QhullError:
-        return pts
 
 
 def placement_yaw(element: Any) -> float | None:

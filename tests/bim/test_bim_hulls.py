@@ -19,12 +19,8 @@ pytest.importorskip("shapely")
 from scipy.spatial import ConvexHull
 
 from bt_manip.bim.footprints import hull_boxes, strip_boxes
-from bt_manip.bim.shapes import (
-    _monotone_chain,
-    footprint_box,
-    hull_xy,
-    unique_rows,
-)
+from bt_manip.bim.hulls import hull_xy, monotone_chain, unique_rows
+from bt_manip.bim.shapes import footprint_box
 
 
 def _shapes(seed: int) -> list[np.ndarray]:
@@ -59,7 +55,7 @@ def test_unique_rows_is_np_unique() -> None:
 def test_monotone_chain_finds_qhulls_corners() -> None:
     for xy in _shapes(1):
         pts = unique_rows(np.round(xy, 9))
-        chain = _monotone_chain(pts)
+        chain = monotone_chain(pts)
         qhull = pts[ConvexHull(pts).vertices]
         assert {tuple(p) for p in chain} == {tuple(p) for p in qhull}
         # counter-clockwise: every turn is to the left
