@@ -9,7 +9,8 @@ modules and the robot's reach map) of the time to parse it (reading the bytes an
 ifcopenshell's parse: the peer every other figure is compared with), to convert it (parse
 included; these exports schedule nothing, so the world alone is written), and to report the
 first error (``--require-install``, which names the file's IfcProject by its line). One JSON
-line per file, with the ratios conversion / parse and first error / parse.
+line per file, with the ratios conversion / parse and first error / parse, in wall time and in
+CPU time (the process's, also medians: on a shared machine the steadier of the two).
 
 Generates with ``ifcopenshell.api`` (in millimetres, IFC4) a storey of N x N rooms of 6 m x 6 m
 (default 7 x 7: 112 walls, each room side its own IfcWall, 0.2 m thick and 2.5 m high), with a
@@ -127,13 +128,15 @@ def generate(rooms: int, path: Path) -> dict[str, int]:
     return counts
 
 
-def _median_time(run: Any, repeat: int) -> float:
-    times = []
+def _median_time(run: Any, repeat: int) -> tuple[float, float]:
+    """Median wall and median CPU seconds of ``run`` over ``repeat`` runs."""
+    wall, cpu = [], []
     for _ in range(repeat):
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         run()
-        times.append(time.perf_counter() - t0)
-    return sorted(times)[len(times) // 2]
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return sorted(wall)[len(wall) // 2], sorted(cpu)[len(cpu) // 2]
 
 
 def time_samples(folder: Path, out: Path, repeat: int) -> None:
@@ -153,15 +156,19 @@ def time_samples(folder: Path, out: Path, repeat: int) -> None:
             else:
                 raise AssertionError(f"{path}: --require-install did not fail")
 
-        parse = _median_time(lambda path=path: open_ifc(path), repeat)
-        conversion = _median_time(
+        (parse, parse_cpu) = _median_time(lambda path=path: open_ifc(path), repeat)
+        (conversion, conversion_cpu) = _median_time(
             lambda path=path: convert(BimOptions(path, out / path.stem)), repeat)
-        error = _median_time(first_error, repeat)
+        (error, error_cpu) = _median_time(first_error, repeat)
         print(json.dumps({
             "bench": "bim_convert", "file": path.name, "ifc_bytes": path.stat().st_size,
             "parse_s": round(parse, 3), "convert_s": round(conversion, 3),
             "first_error_s": round(error, 3), "convert_over_parse": round(conversion / parse, 2),
             "first_error_over_parse": round(error / parse, 2),
+            "parse_cpu_s": round(parse_cpu, 3), "convert_cpu_s": round(conversion_cpu, 3),
+            "first_error_cpu_s": round(error_cpu, 3),
+            "convert_over_parse_cpu": round(conversion_cpu / parse_cpu, 2),
+            "first_error_over_parse_cpu": round(error_cpu / parse_cpu, 2),
         }), flush=True)
 
 

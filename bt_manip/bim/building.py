@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.bim.footprints import hull_boxes, wall_gaps
+from bt_manip.bim.footprints import strip_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
     Box,
@@ -40,9 +40,8 @@ from bt_manip.bim.shapes import (
     footprint_box,
     hull_xy,
     is_box_like,
-    placement_yaw,
 )
-from bt_manip.bim.storeys import choose_storey, storey_elevation, storey_of
+from bt_manip.bim.storeys import choose_storey, direct_containers, storey_elevation, storey_of
 
 __all__ = ["Building", "Furniture", "Names", "Opening", "Space", "Wall", "choose_storey",
            "read_building", "storey_elevation", "storey_of"]
@@ -226,11 +225,13 @@ def read_building(
     ``band_top`` (m above the floor). Problems are collected in ``source``."""
     model = source.model
     single = len(model.by_type("IfcBuildingStorey")) == 1
+    climbed: dict[int, Any] = {}
+    contained = {} if single else direct_containers(model)
 
     def on_storey(el: Any) -> bool:
         if single:
             return True
-        s = storey_of(el)
+        s = storey_of(el, climbed, contained)
         return s is not None and s.id() == storey.id()
 
     reader = ShapeReader(source.scale, model)
@@ -321,7 +322,7 @@ def read_building(
         except UnsupportedGeometry as exc:
             out.notes.append(f"#{space.id()} IfcSpace '{space.Name or ''}' left out: {exc}")
             continue
-        box = _shift(footprint_box(pts, placement_yaw(space)), floor_z)
+        box = _shift(footprint_box(pts, reader.yaw(space)), floor_z)
         label = space.LongName if getattr(space, "LongName", None) else space.Name
         out.spaces.append(Space(space, label or f"space {space.id()}", "", box))
     for item in furniture_found:
@@ -376,11 +377,11 @@ def _obstacle(reader: ShapeReader, element: Any, building: Building, names: Name
     except UnsupportedGeometry as exc:
         building.skip(element, str(exc))
         return None
-    return _footprint(pts, element, building, names, kind)
+    return _footprint(pts, element, building, names, kind, reader.yaw(element))
 
 
 def _footprint(pts: Any, element: Any, building: Building, names: Names,
-               kind: str) -> Furniture | None:
+               kind: str, yaw: float | None) -> Furniture | None:
     bottom = float(pts[:, 2].min()) - building.floor_z
     top = float(pts[:, 2].max()) - building.floor_z
     if top <= FLOOR_TOLERANCE:
@@ -391,14 +392,14 @@ def _footprint(pts: Any, element: Any, building: Building, names: Names,
                                f"{building.band_top:.2f} m (from {bottom:.2f} m)")
         return None
     bottom = max(bottom, 0.0)
-    yaw = placement_yaw(element)
     corners = hull_xy(pts[:, :2])
     flat = np.column_stack([corners, np.zeros(len(corners))])
+    box = footprint_box(flat, yaw)
+    # the hull of the corners is the corners themselves, and their least box this one
     parts = [_shift(b, building.floor_z) for b in
-             hull_boxes(flat, bottom + building.floor_z, top + building.floor_z, yaw)]
+             strip_boxes(corners, box, bottom + building.floor_z, top + building.floor_z)]
     fallback = {"furniture": "furniture", "curtain wall": "curtain", "raised wall": "wall"}
     name = names.make(element.Name, f"{fallback.get(kind, 'obstacle')}_{element.id()}")
-    box = footprint_box(flat, yaw)
     box = Box((box.centre[0], box.centre[1], (bottom + top) / 2), (box.size[0], box.size[1],
               top - bottom), box.yaw)
     return Furniture(element, name, box, parts if len(parts) > 1 else [], kind)
@@ -415,7 +416,7 @@ def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Buil
     except UnsupportedGeometry as exc:
         building.skip(wall, str(exc))
         return []
-    box = _shift(footprint_box(solid.points, placement_yaw(wall)), floor_z)
+    box = _shift(footprint_box(solid.points, reader.yaw(wall)), floor_z)
     if box.top <= FLOOR_TOLERANCE:
         building.notes.append(f"#{wall.id()} {wall.Name or ''}: below the floor, left out")
         building.skip(wall, "below the floor")
@@ -430,7 +431,8 @@ def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Buil
             name = names.make(wall.Name, f"wall_{wall.id()}")
             building.raised.append(Furniture(wall, name, box, [], "raised wall"))
         else:
-            found = _footprint(solid.points, wall, building, names, "raised wall")
+            found = _footprint(solid.points, wall, building, names, "raised wall",
+                               reader.yaw(wall))
             if found is not None:
                 building.raised.append(found)
         return []
@@ -438,7 +440,7 @@ def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Buil
     if not box_like:
         straight = box.size[0] >= 3 * box.size[1]
         if not straight:
-            found = _footprint(solid.points, wall, building, names, "wall")
+            found = _footprint(solid.points, wall, building, names, "wall", reader.yaw(wall))
             if found is not None:
                 building.obstacles.append(found)
             return []

@@ -83,6 +83,9 @@ BAND_MARGIN = 0.1
 """Added (m) to the top of the robot's height band."""
 ROUTE_ROUNDS = 4
 """Stock placements tried, refusing the elements without a route each time, at most."""
+_FAST_DUMPER: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+"""libyaml's emitter when installed: several times faster than PyYAML's, and the same text as
+long as no string needs double quotes (the two fold long double-quoted strings differently)."""
 
 
 @dataclass(frozen=True)
@@ -309,7 +312,9 @@ def convert(options: BimOptions) -> Conversion:
         "# furniture and spaces, the elements to install waiting in stands at the stock\n"
         "# (their order and target poses are in schedule.json), and the robot.\n"
     )
-    text = header + yaml.safe_dump(world, sort_keys=False, default_flow_style=None, width=100)
+    dumper = _FAST_DUMPER if _plain_ascii(world) else yaml.SafeDumper
+    text = header + yaml.dump(world, Dumper=dumper, sort_keys=False, default_flow_style=None,
+                              width=100)
     world_path.write_text(text)
     conversion = Conversion(
         source.path, source.schema, str(storey.Name or f"#{storey.id()}"), building, elements,
@@ -332,6 +337,23 @@ def convert(options: BimOptions) -> Conversion:
     elif install_path.is_file():
         install_path.unlink()
     return conversion
+
+
+def _plain_ascii(data: Any) -> bool:
+    """Whether every string in ``data`` (dicts, lists, scalars) is printable ASCII on one
+    line: such strings are written plain or single-quoted, never double-quoted."""
+    stack = [data]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            if not (item.isascii() and item.isprintable()):
+                return False
+        elif isinstance(item, dict):
+            stack.extend(item.keys())
+            stack.extend(item.values())
+        elif isinstance(item, list | tuple):
+            stack.extend(item)
+    return True
 
 
 def _refused_entry(element: Any, reason: str) -> dict[str, Any]:

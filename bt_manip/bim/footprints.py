@@ -35,11 +35,16 @@ MIN_GAP = 0.05
 def hull_boxes(points: np.ndarray, bottom: float, top: float,
                hint_yaw: float | None = None) -> list[Box]:
     """The boxes (from ``bottom`` to ``top``, m) covering the hull of ``points``' footprint."""
-    from shapely.geometry import MultiPoint
-    from shapely.geometry import box as rect
-
     corners = hull_xy(points[:, :2])
     box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), hint_yaw)
+    return strip_boxes(corners, box, bottom, top)
+
+
+def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> list[Box]:
+    """:func:`hull_boxes` of a footprint whose hull ``corners`` (N x 2) and least box ``box``
+    (:func:`~bt_manip.bim.shapes.footprint_box` of the corners) are known already."""
+    import shapely
+
     height = top - bottom
     z = (bottom + top) / 2
     whole = Box((box.centre[0], box.centre[1], z), (box.size[0], box.size[1], height), box.yaw)
@@ -49,17 +54,21 @@ def hull_boxes(points: np.ndarray, bottom: float, top: float,
     c, s = math.cos(box.yaw), math.sin(box.yaw)
     xy = corners - np.array(box.centre[:2])
     uv = np.column_stack([xy @ np.array([c, s]), xy @ np.array([-s, c])])
-    hull = MultiPoint([tuple(p) for p in uv]).convex_hull
+    hull = shapely.convex_hull(shapely.multipoints(uv))
     if hull.area >= HULL_FILL * area:
         return [whole]
     n = min(MAX_STRIPS, max(2, math.ceil(box.size[0] / STRIP)))
     edges = np.linspace(-box.size[0] / 2, box.size[0] / 2, n + 1)
+    # the strips cut from the hull all at once (one call into GEOS for all of them)
+    strips = shapely.box(edges[:-1], -box.size[1], edges[1:], box.size[1])
+    parts = shapely.intersection(hull, strips)
+    empty = shapely.is_empty(parts)
+    bounds = shapely.bounds(parts)
     out: list[Box] = []
-    for u0, u1 in itertools.pairwise(edges):
-        part = hull.intersection(rect(u0, -box.size[1], u1, box.size[1]))
-        if part.is_empty:
+    for k, (u0, u1) in enumerate(itertools.pairwise(edges)):
+        if empty[k]:
             continue
-        _, v0, _, v1 = part.bounds
+        v0, v1 = float(bounds[k][1]), float(bounds[k][3])
         if v1 - v0 < 1e-6:
             continue
         u, v = (u0 + u1) / 2, (v0 + v1) / 2

@@ -3,10 +3,10 @@
 An IFC file in the STEP physical format (ISO 10303-21) holds one entity per line
 (``#42=IFCWALL('2O2Fr$t4X7Zf8NOew3FLOH',$,'Wall 1',...);``), so a problem about an entity is
 reported as ``file:line: #42 IfcWall 'Wall 1': message``. The line is found only when a problem
-is reported: the entity's ``#42=`` is searched for in the bytes, and its line number read from one
-sorted index of the line starts (a bisection), made once per file; after a few problems, the
-offsets of every entity are indexed at once. A problem thus costs about one pass over the file,
-however many entities it holds.
+is reported: the entity's ``#42=`` is searched for in the bytes and the newlines before it are
+counted; after a few problems, the offsets of every entity and the line starts are indexed at
+once (a line is then a bisection). A problem thus costs about one pass over the file, however
+many entities it holds.
 """
 
 from __future__ import annotations
@@ -49,6 +49,8 @@ class IfcSource:
         offset = self.offset_of(step_id)
         if offset is None:
             return None
+        if self._starts is None and self._lookups <= DIRECT_LOOKUPS:
+            return self.data.count(b"\n", 0, offset) + 1  # a few: count, no index
         if self._starts is None:
             import numpy as np
 

@@ -38,11 +38,51 @@ class StoreyChoice:
                 f"storeys by elevation: {listed})")
 
 
-def storey_of(element: Any) -> Any:
-    """The IfcBuildingStorey containing ``element`` (through spaces and aggregates), or None."""
+def storey_of(element: Any, memo: dict[int, Any] | None = None,
+              contained: dict[int, Any] | None = None) -> Any:
+    """The IfcBuildingStorey containing ``element`` (through spaces and aggregates), or None.
+
+    With ``memo`` (one dict per file), the storey found above each container is kept: the
+    elements of a storey share their containers, so the climb is made once per container.
+    ``contained`` (:func:`direct_containers`) gives the containers of the elements directly
+    contained in one."""
     import ifcopenshell.util.element as util
 
-    current = util.get_container(element) or util.get_aggregate(element)
+    key = int(element.id())
+    if contained is not None and key in contained:
+        current = contained[key] or util.get_aggregate(element)
+    else:
+        current = util.get_container(element) or util.get_aggregate(element)
+    if memo is None or current is None:
+        return _climb(current)
+    key = int(current.id())
+    if key not in memo:
+        memo[key] = _climb(current)
+    return memo[key]
+
+
+def direct_containers(model: Any) -> dict[int, Any]:
+    """The spatial container of each element contained in exactly one
+    (IfcRelContainedInSpatialStructure), by step id: read in one pass over the relations
+    rather than element by element."""
+    found: dict[int, Any] = {}
+    twice: set[int] = set()
+    for rel in model.by_type("IfcRelContainedInSpatialStructure"):
+        structure = rel.RelatingStructure
+        for el in rel.RelatedElements or ():
+            key = int(el.id())
+            if key in found:
+                twice.add(key)
+            found[key] = structure
+    for key in twice:  # in several: the element's own first relation decides
+        del found[key]
+    return found
+
+
+def _climb(current: Any) -> Any:
+    """The first storey from ``current`` up its containers and aggregates (16 steps at most)."""
+    import ifcopenshell.util.element as util
+
     for _ in range(16):
         if current is None or current.is_a("IfcBuildingStorey"):
             return current
