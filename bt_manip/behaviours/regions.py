@@ -182,10 +182,10 @@ class DropPoint(WorldAccess, SyncActionNode):
     by row from the corner of lowest x and y (``index`` 0 .. rows x cols - 1). ``point`` is
     written as a list x;y;z (world), ready for ``MoveToPose position="{point}"``.
 
-    With a ``robot`` (empty, the default: no robot, the cell asked for whatever can reach it),
-    the point is one that robot's arm reaches with its grasp frame, checked by inverse
-    kinematics from where the arm is (the solver MoveToPose uses) and in the arm's planning
-    scene (the arm must not touch the table, the bin, walls or floor there):
+    Without a ``robot`` (the default) the point is that of cell ``index``, whether an arm
+    reaches it or not. With one, it is a point that robot's arm reaches with its grasp frame,
+    checked by inverse kinematics from where the arm is (the solver MoveToPose uses) and in
+    the arm's planning scene (the arm must not touch furniture, walls or floor there):
 
     1. cell ``index`` with the tool at ``orientation`` (MoveToPose's port and default: pointing
        down), when the arm reaches it;

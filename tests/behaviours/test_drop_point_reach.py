@@ -20,7 +20,7 @@ CLEARANCE = 0.0625
 """The drop height of Scenario B's tree (m above the rim)."""
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def far_bin() -> Iterator[World]:
     with World(ROOT / "worlds" / "sawyer_table_bin_far.yaml", seed=0) as world:
         yield world
@@ -91,6 +91,20 @@ def test_a_cell_beyond_reach_gives_way_to_the_nearest_cell_the_arm_reaches(
     assert bb["c"] == 4 and bb["p"] == cells[4]  # 4 and 8 as near: the lower number
 
 
+def test_of_cells_equally_near_the_one_with_fewer_objects_in_it_is_taken() -> None:
+    with World(ROOT / "worlds" / "sawyer_table_bin_far.yaml", seed=0) as world:
+        region = region_of(world, "bin")
+        x, y, _ = grid_cell(region, 4, 3, 3, 0.02, CLEARANCE).tolist()
+        block = f'<SpawnModel model="lying" size="0.05;0.05;0.05" pose="{x};{y};0.79;0.3"/>'
+        status, bb, reason = _drop(world, f'index="5" clearance="{CLEARANCE}" robot="sawyer"',
+                                   block)
+        assert status == "SUCCESS", reason
+        assert bb["c"] == 8  # cell 4 holds a block; cell 8, as near to cell 5, holds none
+        # an asked cell the arm reaches is kept, whatever lies in it
+        status, bb, _ = _drop(world, f'index="4" clearance="{CLEARANCE}" robot="sawyer"')
+        assert status == "SUCCESS" and bb["c"] == 4
+
+
 PAD = '<SpawnModel model="{name}" size="0.06;0.06;0.01" pose="{x};0.3;0.7525;0"/>'
 """A small pad on the table, its only drop cell at (x, 0.3)."""
 
@@ -115,6 +129,18 @@ def test_no_cell_reached_top_down_tilts_the_tool_within_the_cone(far_bin: World)
     outward = np.array([point[0] - base[0], point[1] - base[1]])
     assert float(np.dot(axis[:2], outward / np.linalg.norm(outward))) == pytest.approx(
         math.sin(math.radians(tilt)), abs=1e-6)
+    # MoveToPose takes the point and the orientation written there
+    report, _ = run_xml(
+        far_bin,
+        '<Sequence><DropPoint region="pad_a" index="0" rows="1" cols="1" clearance="0.05" '
+        'robot="sawyer" max_tilt="30" point="{p}" tool_orientation="{o}"/>'
+        '<MoveToPose position="{p}" orientation="{o}"/></Sequence>',
+    )
+    assert report.status == "SUCCESS", report.reason
+    robot = far_bin.robots["sawyer"]
+    reached = robot.link_transform(robot.description.grasp_frame)
+    assert np.linalg.norm(reached[:3, 3] - point) < 0.01
+    assert float(reached[:3, 2] @ axis) > math.cos(math.radians(2.0))
     # without room to tilt: FAILURE naming the best IK error met
     status, _, reason = _drop(
         far_bin, 'index="0" rows="1" cols="1" clearance="0.05" robot="sawyer" '
