@@ -241,8 +241,8 @@ class DropPoint(WorldAccess, SyncActionNode):
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "point": PortInformation(list[float], False, "the drop point x;y;z (m, world)"),
         "tool_orientation": PortInformation(
-            list[float], False, "the tool's orientation x;y;z;w there (world): orientation, or "
-            "orientation tilted"
+            list[float], False, "the tool's orientation there, quaternion x;y;z;w (world): "
+            "orientation, or orientation tilted"
         ),
         "cell": PortInformation(int, False, "the cell of the point"),
         "tilt": PortInformation(float, False, "the tool's tilt from orientation (deg)"),
