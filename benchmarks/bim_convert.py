@@ -1,12 +1,23 @@
-"""``bt-manip bim`` on a generated building of about 100 walls: the time of the conversion.
+"""``bt-manip bim`` timed: real exports against their parse time, and a generated building.
 
-Run: ``.venv/bin/python benchmarks/bim_convert.py [--rooms N] [--keep DIR]``
+Run: ``.venv/bin/python benchmarks/bim_convert.py [--rooms N] [--keep DIR] [--samples DIR]
+[--repeat N]``
+
+Real exports (the ``.ifc`` files of ``--samples``, by default ``../shared/samples/ifc``): for
+each file, the median over ``--repeat`` runs (after one warm-up conversion that loads the
+modules and the robot's reach map) of the time to parse it (reading the bytes and
+ifcopenshell's parse: the peer every other figure is compared with), to convert it (parse
+included; these exports schedule nothing, so the world alone is written), and to report the
+first error (``--require-install``, which names the file's IfcProject by its line). One JSON
+line per file, with the ratios conversion / parse and first error / parse, in wall time and in
+CPU time (the process's, also medians: on a shared machine the steadier of the two).
 
 Generates with ``ifcopenshell.api`` (in millimetres, IFC4) a storey of N x N rooms of 6 m x 6 m
 (default 7 x 7: 112 walls, each room side its own IfcWall, 0.2 m thick and 2.5 m high), with a
 1.6 m door in every inner wall and a window in every outer wall, a space and a table in every
 room, a slab under everything, and 8 panels (IfcPlate, 1.2 x 0.02 x 0.3 m) on walls across the
-building, each the output of an IfcTask, the tasks chained by IfcRelSequence. The file is
+building (standing on the floor, within the arm's reach), each the output of an IfcTask, the
+tasks chained by IfcRelSequence. The file is
 written once, then converted (reading, schedule, walls and openings, floor grid, stock, routes,
 world.yaml and schedule.json, and the check that the world file loads) and timed.
 
@@ -105,7 +116,7 @@ def generate(rooms: int, path: Path) -> dict[str, int]:
     for n in range(8):  # on the west faces of the rooms' east walls, across the building
         i, j = (n * 5) % rooms, (n * 3) % rooms
         cx, cy = (i + 1) * ROOM - WALL_T / 2 - 0.01, j * ROOM + 1.0
-        m = _matrix(cx + 0.01, cy - 0.6, 0.85, math.pi / 2)
+        m = _matrix(cx + 0.01, cy - 0.6, 0.0, math.pi / 2)
         panel = box("IfcPlate", f"Panel {n}", (1.2, 0.02, 0.3), m)
         task = api("sequence.add_task", f, work_schedule=schedule, name=f"Install panel {n}")
         api("sequence.assign_product", f, relating_product=panel, related_object=task)
@@ -117,12 +128,65 @@ def generate(rooms: int, path: Path) -> dict[str, int]:
     return counts
 
 
+def _median_time(run: Any, repeat: int) -> tuple[float, float]:
+    """Median wall and median CPU seconds of ``run`` over ``repeat`` runs."""
+    wall, cpu = [], []
+    for _ in range(repeat):
+        t0, c0 = time.perf_counter(), time.process_time()
+        run()
+        wall.append(time.perf_counter() - t0)
+        cpu.append(time.process_time() - c0)
+    return sorted(wall)[len(wall) // 2], sorted(cpu)[len(cpu) // 2]
+
+
+def time_samples(folder: Path, out: Path, repeat: int) -> None:
+    """Print the parse, conversion and first-error times of each IFC file in ``folder``."""
+    from bt_manip.bim.convert import BimOptions, convert
+    from bt_manip.bim.ifc_input import open_ifc
+    from bt_manip.errors import InputError
+
+    for path in sorted(folder.glob("*.ifc")):
+        convert(BimOptions(path, out / f"{path.stem}-warm"))
+
+        def first_error(path: Path = path) -> None:
+            try:
+                convert(BimOptions(path, out / f"{path.stem}-err", require_install=True))
+            except InputError as exc:
+                str(exc)  # the message, with its line number
+            else:
+                raise AssertionError(f"{path}: --require-install did not fail")
+
+        (parse, parse_cpu) = _median_time(lambda path=path: open_ifc(path), repeat)
+        (conversion, conversion_cpu) = _median_time(
+            lambda path=path: convert(BimOptions(path, out / path.stem)), repeat)
+        (error, error_cpu) = _median_time(first_error, repeat)
+        print(json.dumps({
+            "bench": "bim_convert", "file": path.name, "ifc_bytes": path.stat().st_size,
+            "parse_s": round(parse, 3), "convert_s": round(conversion, 3),
+            "first_error_s": round(error, 3), "convert_over_parse": round(conversion / parse, 2),
+            "first_error_over_parse": round(error / parse, 2),
+            "parse_cpu_s": round(parse_cpu, 3), "convert_cpu_s": round(conversion_cpu, 3),
+            "first_error_cpu_s": round(error_cpu, 3),
+            "convert_over_parse_cpu": round(conversion_cpu / parse_cpu, 2),
+            "first_error_over_parse_cpu": round(error_cpu / parse_cpu, 2),
+        }), flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rooms", type=int, default=7, help="rooms per side (default 7)")
     parser.add_argument("--keep", type=Path, help="folder to keep the IFC file and outputs in")
+    parser.add_argument("--samples", type=Path, default=Path("../shared/samples/ifc"),
+                        help="folder of real IFC exports (default ../shared/samples/ifc)")
+    parser.add_argument("--repeat", type=int, default=3, help="runs per figure (median)")
     args = parser.parse_args()
     from bt_manip.bim.convert import BimOptions, convert
+
+    if args.samples.is_dir():
+        with tempfile.TemporaryDirectory() as tmp:
+            time_samples(args.samples, Path(tmp), args.repeat)
+    else:
+        print(json.dumps({"bench": "bim_convert", "skipped": f"{args.samples} is absent"}))
 
     with tempfile.TemporaryDirectory() as tmp:
         folder = args.keep or Path(tmp)

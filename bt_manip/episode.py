@@ -137,6 +137,9 @@ class Episode:
             report.extra["injected"] = self.faults.report()
         if self.localization is not None:
             report.localization = self.localization.report()
+        planning = self.context.arm_planning()
+        if planning:  # wall time: in the report, never on the blackboard
+            report.extra["arm_planning"] = planning
         rows = self._as_built()
         if rows is not None:
             report.as_built = rows

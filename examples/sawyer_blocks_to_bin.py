@@ -40,7 +40,7 @@ def block_to_bin() -> Sequence:
         CloseGripper("grasp", require_object=True),
         Lift("lift", height=0.15),
         IsHolding("still_holding", object="{block}"),
-        MoveToPose("over_bin", position="{drop}", path="line"),
+        MoveToPose("over_bin", position="{drop}", orientation="{drop_tool}", path="line"),
         OpenGripper("release"),
         Lift("retreat", height=0.08),
         ObjectInRegion("landed_in_bin", object="{block}", inside="bin"),
@@ -53,7 +53,8 @@ def block_to_bin() -> Sequence:
     ])
     return Sequence("block_to_bin", children=[
         DropPoint("drop_point", region="bin", index="{cell}", rows=3, cols=3, margin=0.02,
-                  clearance=0.0625, point="{drop}"),
+                  clearance=0.0625, robot="sawyer", point="{drop}",
+                  tool_orientation="{drop_tool}"),
         Fallback("block_or_skip", children=[
             RetryUntilSuccessful("try_twice", num_attempts=2, child=pick_and_place),
             skip,

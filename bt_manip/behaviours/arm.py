@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import operator
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -28,6 +29,7 @@ from bt_manip.manipulation import cartesian
 from bt_manip.manipulation.arm_planner import PLANNERS, ArmPlanner
 from bt_manip.manipulation.base_search import object_grasp
 from bt_manip.manipulation.rrt_connect import PlanError, path_length
+from bt_manip.manipulation.trajectory import Trajectory, time_parameterise
 from bt_manip.sim.randomize import entity_rng
 
 if TYPE_CHECKING:
@@ -57,11 +59,19 @@ PLANNED_VIA = 0.01
 """rad: how close each joint passes a planned waypoint."""
 IK_GOAL_TRIES = 12
 """Other IK seeds tried when the first solution for a pose is in collision."""
+ARM_PATH_COLOUR = (0.95, 0.45, 0.1, 1.0)
+"""The colour the viewer and the replay draw a planned arm path in."""
+DEFAULT_LOOKAHEAD = 0.05
+"""s: how far ahead of now a trajectory's position is given before the second tick (one tick at
+the default 20 Hz); from then on, the time since the previous tick."""
+MIN_LOOKAHEAD = 0.01
+TRACK_MARGIN = 1.25
+"""A joint following a trajectory may move this many times the trajectory's speed, to catch up."""
 CHECKS_PER_TICK = 4000
 """Collision checks a planning node spends per tick at most (plus one search round)."""
 PLANNER = Port(
     str, False, "auto: plan round obstacles when the direct joint move would collide (and pick "
-    "a collision-free IK solution); rrtconnect: always plan; none: move directly", "none",
+    "a collision-free IK solution); rrtconnect: always plan; none: move directly", "auto",
     Accepts(choices=PLANNERS),
 )
 PADDING_PORT = Port(
@@ -91,6 +101,9 @@ class Stage:
     planned: bool = False
     """A waypoint of a planned path: passed within :data:`PLANNED_VIA` rad, so the arm keeps
     to the checked path."""
+    trajectory: Trajectory | None = None
+    """A planned path to this stage's command, timed within the joints' limits: the arm is
+    given the trajectory's position a tick ahead, tick after tick, then the command."""
 
 
 def to_radians(values: list[float], units: str) -> np.ndarray:
@@ -120,6 +133,12 @@ class JointMove(RobotAction):
 
     PLANS = False
     """Whether the node has a ``planner`` port (its plannable stages may be planned)."""
+    SWEEPS = False
+    """Whether each stage's sweep is checked in the planning scene before the arm moves."""
+    LINE_CHECK = False
+    """Whether the node's straight moves are checked in the planning scene before it starts."""
+    LINE_NAME = "the straight move"
+    """How a failed line check names the move."""
 
     def plan(self, q_now: np.ndarray) -> list[Stage]:
         """The stages of the move."""
@@ -217,7 +236,10 @@ class JointMove(RobotAction):
         """One tick of planning; True when the plan is ready (its stages spliced in)."""
         assert self._planning is not None
         index, steps = self._planning
+        planner = self._planner()
+        assert planner is not None
         spent = 0
+        began = time.perf_counter()
         try:
             while spent < CHECKS_PER_TICK:
                 spent = next(steps)
@@ -227,13 +249,25 @@ class JointMove(RobotAction):
             raise ActionFailed(f"planning the arm's move: {exc}") from None
         else:
             return False
-        vias = [Stage(np.asarray(q, dtype=float), list(range(len(q))), via=True, planned=True)
-                for q in result.path[1:-1]]
-        self.stages[index:index] = vias
+        finally:
+            planner.wall_time += time.perf_counter() - began
+        planner.samples += int(result.samples)
+        self._draw(planner, result.path)
+        arm = self.robot().description.arm
+        stage = self.stages[index]
+        stage.trajectory = time_parameterise(
+            result.path, [v * self.speed for v in arm.velocity_limits],
+            [a * self.speed for a in arm.acceleration_limits])
+        stage.joints = list(range(len(stage.command)))
         self.set_output("path_length", path_length(result.path))
         self.set_output("plan_samples", int(result.samples))
         self._planning = None
         return True
+
+    def _draw(self, planner: ArmPlanner, path: list[np.ndarray]) -> None:
+        """Draw the grasp frame's way along the planned ``path`` (drawn when a viewer or a
+        recording is on)."""
+        self.overlay.show_path("arm_plan", planner.tool_path(path), rgba=ARM_PATH_COLOUR)
 
     def start(self) -> None:
         robot = self.robot()
@@ -267,6 +301,8 @@ class JointMove(RobotAction):
         self.command = q_now.copy()
         self._command = q_now.tolist()
         self.stage = -1
+        self._follow: tuple[Trajectory, float] | None = None
+        self._last_tick = -1.0
         # each joint's allowed speed, and the least it may correct at, fixed for the move
         vmax = np.asarray(arm.velocity_limits, dtype=float) * self.speed
         self._vmax: list[float] = vmax.tolist()
@@ -274,6 +310,8 @@ class JointMove(RobotAction):
         # contacts the arm already has may stay (it can then move away from them); only new
         # ones end the move
         self.initial_contacts = set(arm_collisions(self.world, robot)) if self.check else set()
+        if self.LINE_CHECK and self.check:
+            self._check_lines(q_now, stages)
         self._start_planning(robot, q_now)
         if self._planning is None:
             self._next_stage(robot, robot.arm_motion()[0])
@@ -285,14 +323,101 @@ class JointMove(RobotAction):
         if self.stage >= len(self.stages):
             return
         stage = self.stages[self.stage]
-        target, joints = stage.command, stage.joints
+        target = stage.command
         self.command = target.copy()
         self._command = target.tolist()
+        if stage.trajectory is not None and stage.trajectory.duration > 0.0:
+            self._follow = (stage.trajectory, self.now())
+            self._track(robot)
+            return
+        if self.SWEEPS and self.check:
+            self._check_sweep(np.asarray(q, dtype=float), stage)
+        self._settle_on(robot, q)
+
+    def _check_sweep(self, q: np.ndarray, stage: Stage) -> None:
+        """ActionFailed naming what the arm (or what it carries) would touch of the walls,
+        furniture and floor on its way from ``q`` to the stage's command, checked in the
+        planning scene before it moves (what it touches at ``q`` already may stay)."""
+        hits = self._world_hits(q, [stage.command])
+        if hits:
+            joints = self.robot().description.arm.joints
+            moving = ", ".join(f"{j} ({joints[j]})" for j in stage.joints)
+            self.robot().hold_arm()
+            raise ActionFailed(f"joint {moving} would collide on its way: {hits}")
+
+    def _check_lines(self, q_now: np.ndarray, stages: list[Stage]) -> None:
+        """ActionFailed naming what the arm (or what it carries) would touch of the walls,
+        furniture and floor along the straight moves of ``stages`` (the runs of stages that
+        are not planned: a planned stage's way is the planner's), before the arm moves."""
+        runs: list[list[np.ndarray]] = [[q_now]]
+        for st in stages:
+            if st.plannable:
+                runs.append([st.command])
+            else:
+                runs[-1].append(st.command)
+        for run in runs:
+            if len(run) > 1:
+                hits = self._world_hits(run[0], run[1:])
+                if hits:
+                    raise ActionFailed(f"{self.LINE_NAME} would collide: {hits}")
+
+    def _world_hits(self, q: np.ndarray, waypoints: list[np.ndarray]) -> str:
+        """What of the walls, furniture and floor the arm (or what it carries) would touch on
+        the straight joint moves from ``q`` through ``waypoints`` ("" for nothing), checked in
+        the planning scene at the planner's validation step. The arm against itself is not
+        checked (nor is it while it moves), nor are movable objects (it may push them); what it
+        touches at ``q`` already may stay."""
+        services = self.services()
+        if services.arm_planner is None:
+            robot = self.robot()
+            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
+        planner: ArmPlanner = services.arm_planner
+        scene = planner.scene()
+        planner.sync(scene, "", (q,), movables=False)
+        step = planner.options.validate_step
+        here_from = q
+        for there in waypoints:
+            n = max(1, math.ceil(float(np.max(np.abs(there - here_from))) / step))
+            for k in range(1, n + 1):
+                here = here_from + (there - here_from) * (k / n)
+                if scene.collides(here):
+                    hits = [p for p in scene.contacts(here)
+                            if p[0] in scene.obstacles or p[1] in scene.obstacles]
+                    if hits:
+                        return ", ".join(f"{a} touches {b}" for a, b in hits[:4])
+            here_from = there
+        return ""
+
+    def _settle_on(self, robot: Robot, q: list[float]) -> None:
+        """Send the stage's command from the joint positions ``q`` (rad)."""
+        joints = self.stages[self.stage].joints
         # joints moved together arrive together: scale each speed to the slowest travel time
         command, vmax = self._command, self._vmax
         travel = [abs(command[j] - q[j]) for j in joints]
         t = _largest([d / vmax[j] for d, j in zip(travel, joints, strict=True)]) if joints else 0.0
         self._send(robot, joints, travel, t)
+
+    def _track(self, robot: Robot) -> bool:
+        """Follow the stage's trajectory: give the arm its position a tick ahead, at no more
+        than the speed it has there (plus the correction margin). False once it has run out
+        (the stage's command is then sent, and the stage's time-out starts)."""
+        assert self._follow is not None
+        trajectory, t0 = self._follow
+        now = self.now()
+        ahead = max(now - self._last_tick, MIN_LOOKAHEAD) if self._last_tick >= 0 else (
+            DEFAULT_LOOKAHEAD)
+        self._last_tick = now
+        t = now - t0
+        if t >= trajectory.duration:
+            self._follow = None
+            self.stage_started = now
+            self._settle_on(robot, robot.arm_motion()[0])
+            return False
+        target = trajectory.position(t + ahead)
+        speed = np.maximum(np.abs(trajectory.velocity(t)), np.abs(trajectory.velocity(t + ahead)))
+        caps = np.maximum(speed * TRACK_MARGIN, self._floor)
+        robot.set_arm_targets(target, max_velocity=caps.tolist())
+        return True
 
     def _send(self, robot: Robot, joints: list[int], travel: list[float], t: float) -> None:
         """Command the stage. The moving joints get speeds that make them arrive together;
@@ -324,6 +449,8 @@ class JointMove(RobotAction):
                 raise ActionFailed(self._where() + ": " + "; ".join(hits))
         if self.stage >= len(self.stages):
             return Status.SUCCESS
+        if self._follow is not None and self._track(robot):
+            return Status.RUNNING
         # every joint, not only the moving ones, must be where it was told to be: a load can
         # push a holding joint away, and the move is not done until it is back
         q, qd = robot.arm_motion()
@@ -363,9 +490,14 @@ class MoveJointsSequentially(JointMove):
     - SUCCESS when every joint named in ``order`` has reached its target within ``tolerance``;
     - FAILURE when a target is outside its joint limits, a joint does not arrive within
       ``joint_timeout`` s, or the arm (or what it carries) comes into contact with a wall,
-      furniture or the floor (contacts it already had when it started do not count).
+      furniture or the floor (contacts it already had when it started do not count); with
+      ``check_collisions``, each joint's sweep is checked in the arm's planning scene before
+      the joint moves, and one that would meet a wall, furniture or the floor ends the node
+      with FAILURE naming what would touch, the arm unmoved.
     Halted: the arm holds where it is.
     """
+
+    SWEEPS = True
 
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
@@ -459,9 +591,13 @@ class Lift(JointMove):
 
     - RUNNING while moving; SUCCESS when the arm is at the last target within ``tolerance``;
     - FAILURE when a target is outside the limits or unreachable, on a time-out, or on a
-      collision.
+      collision; before the arm moves, when the lift would bring the arm or what it carries
+      against a wall, furniture or the floor (checked in the arm's planning scene), naming what.
     Halted: the arm holds where it is.
     """
+
+    LINE_CHECK = True
+    LINE_NAME = "the lift"
 
     REQUIRED_ONE_OF = (("deltas", "height"),)
     INPUT_PORTS: dict[str, PortInformation] = {
@@ -534,9 +670,13 @@ class MoveToPose(JointMove):
     - FAILURE when no configuration reaches the pose (the reason says why: beyond reach, joint
       limits, not converged), on a time-out, or on a collision with walls, furniture or floor;
       with a planner also when every IK solution (or its approach) is in collision, naming what
-      each touches, or when no path is found within the budget.
+      each touches, or when no path is found within the budget; before the arm moves, when a
+      straight part of the move (the retreat, a ``path="line"`` move, the approach) would bring
+      the arm or what it carries against a wall, furniture or the floor, naming what.
     Halted: the arm holds where it is.
     """
+
+    LINE_CHECK = True
 
     REQUIRED_ONE_OF = (("position", "object"),)
     INPUT_PORTS: dict[str, PortInformation] = {

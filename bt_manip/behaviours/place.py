@@ -132,11 +132,15 @@ class Place(JointMove):
       reaches the pre-place point or the line down (unreachable), the object touched anything
       while carried or before the final motion, it touches another object or the arm touches
       a wall, furniture or the floor during the final motion, a joint times out, or the placed
-      object is out of tolerance (the deviation outputs are set then too).
+      object is out of tolerance (the deviation outputs are set then too); before the arm
+      moves, when the way there (checked in the arm's planning scene) would bring the arm or the
+      object against a wall, furniture or the floor, naming what.
     Halted: the arm holds where it is, with the object still in the hand.
     """
 
     CARRIES = True
+    LINE_CHECK = True
+    LINE_NAME = "the move to the place"
     INPUT_PORTS: dict[str, PortInformation] = {
         **JointMove.INPUT_PORTS,
         "object": OBJECT,

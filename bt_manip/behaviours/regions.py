@@ -11,11 +11,17 @@ Nodes:
 
 - ``DropPoint``: the centre of one cell of a ``rows`` x ``cols`` grid laid over the top of a
   region (inset by ``margin``), ``clearance`` metres above its top: where to let go of an
-  object so that it falls into a bin, each object on its own spot.
+  object so that it falls into a bin, each object on its own spot. Given a ``robot``, the cell
+  is one its arm reaches (:mod:`bt_manip.manipulation.reach`): the asked one when it can, else
+  the nearest one it can, else one it reaches with the tool tilted within ``max_tilt``.
+
+Only DropPoint picks a point in a region; :class:`~bt_manip.behaviours.conditions.ObjectInRegion`
+reads the region to test a point, not to choose one.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -24,17 +30,27 @@ import pybullet as pb
 from py_trees.common import Status
 from py_trees.ports import PortInformation
 
-from bt_manip.behaviours.base import ActionFailed, WorldAccess
-from bt_manip.bt import PortError, SyncActionNode, registry
+from bt_manip.behaviours.base import FAILS, ActionFailed, WorldAccess, failure_reason
+from bt_manip.bt import SyncActionNode, registry
 from bt_manip.bt.node import closest
-from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port
-from bt_manip.geometry import rotation_matrix
+from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port, count_of
+from bt_manip.geometry import quat_from_matrix, rotation_matrix
+from bt_manip.manipulation.arm_planner import ArmPlanner
+from bt_manip.manipulation.reach import Reached, ReachOptions, UnreachableError, first_reached
 from bt_manip.sim import pybullet_queries as pbq
 
 MAX_CELLS_PER_SIDE = 100
 """Largest number of rows or columns of a grid."""
 MAX_CLEARANCE = 2.0
 """Highest a point may be above its region (m)."""
+MAX_REACH_CELLS = 16
+"""Cells of a grid (the asked one and the nearest others) a robot's reach is checked at."""
+MAX_TILT = 60.0
+"""Largest ``max_tilt`` of DropPoint (deg)."""
+TILT_STEPS = 5
+"""Even steps of the tool's tilt up to ``max_tilt`` that DropPoint tries."""
+TOOL_DOWN = [0.0, 1.0, 0.0, 0.0]
+"""The tool pointing straight down (quaternion x;y;z;w): MoveToPose's default orientation."""
 
 
 @dataclass(frozen=True)
@@ -166,10 +182,33 @@ class DropPoint(WorldAccess, SyncActionNode):
     by row from the corner of lowest x and y (``index`` 0 .. rows x cols - 1). ``point`` is
     written as a list x;y;z (world), ready for ``MoveToPose position="{point}"``.
 
-    - SUCCESS with ``point`` written;
+    Without a ``robot`` (the default) the point is that of cell ``index``, whether an arm
+    reaches it or not. With one, it is a point that robot's arm reaches with its grasp frame,
+    checked by inverse kinematics from where the arm is (the solver MoveToPose uses) and in
+    the arm's planning scene (the arm must not touch furniture, walls or floor there):
+
+    1. cell ``index`` with the tool at ``orientation`` (MoveToPose's port and default: pointing
+       down), when the arm reaches it;
+    2. else the nearest cell it reaches with that orientation: the other cells by their
+       distance from cell ``index``; of cells equally near, the one with fewer movable objects
+       lying in the region under it first (each object on its own spot as far as can be),
+       then the lower cell number (at most the :data:`MAX_REACH_CELLS` nearest cells are
+       tried);
+    3. else the tool tilted from ``orientation`` in five even steps up to ``max_tilt``
+       degrees, the wrist toward the robot (the tool axis leaning away from it, as a hand
+       reaching over a box's far edge), the smallest tilt first and each tilt over the cells in
+       the order of 2.
+
+    ``tool_orientation`` gets the orientation used (``orientation`` itself unless tilted), for
+    ``MoveToPose orientation="{...}"``; ``cell`` the cell chosen and ``tilt`` the tilt (deg).
+
+    - SUCCESS with ``point`` (and ``tool_orientation``, ``cell``, ``tilt``) written;
     - FAILURE (reason in the feedback) when ``region`` names no body of the world, ``index``
-      is not a cell of the grid (or not a whole number), the margin leaves no room, or a
-      value read from the blackboard breaks its port's rule.
+      is not a cell of the grid (or not a whole number), the margin leaves no room, a value
+      read from the blackboard breaks its port's rule, ``robot`` names no robot of the world,
+      or, with a robot, no cell tried is reached within ``max_tilt``: the reason gives the
+      best IK error met, at which cell and tilt (or IK's reason when every cell is beyond
+      reach).
     It finishes within its tick (never RUNNING), so there is nothing to halt.
     """
 
@@ -185,9 +224,28 @@ class DropPoint(WorldAccess, SyncActionNode):
                        Accepts(0, 1)),
         "clearance": Port(float, False, "height of the point above the region's top (m)", 0.06,
                           Accepts(0, MAX_CLEARANCE)),
+        "robot": PortInformation(
+            str, False, "robot whose arm must reach the point (empty: none, the cell as asked)",
+            "",
+        ),
+        "orientation": Port(
+            list[float], False, "with a robot: the tool's orientation at the point, quaternion "
+            "x;y;z;w (world), as MoveToPose's", list(TOOL_DOWN), count_of(4),
+        ),
+        "max_tilt": Port(
+            float, False, "with a robot: how far the tool may tilt from orientation, the wrist "
+            "toward the robot, when no cell is reached without (deg)", 25.0,
+            Accepts(0, MAX_TILT),
+        ),
     }
     OUTPUT_PORTS: dict[str, PortInformation] = {
         "point": PortInformation(list[float], False, "the drop point x;y;z (m, world)"),
+        "tool_orientation": PortInformation(
+            list[float], False, "the tool's orientation there, quaternion x;y;z;w (world): "
+            "orientation, or orientation tilted"
+        ),
+        "cell": PortInformation(int, False, "the cell of the point"),
+        "tilt": PortInformation(float, False, "the tool's tilt from orientation (deg)"),
     }
 
     def update(self) -> Status:
@@ -196,17 +254,96 @@ class DropPoint(WorldAccess, SyncActionNode):
             index = self.get_input("index")
             if index != int(index):  # a script's number from the blackboard
                 raise ActionFailed(f"index must be a whole number, got {index}")
-            point = grid_cell(
-                region,
-                int(index),
-                int(self.get_input("rows")),
-                int(self.get_input("cols")),
-                float(self.get_input("margin")),
-                float(self.get_input("clearance")),
-            )
-        except (ActionFailed, PortError) as exc:
-            self.feedback_message = str(exc)
+            rows, cols = int(self.get_input("rows")), int(self.get_input("cols"))
+            margin, clearance = float(self.get_input("margin")), float(self.get_input("clearance"))
+            point = grid_cell(region, int(index), rows, cols, margin, clearance)
+            orientation = [float(v) for v in self.get_input("orientation")]
+            cell, tilt = int(index), 0.0
+            if self.get_input("robot"):
+                cells = _nearest_cells(self.world, region, int(index), rows, cols, margin,
+                                       clearance)
+                reached = self._reach(region, cells, orientation)
+                cell, point = cells[reached.index]
+                tilt = math.degrees(reached.tilt)
+                if reached.tilt > 0.0:
+                    orientation = [float(v) for v in quat_from_matrix(reached.rotation)]
+        except FAILS as exc:
+            self.feedback_message = failure_reason(exc)
             return Status.FAILURE
         self.feedback_message = ""
         self.set_output("point", [float(v) for v in point])
+        self.set_output("tool_orientation", orientation)
+        self.set_output("cell", cell)
+        self.set_output("tilt", tilt)
         return Status.SUCCESS
+
+    def _reach(self, region: Region, cells: list[tuple[int, np.ndarray]],
+               orientation: list[float]) -> Reached:
+        """The first of ``cells`` the robot's arm reaches (see the class docstring)."""
+        robot = self.robot()
+        services = self.services()
+        if services.arm_planner is None:
+            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
+        planner: ArmPlanner = services.arm_planner
+        scene = planner.scene()
+        seed = robot.arm_positions()
+        planner.sync(scene, "", (seed,), movables=False)
+
+        def free(q: np.ndarray) -> str | None:
+            if not scene.collides(q):
+                return None
+            return ", ".join(f"{a} touches {b}" for a, b in scene.contacts(q)[:3])
+
+        rows = int(self.get_input("rows"))
+        cols = int(self.get_input("cols"))
+        options = ReachOptions(math.radians(float(self.get_input("max_tilt"))), TILT_STEPS)
+        try:
+            return first_reached(
+                services, robot.description.grasp_frame, [p for _, p in cells],
+                rotation_matrix(orientation), seed, options, free,
+                lambda i: f"cell {cells[i][0]}",
+            )
+        except UnreachableError as exc:
+            tried = f" (the {len(cells)} nearest tried)" if len(cells) < rows * cols else ""
+            raise ActionFailed(
+                f"{self.robot_name_of(robot)} reaches no cell of the {rows} x {cols} grid over "
+                f"'{region.name}'{tried}: {exc}"
+            ) from None
+
+
+def _nearest_cells(world: Any, region: Region, index: int, rows: int, cols: int,
+                   margin: float, clearance: float) -> list[tuple[int, np.ndarray]]:
+    """Cell ``index`` and the other cells of the grid by their distance from it, equal
+    distances by the objects lying in them (fewer first), then by cell number; at most
+    :data:`MAX_REACH_CELLS`, with their points."""
+    step_x, step_y = ((region.size[:2] - 2.0 * margin) / (cols, rows)).tolist()
+    lying = _objects_per_cell(world, region, rows, cols, margin)
+    ranked = sorted(
+        (((i % cols - index % cols) * step_x) ** 2 + ((i // cols - index // cols) * step_y) ** 2,
+         lying.get(i, 0), i)
+        for i in range(rows * cols)
+        if i != index
+    )
+    chosen = [index] + [i for _, _, i in ranked[:MAX_REACH_CELLS - 1]]
+    return [(i, grid_cell(region, i, rows, cols, margin, clearance)) for i in chosen]
+
+
+def _objects_per_cell(world: Any, region: Region, rows: int, cols: int,
+                      margin: float) -> dict[int, int]:
+    """How many of the world's movable objects (the region's own body aside) have their
+    centre in the region's box under each cell of the grid."""
+    lo = region.lower[:2] + margin
+    width = region.size[:2] - 2.0 * margin
+    counts: dict[int, int] = {}
+    for name, body in world.movable.items():
+        if name == region.name:
+            continue
+        pos = pb.getBasePositionAndOrientation(body, physicsClientId=world.client)[0]
+        if not region.contains(np.asarray(pos, dtype=float)):
+            continue
+        local = region.to_local(np.asarray(pos, dtype=float))
+        col, row = ((local[:2] - lo) / width * (cols, rows)).tolist()
+        if 0.0 <= col < cols and 0.0 <= row < rows:
+            cell = int(row) * cols + int(col)
+            counts[cell] = counts.get(cell, 0) + 1
+    return counts

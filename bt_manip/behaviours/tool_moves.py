@@ -31,9 +31,13 @@ class MoveToolBy(JointMove):
     - RUNNING while the arm moves;
     - SUCCESS when the arm is at the end of the line within ``tolerance``;
     - FAILURE when a point of the line is out of reach (the reason says which), on a time-out,
-      or when the arm or what it carries touches a wall, furniture or the floor.
+      or when the arm or what it carries touches a wall, furniture or the floor (the line is
+      checked in the arm's planning scene before the arm moves, naming what it would touch).
     Halted: the arm holds where it is.
     """
+
+    LINE_CHECK = True
+    LINE_NAME = "the tool's straight move"
 
     CARRIES = True
     INPUT_PORTS: dict[str, PortInformation] = {

@@ -48,7 +48,7 @@ def read_report(path: Path) -> dict[str, Any]:
     return data
 
 
-def _bar(ax: Any, pose: list[float], size: list[float], **style: Any) -> None:
+def bar(ax: Any, pose: list[float], size: list[float], **style: Any) -> None:
     """A rectangle of ``size`` (length, width) centred at ``pose`` (x, y, _, yaw)."""
     from matplotlib.patches import Polygon
 
@@ -58,6 +58,34 @@ def _bar(ax: Any, pose: list[float], size: list[float], **style: Any) -> None:
     pts = [(x + c * u - s * v, y + s * u + c * v) for u, v in
            ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
     ax.add_patch(Polygon(pts, closed=True, **style))
+
+
+def draw_walls(ax: Any, spec: Any) -> None:
+    """The world's walls, cut at their doors, as grey bars."""
+    for wall in spec.walls:
+        (x0, y0), (x1, y1) = wall.start, wall.end
+        length = wall.length
+        yaw = math.atan2(y1 - y0, x1 - x0)
+        cuts = sorted((d.at - d.width / 2, d.at + d.width / 2) for d in wall.doors)
+        pos = 0.0
+        for a, b in [*cuts, (length, length)]:
+            if a > pos + 1e-6:
+                mid = (pos + a) / 2
+                bar(ax, [x0 + math.cos(yaw) * mid, y0 + math.sin(yaw) * mid, 0.0, yaw],
+                     [a - pos, wall.thickness], facecolor="0.55", edgecolor="none")
+            pos = max(pos, b)
+
+
+def draw_boxes(ax: Any, item: Any, **style: Any) -> None:
+    """The boxes of a static body (its parts, turned with it), as outlines or fills."""
+    yaw = yaw_of(item.pose.quat)
+    c, s = math.cos(yaw), math.sin(yaw)
+    for part in item.parts:
+        if part.shape != "box":
+            continue
+        x = item.pose.xyz[0] + c * part.xyz[0] - s * part.xyz[1]
+        y = item.pose.xyz[1] + s * part.xyz[0] + c * part.xyz[1]
+        bar(ax, [x, y, 0.0, yaw + part.rpy[2]], [part.size[0], part.size[1]], **style)
 
 
 def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
@@ -71,23 +99,12 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
     spec = parse_world(world_path)
     sizes = {o.name: o.parts[0].size for o in spec.objects if o.parts}
     fig, ax = plt.subplots(figsize=(9, 6), dpi=100)
-    for wall in spec.walls:
-        (x0, y0), (x1, y1) = wall.start, wall.end
-        length = wall.length
-        yaw = math.atan2(y1 - y0, x1 - x0)
-        cuts = sorted((d.at - d.width / 2, d.at + d.width / 2) for d in wall.doors)
-        pos = 0.0
-        for a, b in [*cuts, (length, length)]:
-            if a > pos + 1e-6:
-                mid = (pos + a) / 2
-                _bar(ax, [x0 + math.cos(yaw) * mid, y0 + math.sin(yaw) * mid, 0.0, yaw],
-                     [a - pos, wall.thickness], facecolor="0.55", edgecolor="none")
-            pos = max(pos, b)
+    draw_walls(ax, spec)
     for f in spec.furniture:
         for part in f.parts:
             if part.shape != "box" or abs(part.xyz[0]) + abs(part.xyz[1]) > 1e-9:
                 continue
-            _bar(ax, [f.pose.xyz[0], f.pose.xyz[1], 0.0, yaw_of(f.pose.quat)],
+            bar(ax, [f.pose.xyz[0], f.pose.xyz[1], 0.0, yaw_of(f.pose.quat)],
                  [part.size[0], part.size[1]], fill=False, edgecolor="0.7", linewidth=0.8)
     ends = [p for w in spec.walls for p in (w.start, w.end)] or [(0.0, 0.0)]
     middle = (sum(p[0] for p in ends) / len(ends), sum(p[1] for p in ends) / len(ends))
@@ -96,13 +113,13 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
     for row in report["as_built"]:
         size = sizes.get(row.get("object"), [0.5, 0.05, 0.1])
         planned = row["planned"]
-        _bar(ax, planned, [size[0], max(size[1], 0.03)], fill=False, edgecolor="0.3",
+        bar(ax, planned, [size[0], max(size[1], 0.03)], fill=False, edgecolor="0.3",
              linestyle="--", linewidth=0.8)
         placed = row.get("placed")
         label = f"{row.get('order')}. {row.get('name')}"
         if row.get("status") == "installed" or row.get("status") == "out of tolerance":
             colour = cmap(norm(min(float(row["deviation_mm"]), SCALE_MM)))
-            _bar(ax, placed, [size[0], max(size[1], 0.05)], facecolor=colour,
+            bar(ax, placed, [size[0], max(size[1], 0.05)], facecolor=colour,
                  edgecolor="black", linewidth=0.6)
             label += f"\n{row['deviation_mm']:.1f} mm, {row['deviation_deg']:.2f} deg"
         else:
@@ -123,8 +140,8 @@ def plot(report: dict[str, Any], world_path: Path, out: Path) -> None:
         f"As built: {installed} of {len(report['as_built'])} installed "
         f"({Path(str(report.get('world', world_path))).name}, seed {report.get('seed')})"
     )
-    bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.7)
-    bar.set_label("deviation from the planned pose (mm)")
+    colour_bar = fig.colorbar(cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.7)
+    colour_bar.set_label("deviation from the planned pose (mm)")
     fig.tight_layout()
     fig.savefig(out)
     plt.close(fig)

@@ -6,9 +6,20 @@ or not by an IfcDoor or IfcWindow (IfcRelFillsElement). An opening is a passage 
 when it starts at the floor and reaches :data:`PASSAGE_HEIGHT` (or the top of a lower wall);
 any other opening (a window, a hatch) cuts the wall but leaves a sill below it and a lintel
 above it as static boxes, so the robot cannot drive through. Spaces (IfcSpace) become named
-poses, furniture (IfcFurnishingElement) boxes around its geometry, and slabs (IfcSlab) give the
-floor's extent. Elevations are measured from the storey's placement, which is z = 0 in the
-world.
+poses, and slabs (IfcSlab) give the floor's extent. Elevations are measured from the storey's
+placement, which is z = 0 in the world.
+
+Only what stands in the robot's height band (from the floor to ``band_top``: the top of the
+tucked robot or of an element it carries, whichever is higher) matters to it; an element lying
+entirely above it (a gable piece, a beam under the ceiling) is left out, and so is an element
+whose body cannot be read (none, or one the geometry kernel refuses): each is listed in the
+building's ``skipped`` with its reason, never a refusal of the building. A wall that is not a
+plain box is read as the obstacle it is: a straight one with holes cut into its body gets those
+holes as openings (:func:`~bt_manip.bim.footprints.wall_gaps`), any other becomes its footprint
+(:func:`~bt_manip.bim.footprints.hull_boxes`). Curtain walls (IfcCurtainWall: its body, else its
+plates and members), columns, stairs, ramps, railings, beams, coverings (but floor and ceiling
+finishes), proxies, plates and members become obstacles of their footprint, furniture
+(IfcFurnishingElement) too.
 """
 
 from __future__ import annotations
@@ -18,26 +29,44 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
+from bt_manip.bim.footprints import strip_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
     Box,
     ShapeReader,
     UnsupportedGeometry,
     footprint_box,
+    hull_xy,
     is_box_like,
-    placement_yaw,
 )
-from bt_manip.errors import Problem
+from bt_manip.bim.storeys import choose_storey, direct_containers, storey_elevation, storey_of
+
+__all__ = ["Building", "Furniture", "Names", "Opening", "Space", "Wall", "choose_storey",
+           "read_building", "storey_elevation", "storey_of"]
 
 PASSAGE_HEIGHT = 1.5
 """An opening from the floor at least this high (m) is a passage for the robot."""
 FLOOR_TOLERANCE = 0.05
 """An opening or wall within this height (m) of the floor starts at the floor."""
+RAISED_FLOOR = 0.6
+"""When every door of the storey starts higher than the storey's elevation, by at most this
+much (m), the doors stand on a finished floor laid on the structure the walls start from: they
+are passages from there."""
 MAX_WALLS = 5000
 MAX_OPENINGS = 10000
 MAX_SPACES = 2000
 MAX_FURNITURE = 5000
 MAX_SLABS = 2000
+MAX_OBSTACLES = 20000
+"""Obstacles of the other classes (columns, stairs, proxies...) and curtain wall parts at most."""
+OBSTACLE_CLASSES = ("IfcColumn", "IfcStair", "IfcStairFlight", "IfcRamp", "IfcRampFlight",
+                    "IfcRailing", "IfcBeam", "IfcCovering", "IfcBuildingElementProxy",
+                    "IfcPlate", "IfcMember")
+"""Classes read as obstacles besides walls, curtain walls and furniture."""
+FINISHES = ("FLOORING", "CEILING", "ROOFING")
+"""Covering types that are no obstacle: the robot drives on a floor finish."""
 
 
 @dataclass
@@ -97,9 +126,19 @@ class Space:
 
 @dataclass
 class Furniture:
+    """A static obstacle: its bounding box, and the boxes it is made of (``parts``, world frame;
+    empty: the box itself)."""
+
     entity: Any
     name: str
     box: Box
+    parts: list[Box] = field(default_factory=list)
+    kind: str = "furniture"
+    """furniture, raised wall, wall, curtain wall or obstacle"""
+
+    @property
+    def boxes(self) -> list[Box]:
+        return self.parts or [self.box]
 
 
 @dataclass
@@ -116,6 +155,43 @@ class Building:
     spaces: list[Space] = field(default_factory=list)
     furniture: list[Furniture] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    curtain_walls: list[Furniture] = field(default_factory=list)
+    """Curtain walls, their body or their plates and members, as obstacles."""
+    obstacles: list[Furniture] = field(default_factory=list)
+    """Columns, stairs, railings, beams, coverings, proxies... and walls that are no box."""
+    band_top: float = 0.0
+    counts: dict[str, int] = field(default_factory=dict)
+    """Elements of the storey read, by kind (walls, curtain walls, plates, members, doors,
+    windows, other obstacles)."""
+    skipped: list[tuple[str, str]] = field(default_factory=list)
+    """(element, reason) of what was left out."""
+
+    def skip(self, element: Any, reason: str) -> None:
+        label = f"#{element.id()} {element.is_a()}" + (f" '{element.Name}'" if element.Name
+                                                      else "")
+        self.skipped.append((label, reason))
+
+    def read_text(self) -> str:
+        """What was read, and what was left out, in one paragraph."""
+        c = self.counts
+        text = (
+            f"{c.get('walls', 0)} walls, {c.get('curtain walls', 0)} curtain walls "
+            f"({c.get('plates', 0)} plates, {c.get('members', 0)} members), "
+            f"{c.get('doors', 0)} doors, {c.get('windows', 0)} windows, "
+            f"{c.get('other obstacles', 0)} other obstacles of storey "
+            f"'{self.storey.Name or self.storey.id()}'"
+        )
+        if self.skipped:
+            groups: dict[str, list[str]] = {}
+            for label, why in self.skipped:
+                groups.setdefault(re.sub(r" \(from [^)]*\)|, the band ends at [0-9.]+ m", "",
+                                         why), []).append(label)
+            parts = []
+            for why, labels in groups.items():
+                named = ", ".join(labels) if len(labels) <= 3 else f"{len(labels)} elements"
+                parts.append(f"{named} ({why})")
+            text += "; skipped: " + "; ".join(parts)
+        return text
 
 
 class Names:
@@ -133,61 +209,32 @@ class Names:
         return out
 
 
-def choose_storey(source: IfcSource) -> Any:
-    """The storey to build: the one holding the most walls. A file without one is a problem."""
-    storeys = source.model.by_type("IfcBuildingStorey")
-    if not storeys:
-        message = "no IfcBuildingStorey: the world is built from the walls of one storey"
-        projects = source.model.by_type("IfcProject")
-        if projects:
-            source.fail(projects[0], message)
-        else:
-            source.problems.append(Problem(str(source.path), None, message))
-        source.raise_problems()
-    if len(storeys) == 1:
-        return storeys[0]
-    counts = {s.id(): 0 for s in storeys}
-    for wall in source.model.by_type("IfcWall"):
-        storey = storey_of(wall)
-        if storey is not None and storey.id() in counts:
-            counts[storey.id()] += 1
-    return max(storeys, key=lambda s: (counts[s.id()], -s.id()))
+def _by_type(model: Any, ifc_class: str) -> list[Any]:
+    """Entities of ``ifc_class`` (and its subtypes); none when the schema has no such class."""
+    try:
+        return list(model.by_type(ifc_class))
+    except RuntimeError:
+        return []
 
 
-def storey_of(element: Any) -> Any:
-    """The IfcBuildingStorey containing ``element`` (through spaces), or None."""
-    import ifcopenshell.util.element as util
-
-    current = util.get_container(element) or util.get_aggregate(element)
-    for _ in range(16):
-        if current is None or current.is_a("IfcBuildingStorey"):
-            return current
-        current = util.get_container(current) or util.get_aggregate(current)
-    return None
-
-
-def storey_elevation(source: IfcSource, storey: Any) -> float:
-    """Height (m) of the storey's floor: its placement, else its Elevation attribute."""
-    import ifcopenshell.util.placement as placement
-
-    if storey.ObjectPlacement is not None:
-        return float(placement.get_local_placement(storey.ObjectPlacement)[2][3]) * source.scale
-    return float(storey.Elevation or 0.0) * source.scale
-
-
-def read_building(source: IfcSource, storey: Any, exclude: set[int], names: Names) -> Building:
-    """The walls, spaces, furniture and extent of ``storey``; elements in ``exclude`` (step
-    ids of the elements to install) are left out. Problems are collected in ``source``."""
+def read_building(
+    source: IfcSource, storey: Any, exclude: set[int], names: Names, band_top: float = 2.0
+) -> Building:
+    """The walls, obstacles, spaces, furniture and extent of ``storey``; elements in
+    ``exclude`` (step ids of the elements to install) are left out, and so is anything above
+    ``band_top`` (m above the floor). Problems are collected in ``source``."""
     model = source.model
     single = len(model.by_type("IfcBuildingStorey")) == 1
+    climbed: dict[int, Any] = {}
+    contained = {} if single else direct_containers(model)
 
     def on_storey(el: Any) -> bool:
         if single:
             return True
-        s = storey_of(el)
+        s = storey_of(el, climbed, contained)
         return s is not None and s.id() == storey.id()
 
-    reader = ShapeReader(source.scale)
+    reader = ShapeReader(source.scale, model)
     floor_z = storey_elevation(source, storey)
     walls_found = [w for w in model.by_type("IfcWall") if w.id() not in exclude]
     check_count(source, "IfcWall", walls_found, MAX_WALLS)
@@ -198,57 +245,94 @@ def read_building(source: IfcSource, storey: Any, exclude: set[int], names: Name
     check_count(source, "IfcFurnishingElement", furniture_found, MAX_FURNITURE)
     slabs_found = model.by_type("IfcSlab")
     check_count(source, "IfcSlab", slabs_found, MAX_SLABS)
-    out = Building(storey, floor_z, (0.0, 0.0, 0.0, 0.0))
+    others = [el for cls in OBSTACLE_CLASSES for el in _by_type(model, cls)]
+    curtains = _by_type(model, "IfcCurtainWall")
+    check_count(source, "obstacle (column, stair, proxy...)", others + curtains, MAX_OBSTACLES)
+    out = Building(storey, floor_z, (0.0, 0.0, 0.0, 0.0), band_top=band_top)
+    counts = dict.fromkeys(("walls", "curtain walls", "plates", "members", "doors", "windows",
+                            "other obstacles"), 0)
     xs: list[float] = []
     ys: list[float] = []
     for wall in walls_found:
         if not on_storey(wall):
             continue
-        box = _box_of(source, reader, wall, floor_z, need_box=True)
-        if box is None:
+        counts["walls"] += 1
+        for w in _read_wall(source, reader, wall, out, names):
+            out.walls.append(w)
+            xs += [w.start[0], w.end[0]]
+            ys += [w.start[1], w.end[1]]
+    _doors_on_a_raised_floor(out)
+    for cls, key in (("IfcDoor", "doors"), ("IfcWindow", "windows")):
+        counts[key] = sum(1 for el in _by_type(model, cls) if on_storey(el))
+    done: set[int] = set(exclude)
+    for curtain in curtains:
+        if curtain.id() in exclude or not on_storey(curtain):
             continue
-        name = names.make(wall.Name, f"wall_{wall.id()}")
-        if box.top <= FLOOR_TOLERANCE:
-            out.notes.append(f"#{wall.id()} {wall.Name or ''}: below the floor, left out")
+        counts["curtain walls"] += 1
+        done.add(curtain.id())
+        parts = [p for rel in getattr(curtain, "IsDecomposedBy", None) or []
+                 for p in rel.RelatedObjects]
+        counts["plates"] += sum(1 for p in parts if p.is_a("IfcPlate"))
+        counts["members"] += sum(1 for p in parts if p.is_a("IfcMember"))
+        done.update(p.id() for p in parts)
+        pieces = [curtain] if curtain.Representation is not None else parts
+        if not pieces:
+            out.skip(curtain, "no body geometry and no plates or members")
+        for piece in pieces:
+            if piece.id() in exclude:
+                continue
+            found = _obstacle(reader, piece, out, names, "curtain wall")
+            if found is not None:
+                out.curtain_walls.append(found)
+    for el in others:
+        if el.id() in done or not on_storey(el):
             continue
-        if box.bottom > FLOOR_TOLERANCE:
-            out.raised.append(Furniture(wall, name, box))
+        done.add(el.id())
+        counts["other obstacles"] += 1
+        if el.is_a("IfcCovering") and str(getattr(el, "PredefinedType", "")) in FINISHES:
+            out.skip(el, f"a {str(el.PredefinedType).lower()} finish, no obstacle")
             continue
-        c, s = box.axis()
-        half = box.size[0] / 2
-        start = (box.centre[0] - c * half, box.centre[1] - s * half)
-        end = (box.centre[0] + c * half, box.centre[1] + s * half)
-        w = Wall(wall, name, start, end, box.size[1], max(box.bottom, 0.0), box.top)
-        w.openings = _openings(source, reader, w, floor_z)
-        out.walls.append(w)
-        xs += [start[0], end[0]]
-        ys += [start[1], end[1]]
+        pieces = [el]
+        if el.Representation is None:  # a stair or a ramp made of its parts
+            pieces = [p for rel in getattr(el, "IsDecomposedBy", None) or []
+                      for p in rel.RelatedObjects if p.id() not in done]
+            done.update(p.id() for p in pieces)
+            if not pieces:
+                out.skip(el, "it has no body geometry (no 'Body' representation)")
+        for piece in pieces:
+            found = _obstacle(reader, piece, out, names, "obstacle")
+            if found is not None:
+                out.obstacles.append(found)
     slab_xy: list[tuple[float, float, float, float]] = []
     for slab in slabs_found:
         if slab.id() in exclude or not on_storey(slab):
             continue
-        box = _box_of(source, reader, slab, floor_z, need_box=False)
-        if box is not None:
-            slab_xy.append(_xy_bounds(box))
+        try:
+            pts = reader.points(slab)
+        except UnsupportedGeometry as exc:
+            out.skip(slab, str(exc))
+            continue
+        slab_xy.append((float(pts[:, 0].min()), float(pts[:, 1].min()),
+                        float(pts[:, 0].max()), float(pts[:, 1].max())))
     for space in spaces_found:
         if not on_storey(space):
             continue
         try:
-            solid = reader.solid(space)
+            pts = reader.points(space)
         except UnsupportedGeometry as exc:
             out.notes.append(f"#{space.id()} IfcSpace '{space.Name or ''}' left out: {exc}")
             continue
-        box = _shift(footprint_box(solid.points, placement_yaw(space)), floor_z)
+        box = _shift(footprint_box(pts, reader.yaw(space)), floor_z)
         label = space.LongName if getattr(space, "LongName", None) else space.Name
         out.spaces.append(Space(space, label or f"space {space.id()}", "", box))
     for item in furniture_found:
         if item.id() in exclude or not on_storey(item):
             continue
-        box = _box_of(source, reader, item, floor_z, need_box=False)
-        if box is not None:
-            out.furniture.append(
-                Furniture(item, names.make(item.Name, f"furniture_{item.id()}"), box)
-            )
+        counts["other obstacles"] += 1
+        found = _obstacle(reader, item, out, names, "furniture")
+        if found is not None:
+            out.furniture.append(found)
+    out.counts = counts
     if slab_xy:
         out.extent = (
             min(b[0] for b in slab_xy),
@@ -261,12 +345,23 @@ def read_building(source: IfcSource, storey: Any, exclude: set[int], names: Name
     return out
 
 
-def _xy_bounds(box: Box) -> tuple[float, float, float, float]:
-    c, s = box.axis()
-    hx, hy = box.size[0] / 2, box.size[1] / 2
-    ex = abs(c) * hx + abs(s) * hy
-    ey = abs(s) * hx + abs(c) * hy
-    return (box.centre[0] - ex, box.centre[1] - ey, box.centre[0] + ex, box.centre[1] + ey)
+def _doors_on_a_raised_floor(building: Building) -> None:
+    """Doors all starting a little above the walls' foot are passages (see RAISED_FLOOR)."""
+    doors = [o for w in building.walls for o in w.openings if o.kind == "door"]
+    if not doors or any(o.passage for o in doors):
+        return
+    floor = min(o.bottom - w.bottom for w in building.walls for o in w.openings
+                if o.kind == "door")
+    if not FLOOR_TOLERANCE < floor <= RAISED_FLOOR:
+        return
+    for w in building.walls:
+        for o in w.openings:
+            if o.bottom - w.bottom <= floor + FLOOR_TOLERANCE and o.top - w.bottom >= min(
+                floor + PASSAGE_HEIGHT, w.top - w.bottom - FLOOR_TOLERANCE
+            ):
+                o.passage = True
+    building.notes.append(f"the doors start {floor:.2f} m above the foot of the walls, on a "
+                          "finished floor: they are passages from there")
 
 
 def _shift(box: Box, floor_z: float) -> Box:
@@ -274,43 +369,126 @@ def _shift(box: Box, floor_z: float) -> Box:
     return Box((x, y, z - floor_z), box.size, box.yaw)
 
 
-def _box_of(
-    source: IfcSource, reader: ShapeReader, element: Any, floor_z: float, need_box: bool
-) -> Box | None:
-    """The element's upright box (floor at z = 0); a problem when it cannot be read, or when
-    ``need_box`` and the body is not box-like."""
+def _obstacle(reader: ShapeReader, element: Any, building: Building, names: Names,
+              kind: str) -> Furniture | None:
+    """The element as an obstacle of its footprint, or None (skipped, with its reason)."""
     try:
-        solid = reader.solid(element)
+        pts = reader.points(element)
     except UnsupportedGeometry as exc:
-        source.fail(element, f"unsupported geometry: {exc}")
+        building.skip(element, str(exc))
         return None
-    box = footprint_box(solid.points, placement_yaw(element))
-    if need_box and not is_box_like(solid, box):
-        fill = solid.volume / box.volume if box.volume > 0 else 0.0
-        source.fail(
-            element,
-            f"unsupported geometry: its body fills {fill:.0%} of its upright bounding box "
-            f"({box.size[0]:.3f} x {box.size[1]:.3f} x {box.size[2]:.3f} m); a straight, "
-            "upright element of constant thickness is expected (curved, L-shaped, sloped or "
-            "tilted ones are not read)",
-        )
-        return None
-    return _shift(box, floor_z)
+    return _footprint(pts, element, building, names, kind, reader.yaw(element))
 
 
-def _openings(source: IfcSource, reader: ShapeReader, wall: Wall, floor_z: float) -> list[Opening]:
-    """The wall's openings along its centre line, overlapping ones merged."""
+def _footprint(pts: Any, element: Any, building: Building, names: Names,
+               kind: str, yaw: float | None) -> Furniture | None:
+    bottom = float(pts[:, 2].min()) - building.floor_z
+    top = float(pts[:, 2].max()) - building.floor_z
+    if top <= FLOOR_TOLERANCE:
+        building.skip(element, "at or below the floor")
+        return None
+    if bottom >= building.band_top:
+        building.skip(element, f"above the robot's height band, which ends at "
+                               f"{building.band_top:.2f} m (from {bottom:.2f} m)")
+        return None
+    bottom = max(bottom, 0.0)
+    corners = hull_xy(pts[:, :2])
+    flat = np.column_stack([corners, np.zeros(len(corners))])
+    box = footprint_box(flat, yaw)
+    # the hull of the corners is the corners themselves, and their least box this one
+    parts = [_shift(b, building.floor_z) for b in
+             strip_boxes(corners, box, bottom + building.floor_z, top + building.floor_z)]
+    fallback = {"furniture": "furniture", "curtain wall": "curtain", "raised wall": "wall"}
+    name = names.make(element.Name, f"{fallback.get(kind, 'obstacle')}_{element.id()}")
+    box = Box((box.centre[0], box.centre[1], (bottom + top) / 2), (box.size[0], box.size[1],
+              top - bottom), box.yaw)
+    return Furniture(element, name, box, parts if len(parts) > 1 else [], kind)
+
+
+def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Building,
+               names: Names) -> list[Wall]:
+    """The wall as a straight wall with its openings; a wall that is not one (raised, round,
+    L-shaped) is added to the building's obstacles instead, and one that cannot be read or
+    lies out of the band is skipped."""
+    floor_z = building.floor_z
+    try:
+        solid = reader.solid(wall)
+    except UnsupportedGeometry as exc:
+        building.skip(wall, str(exc))
+        return []
+    box = _shift(footprint_box(solid.points, reader.yaw(wall)), floor_z)
+    if box.top <= FLOOR_TOLERANCE:
+        building.notes.append(f"#{wall.id()} {wall.Name or ''}: below the floor, left out")
+        building.skip(wall, "below the floor")
+        return []
+    if box.bottom >= building.band_top:
+        building.skip(wall, f"above the robot's height band, which ends at "
+                            f"{building.band_top:.2f} m (from {box.bottom:.2f} m)")
+        return []
+    box_like = is_box_like(solid, box)
+    if box.bottom > FLOOR_TOLERANCE:
+        if box_like:
+            name = names.make(wall.Name, f"wall_{wall.id()}")
+            building.raised.append(Furniture(wall, name, box, [], "raised wall"))
+        else:
+            found = _footprint(solid.points, wall, building, names, "raised wall",
+                               reader.yaw(wall))
+            if found is not None:
+                building.raised.append(found)
+        return []
+    gaps: list[tuple[float, float, float, float]] = []
+    if not box_like:
+        straight = box.size[0] >= 3 * box.size[1]
+        if not straight:
+            found = _footprint(solid.points, wall, building, names, "wall", reader.yaw(wall))
+            if found is not None:
+                building.obstacles.append(found)
+            return []
+        try:
+            verts, faces = reader.mesh(wall)
+        except UnsupportedGeometry as exc:
+            building.skip(wall, str(exc))
+            return []
+        c, s = box.axis()
+        half = box.size[0] / 2
+        start = (box.centre[0] - c * half, box.centre[1] - s * half)
+        shifted = verts - [0.0, 0.0, floor_z]
+        gaps = wall_gaps(shifted, faces, start, box.yaw, box.size[0], max(box.bottom, 0.0),
+                         box.top)
+    name = names.make(wall.Name, f"wall_{wall.id()}")
+    c, s = box.axis()
+    half = box.size[0] / 2
+    start = (box.centre[0] - c * half, box.centre[1] - s * half)
+    end = (box.centre[0] + c * half, box.centre[1] + s * half)
+    w = Wall(wall, name, start, end, box.size[1], max(box.bottom, 0.0), box.top)
+    holes = [_opening_of(w, a, b, lo, hi, "hole", None) for a, b, lo, hi in gaps]
+    w.openings = _openings(source, reader, w, floor_z, building, holes)
+    return [w]
+
+
+def _opening_of(wall: Wall, start: float, end: float, bottom: float, top: float, kind: str,
+                entity: Any) -> Opening:
+    passage = bottom <= wall.bottom + FLOOR_TOLERANCE and top >= min(
+        PASSAGE_HEIGHT, wall.top - FLOOR_TOLERANCE
+    )
+    return Opening(start, end, max(bottom, wall.bottom), min(top, wall.top), passage, kind,
+                   entity)
+
+
+def _openings(source: IfcSource, reader: ShapeReader, wall: Wall, floor_z: float,
+              building: Building, holes: list[Opening]) -> list[Opening]:
+    """The wall's openings along its centre line (its IfcOpeningElements and the holes of
+    its body), overlapping ones merged."""
     ux = (wall.end[0] - wall.start[0]) / wall.length
     uy = (wall.end[1] - wall.start[1]) / wall.length
-    found: list[Opening] = []
+    found: list[Opening] = list(holes)
     for rel in getattr(wall.entity, "HasOpenings", None) or []:
         opening = rel.RelatedOpeningElement
         try:
-            solid = reader.solid(opening)
+            pts = reader.points(opening)
         except UnsupportedGeometry as exc:
-            source.fail(opening, f"unsupported geometry: {exc}")
+            building.skip(opening, str(exc))
             continue
-        pts = solid.points
         along = (pts[:, 0] - wall.start[0]) * ux + (pts[:, 1] - wall.start[1]) * uy
         start = max(float(along.min()), 0.0)
         end = min(float(along.max()), wall.length)
@@ -325,11 +503,7 @@ def _openings(source: IfcSource, reader: ShapeReader, wall: Wall, floor_z: float
                 kind = "door"
             elif filler.is_a("IfcWindow"):
                 kind = "window"
-        passage = bottom <= wall.bottom + FLOOR_TOLERANCE and top >= min(
-            PASSAGE_HEIGHT, wall.top - FLOOR_TOLERANCE
-        )
-        found.append(Opening(start, end, max(bottom, wall.bottom), min(top, wall.top), passage,
-                             kind, opening))
+        found.append(_opening_of(wall, start, end, bottom, top, kind, opening))
     found.sort(key=lambda o: o.start)
     merged: list[Opening] = []
     for o in found:
@@ -339,8 +513,8 @@ def _openings(source: IfcSource, reader: ShapeReader, wall: Wall, floor_z: float
             m.bottom = min(m.bottom, o.bottom)
             m.top = max(m.top, o.top)
             m.passage = m.passage or o.passage
-            if o.kind == "door":
-                m.kind = "door"
+            if o.kind == "door" or m.kind == "hole":
+                m.kind = o.kind
         else:
             merged.append(o)
     return merged

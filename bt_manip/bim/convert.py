@@ -9,6 +9,14 @@ input is collected and reported as ``file:line: #id IfcClass 'Name': message``.
 
 Last, the installation tree ``DIR/install.xml`` (:mod:`~bt_manip.bim.install_tree`: fetch each
 element from its stand, carry it, place and fasten it at its target pose, in schedule order).
+
+An element the robot cannot install is refused with its reason: not a box, on another storey,
+heavier than the payload, a top edge out of the arm's reach where it is fetched or placed, too
+thick for the gripper (:mod:`~bt_manip.bim.robot_fit`), or no route wide enough from the stock.
+Refusals are problems (exit 2, nothing written) unless ``skip_uninstallable``: then the others
+are installed and the refused ones listed in schedule.json's ``refused``. With nothing to install
+(no schedule, or everything refused), only the world is written (the building, the robot and the
+spaces as named poses), unless ``require_install``.
 """
 
 from __future__ import annotations
@@ -22,12 +30,13 @@ from typing import Any
 import yaml
 
 from bt_manip.bim import require_ifcopenshell
-from bt_manip.bim.building import Building, Names, choose_storey, read_building, storey_of
+from bt_manip.bim.building import Building, Names, read_building
 from bt_manip.bim.doorways import crossings, door_poses
 from bt_manip.bim.floor_grid import FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
 from bt_manip.bim.install_tree import install_tree
-from bt_manip.bim.routes import CLEARANCE, check_routes, floor_grid
+from bt_manip.bim.robot_fit import RobotFit, robot_fit
+from bt_manip.bim.routes import CLEARANCE, check_routes, floor_grid, route_problems
 from bt_manip.bim.schedule import (
     MAX_ELEMENTS,
     InstallElement,
@@ -38,6 +47,7 @@ from bt_manip.bim.schedule import (
 from bt_manip.bim.shapes import ShapeReader, UnsupportedGeometry, footprint_box, is_box_like
 from bt_manip.bim.shapes import placement_yaw as _placement_yaw
 from bt_manip.bim.stock import (
+    Slot,
     StockPose,
     apron_pose,
     element_entry,
@@ -48,6 +58,7 @@ from bt_manip.bim.stock import (
     stock_group,
     stock_poses,
 )
+from bt_manip.bim.storeys import StoreyChoice, choose_storey, storey_elevation, storey_of
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_folder, make_folder
@@ -68,6 +79,13 @@ MAX_STOCK_TRIALS = 24
 first is kept and its problems reported."""
 PAYLOADS: dict[str, float] = {"husky_ur3": 3.0}
 """Rated payload (kg) of the arms of known robots: the UR3's is 3 kg (Universal Robots)."""
+BAND_MARGIN = 0.1
+"""Added (m) to the top of the robot's height band."""
+ROUTE_ROUNDS = 4
+"""Stock placements tried, refusing the elements without a route each time, at most."""
+_FAST_DUMPER: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
+"""libyaml's emitter when installed: several times faster than PyYAML's, and the same text as
+long as no string needs double quotes (the two fold long double-quoted strings differently)."""
 
 
 @dataclass(frozen=True)
@@ -83,6 +101,10 @@ class BimOptions:
     start_space: str | None = None
     payload: float | None = None
     """Heaviest element (kg) the robot may carry; None: the robot's figure in PAYLOADS."""
+    storey: str | None = None
+    """Storey name or index (ascending elevation); None: the ground storey."""
+    skip_uninstallable: bool = False
+    require_install: bool = False
 
 
 @dataclass
@@ -100,6 +122,10 @@ class Conversion:
     schedule_path: Path
     notes: list[str] = field(default_factory=list)
     install_path: Path | None = None
+    storey_choice: StoreyChoice | None = None
+    refused: list[dict[str, Any]] = field(default_factory=list)
+    """Elements refused (with ``skip_uninstallable``): global_id, name, ifc_class, step_id,
+    reason."""
 
     def summary(self) -> str:
         b = self.building
@@ -109,14 +135,24 @@ class Conversion:
         lines = [
             f"{self.source}: {self.schema}, storey '{self.storey}', "
             f"{xmax - xmin:.2f} m x {ymax - ymin:.2f} m",
+        ]
+        if self.storey_choice is not None:
+            lines.append(f"  {self.storey_choice.text()}")
+        lines += [
+            f"  read {b.read_text()}",
             f"  {_count(len(b.walls), 'wall')} with {_count(doors, 'passage')} and "
             f"{_count(closed, 'closed opening')} (windows), {_count(len(b.spaces), 'space')}, "
             f"{_count(len(b.furniture), 'piece')} of furniture",
-            f"  stock at ({self.stock.x:.2f}, {self.stock.y:.2f}) heading "
-            f"{math.degrees(self.stock.yaw):.0f} deg; robot start at ({self.start[0]:.2f}, "
-            f"{self.start[1]:.2f})",
-            f"  {len(self.elements)} elements to install, in order:",
         ]
+        if self.elements:
+            lines.append(
+                f"  stock at ({self.stock.x:.2f}, {self.stock.y:.2f}) heading "
+                f"{math.degrees(self.stock.yaw):.0f} deg; robot start at ({self.start[0]:.2f}, "
+                f"{self.start[1]:.2f})")
+        else:
+            lines.append(f"  robot start at ({self.start[0]:.2f}, {self.start[1]:.2f})")
+        lines.append(f"  {len(self.elements)} elements to install"
+                     + (", in order:" if self.elements else ""))
         for e in self.elements:
             t = e.target
             lines.append(
@@ -126,10 +162,17 @@ class Conversion:
                 + (f", task '{e.task}'" if e.task else "")
                 + (f", start {e.start}" if e.start else "")
             )
+        lines += [f"  refused: {r['ifc_class']} '{r['name']}' ({r['global_id']}): {r['reason']}"
+                  for r in self.refused]
         lines += [f"  note: {n}" for n in self.notes]
-        written = [self.world_path, self.schedule_path]
+        written = [self.world_path]
+        written += [self.schedule_path] if self.schedule_path.is_file() else []
         written += [self.install_path] if self.install_path is not None else []
-        lines.append("wrote " + ", ".join(str(p) for p in written[:-1]) + f" and {written[-1]}")
+        if len(written) == 1:
+            lines.append(f"wrote {written[0]}")
+        else:
+            lines.append("wrote " + ", ".join(str(p) for p in written[:-1])
+                         + f" and {written[-1]}")
         return "\n".join(lines)
 
 
@@ -144,54 +187,90 @@ def convert(options: BimOptions) -> Conversion:
     descriptor = find_descriptor(options.robot)
     if descriptor is None:
         raise InputError.single("--robot", None, f"unknown robot '{options.robot}'")
-    robot = RobotDescription.load(descriptor)
-    fp = robot.footprint
-    robot_width = 2 * fp.radius if fp.is_circle else fp.width
-    robot_radius = fp.circumradius
-
     source = open_ifc(options.ifc)
     if options.schedule is not None:
         planned = schedule_from_csv(source, options.schedule)
     else:
         planned = schedule_from_tasks(source)
-    if not planned:
+    if not planned and (options.require_install or options.schedule is not None):
         _no_elements(source, options)
     if len(planned) > MAX_ELEMENTS:
         raise InputError.single(
             str(source.path), None,
             f"{len(planned)} elements to install, more than the limit of {MAX_ELEMENTS}",
         )
-    storey = choose_storey(source)
-    names = Names()
-    building = read_building(source, storey, {p.entity.id() for p in planned}, names)
-    elements = _elements(source, planned, storey, building.floor_z, names)
-    source.raise_problems()
-    check_payload(source, elements, options)
+    robot = RobotDescription.load(descriptor)
+    fp = robot.footprint
+    robot_width = 2 * fp.radius if fp.is_circle else fp.width
+    robot_radius = fp.circumradius
 
-    grid = floor_grid(building)
-    sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
-    stock = _stock_pose(options, source, building, grid, sizes, elements, robot_width)
+    fit = robot_fit(robot)
+    choice = choose_storey(source, options.storey)
+    storey = choice.storey
+    floor_z = storey_elevation(source, storey)
+    names = Names()
+    refusals: list[tuple[Any, str]] = []
+    elements = _elements(source, planned, choice, floor_z, names, refusals)
+    source.raise_problems()
+    elements = _refuse(source, options, elements, refusals)
+    checks = robot_checks(source, elements, options, fit)
+    refusals += checks
+    elements = _refuse(source, options, elements, checks)
+    band_top = max([fit.tucked_top] + [e.target["z"] + e.size[2] / 2 for e in elements]
+                   + [e.size[2] for e in elements]) + BAND_MARGIN
+    building = read_building(source, storey, {p.entity.id() for p in planned}, names, band_top)
+    source.raise_problems()
+
     world_stands: list[dict[str, Any]] = []
     world_objects: list[dict[str, Any]] = []
-    for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
-        world_stands.append(stand_entry(names.make(f"stand_{e.object}", "stand"), slot, size))
-        world_objects.append(element_entry(e.object, slot, size, e.mass))
-        e.stock = {"x": r(slot.x), "y": r(slot.y), "z": r(size[2] / 2 + 0.0005), "yaw": r(slot.yaw)}
-        for rect in stand_rects(slot, size):
-            grid.block(rect)
-    apron = apron_pose(stock, sizes)
-    check_routes(source, building, grid, elements, apron, robot_width)
-    source.raise_problems()
-    cross = crossings(building, grid, elements, apron, robot_width)
+    stock = StockPose(0.0, 0.0, 0.0)
+    apron = (0.0, 0.0, 0.0)
+    slot_of: dict[int, Slot] = {}
+    for _ in range(ROUTE_ROUNDS):
+        grid = floor_grid(building)
+        if not elements:
+            break
+        sizes = [(e.size[0], e.size[1], e.size[2]) for e in elements]
+        stock = _stock_pose(options, source, building, grid, sizes, elements, robot_width)
+        for e, size, slot in zip(elements, sizes, slots(stock, sizes), strict=True):
+            slot_of[e.step_id] = slot
+            e.stock = {"x": r(slot.x), "y": r(slot.y), "z": r(size[2] / 2 + 0.0005),
+                       "yaw": r(slot.yaw)}
+            for rect in stand_rects(slot, size):
+                grid.block(rect)
+        apron = apron_pose(stock, sizes)
+        issues = route_problems(building, grid, elements, apron, robot_width)
+        if not issues:
+            break
+        if any(e is None for e, _ in issues) or not options.skip_uninstallable:
+            check_routes(source, building, grid, elements, apron, robot_width)
+            source.raise_problems()
+        routes = [(source.model.by_id(e.step_id), why) for e, why in issues if e is not None]
+        refusals += routes
+        elements = _refuse(source, options, elements, routes)
+    if not elements and options.require_install:
+        _no_elements(source, options, refused=bool(refusals))
+    for e in elements:
+        size = (e.size[0], e.size[1], e.size[2])
+        world_stands.append(stand_entry(names.make(f"stand_{e.object}", "stand"),
+                                        slot_of[e.step_id], size))
+        world_objects.append(element_entry(e.object, slot_of[e.step_id], size, e.mass))
+    cross = crossings(building, grid, elements, apron, robot_width) if elements else {}
     start, jitter = _robot_start(options, building, grid, robot_radius)
 
     walls, furniture = building_entries(building)
-    poses: dict[str, list[float]] = {"start": [r(v) for v in start], "stock": [r(v) for v in apron]}
+    poses: dict[str, list[float]] = {"start": [r(v) for v in start]}
+    if elements:
+        poses["stock"] = [r(v) for v in apron]
     poses.update(door_poses({c.door for cs in cross.values() for c in cs}, building))
-    half = robot_width / 2 + CLEARANCE
     for space in sorted(building.spaces, key=lambda s: s.entity.id()):
-        spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
-                                  within=_space_rect(space))
+        spot = None
+        # room to turn on the spot there (a Navigate goal), else room to stand
+        for half in (robot_radius + CLEARANCE, robot_width / 2 + CLEARANCE):
+            spot = grid.nearest_clear(space.box.centre[0], space.box.centre[1], half,
+                                      within=_space_rect(space))
+            if spot is not None:
+                break
         if spot is not None:
             space.key = _pose_key(space.name, poses)
             poses[space.key] = [r(spot[0]), r(spot[1]), 0.0]
@@ -214,10 +293,11 @@ def convert(options: BimOptions) -> Conversion:
             }
         ],
         "poses": poses,
-        "groups": [
-            stock_group(stock, [e["name"] for e in world_stands + world_objects] + ["stock"])
-        ],
     }
+    if elements:
+        world["groups"] = [
+            stock_group(stock, [e["name"] for e in world_stands + world_objects] + ["stock"])
+        ]
     if "tuck" in robot.states:
         world["robots"][0]["arm_state"] = "tuck"
     if jitter > 0:
@@ -232,17 +312,99 @@ def convert(options: BimOptions) -> Conversion:
         "# furniture and spaces, the elements to install waiting in stands at the stock\n"
         "# (their order and target poses are in schedule.json), and the robot.\n"
     )
-    text = header + yaml.safe_dump(world, sort_keys=False, default_flow_style=None, width=100)
+    dumper = _FAST_DUMPER if _plain_ascii(world) else yaml.SafeDumper
+    text = header + yaml.dump(world, Dumper=dumper, sort_keys=False, default_flow_style=None,
+                              width=100)
     world_path.write_text(text)
     conversion = Conversion(
         source.path, source.schema, str(storey.Name or f"#{storey.id()}"), building, elements,
-        stock, start, world_path, schedule_path, list(building.notes),
+        stock, start, world_path, schedule_path, list(building.notes), storey_choice=choice,
+        refused=[_refused_entry(el, why) for el, why in refusals],
     )
-    schedule_path.write_text(json.dumps(_schedule_document(conversion, options), indent=2) + "\n")
+    if not elements:
+        conversion.notes.append(_no_elements_text(source, options, refused=bool(refusals))
+                                + "; the world holds the building alone")
+    if planned:
+        schedule_path.write_text(
+            json.dumps(_schedule_document(conversion, options), indent=2) + "\n")
+    elif schedule_path.is_file():
+        schedule_path.unlink()  # an earlier conversion's: not this world's
     _check_world(world_path)
-    conversion.install_path = options.out / "install.xml"
-    conversion.install_path.write_text(install_tree(elements, source.path.name, cross))
+    install_path = options.out / "install.xml"
+    if elements:
+        conversion.install_path = install_path
+        install_path.write_text(install_tree(elements, source.path.name, cross))
+    elif install_path.is_file():
+        install_path.unlink()
     return conversion
+
+
+def _plain_ascii(data: Any) -> bool:
+    """Whether every string in ``data`` (dicts, lists, scalars) is printable ASCII on one
+    line: such strings are written plain or single-quoted, never double-quoted."""
+    stack = [data]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, str):
+            if not (item.isascii() and item.isprintable()):
+                return False
+        elif isinstance(item, dict):
+            stack.extend(item.keys())
+            stack.extend(item.values())
+        elif isinstance(item, list | tuple):
+            stack.extend(item)
+    return True
+
+
+def _refused_entry(element: Any, reason: str) -> dict[str, Any]:
+    return {"global_id": str(element.GlobalId), "name": str(element.Name or ""),
+            "ifc_class": element.is_a(), "step_id": int(element.id()), "reason": reason}
+
+
+def _refuse(source: IfcSource, options: BimOptions, elements: list[InstallElement],
+            refusals: list[tuple[Any, str]]) -> list[InstallElement]:
+    """Without ``skip_uninstallable``, every refusal is a problem (raised); with it, the
+    refused elements are left out (and ``refusals`` kept for the schedule)."""
+    if not refusals:
+        return elements
+    if not options.skip_uninstallable:
+        for entity, why in refusals:
+            source.fail(entity, why)
+        source.raise_problems()
+    gone = {int(entity.id()) for entity, _ in refusals}
+    out = [e for e in elements if e.step_id not in gone]
+    for order, e in enumerate(out, start=1):
+        e.order = order
+    return out
+
+
+def robot_checks(source: IfcSource, elements: list[InstallElement], options: BimOptions,
+                 fit: RobotFit) -> list[tuple[Any, str]]:
+    """Every element the robot cannot handle, with its reason: heavier than its payload, a
+    top edge out of its arm's reach where it is fetched (standing in its stand) or placed, or
+    thicker than its gripper opens."""
+    out: list[tuple[Any, str]] = []
+    payload = payload_of(options)
+    where = "--payload" if options.payload is not None else f"the {options.robot}'s rated payload"
+    for e in elements:
+        entity = source.model.by_id(e.step_id)
+        if payload is not None and e.mass > payload:
+            out.append((entity, f"{e.mass:.2f} kg ({e.mass_source}), heavier than the "
+                                f"{payload:g} kg the robot can carry ({where}): not to be "
+                                "installed by it"))
+        thickness, height = e.size[1], e.size[2]
+        place_top = e.target["z"] + height / 2
+        for label, top in (("where it is placed", place_top), ("in its stand", height)):
+            if not fit.top_edge_reached(top, height):
+                out.append((entity, f"its top edge {label}, {top:.2f} m above the floor, is "
+                                    f"out of the {options.robot}'s reach for a grasp from above "
+                                    f"(top edges at {fit.reach_text()})"))
+        if not fit.grips(thickness):
+            opening = fit.max_opening * 100
+            out.append((entity, f"{thickness * 100:.1f} cm thick, too thick for the "
+                                f"{options.robot}'s gripper, which opens {opening:.1f} cm (1 cm "
+                                "of it kept free)"))
+    return out
 
 
 def payload_of(options: BimOptions) -> float | None:
@@ -253,26 +415,24 @@ def payload_of(options: BimOptions) -> float | None:
     return PAYLOADS.get(options.robot)
 
 
-def check_payload(source: IfcSource, elements: list[InstallElement], options: BimOptions) -> None:
-    """Every element heavier than the robot can carry is a problem: not to be attempted."""
-    payload = payload_of(options)
-    if payload is None:
-        return
-    where = "--payload" if options.payload is not None else f"the {options.robot}'s rated payload"
-    for e in elements:
-        if e.mass > payload:
-            source.fail(
-                source.model.by_id(e.step_id),
-                f"{e.mass:.2f} kg ({e.mass_source}), heavier than the {payload:g} kg the robot "
-                f"can carry ({where}): not to be installed by it",
-            )
-    source.raise_problems()
+def _no_elements(source: IfcSource, options: BimOptions, refused: bool = False) -> None:
+    """Raise the problem of a conversion with nothing to install (``--require-install``)."""
+    message = _no_elements_text(source, options, refused)
+    if options.schedule is not None and not refused:
+        raise InputError.single(str(options.schedule), None, message)
+    projects = source.model.by_type("IfcProject")
+    if projects:
+        raise InputError([source.problem(projects[0], message)])
+    raise InputError.single(str(source.path), None, message)
 
 
-def _no_elements(source: IfcSource, options: BimOptions) -> None:
-    if options.schedule is not None:
-        raise InputError.single(str(options.schedule), None, "the schedule lists no element")
-    if source.schema == "IFC2X3":
+def _no_elements_text(source: IfcSource, options: BimOptions, refused: bool = False) -> str:
+    if refused:
+        message = ("nothing to install: every element was refused (see --skip-uninstallable's "
+                   "list), and --require-install asks for one")
+    elif options.schedule is not None:
+        message = "the schedule lists no element"
+    elif source.schema == "IFC2X3":
         message = (
             "no element to install: schedules are read from IFC4 files only; give the order "
             "of an IFC2X3 file's elements with --schedule FILE.csv (GlobalId,start)"
@@ -283,19 +443,19 @@ def _no_elements(source: IfcSource, options: BimOptions) -> None:
             "IfcRelAssignsToProcess) to an IfcPlate, IfcMember or IfcWall; link them or give "
             "--schedule FILE.csv (GlobalId,start)"
         )
-    projects = source.model.by_type("IfcProject")
-    if projects:
-        raise InputError([source.problem(projects[0], message)])
-    raise InputError.single(str(source.path), None, message)
+    return message
 
 
 def _elements(
-    source: IfcSource, planned: list[PlannedElement], storey: Any, floor_z: float, names: Names
+    source: IfcSource, planned: list[PlannedElement], choice: StoreyChoice, floor_z: float,
+    names: Names, refusals: list[tuple[Any, str]],
 ) -> list[InstallElement]:
-    """Target pose, size and mass of each element to install (on ``storey``)."""
+    """Target pose, size and mass of each element to install (on the chosen storey); an
+    element elsewhere, or not a box, goes to ``refusals`` with its reason."""
     import ifcopenshell.util.element as util
 
-    reader = ShapeReader(source.scale)
+    storey = choice.storey
+    reader = ShapeReader(source.scale, source.model)
     single = len(source.model.by_type("IfcBuildingStorey")) == 1
     out: list[InstallElement] = []
     for i, p in enumerate(planned):
@@ -304,24 +464,25 @@ def _elements(
             on = storey_of(el)
             if on is None or on.id() != storey.id():
                 where = f"storey '{on.Name}'" if on is not None else "no storey"
-                source.fail(
+                refusals.append((
                     el,
-                    f"it is on {where}; the world is built from storey '{storey.Name}' (the "
-                    "one holding the most walls) only",
-                )
+                    f"it is on {where}; the world is built from storey '{storey.Name}' "
+                    f"({choice.reason}) only",
+                ))
                 continue
         try:
             solid = reader.solid(el)
         except UnsupportedGeometry as exc:
-            source.fail(el, f"unsupported geometry: {exc}")
+            refusals.append((el, f"unsupported geometry: {exc}"))
             continue
         box = footprint_box(solid.points, _placement_yaw(el))
         if not is_box_like(solid, box):
-            source.fail(
+            refusals.append((
                 el,
-                "unsupported geometry: an element to install must be an upright box (it fills "
-                f"{solid.volume / max(box.volume, 1e-12):.0%} of its upright bounding box)",
-            )
+                "unsupported geometry: an element to install must be an upright box; its body "
+                f"fills {solid.volume / max(box.volume, 1e-12):.0%} of its upright bounding box "
+                f"({box.size[0]:.3f} x {box.size[1]:.3f} x {box.size[2]:.3f} m)",
+            ))
             continue
         density, where = None, ""
         for material in util.get_materials(el):
@@ -504,6 +665,7 @@ def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
             for s in c.building.spaces
         ],
         "elements": [asdict(e) for e in c.elements],
+        "refused": list(c.refused),
     }
 
 

@@ -68,6 +68,16 @@ class FloorGrid:
     # -- painting --------------------------------------------------------------------------
     def cells(self, rect: Rect) -> tuple[np.ndarray, np.ndarray]:
         """Row and column indices of the cells whose centres lie in ``rect``."""
+        found = self._window(rect)
+        if found is None:
+            return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+        j0, i0, inside = found
+        rows, cols = np.nonzero(inside)
+        return rows + j0, cols + i0
+
+    def _window(self, rect: Rect) -> tuple[int, int, np.ndarray] | None:
+        """The first row and column of the grid's window round ``rect``, and which cells of
+        the window have their centres in ``rect``; None when the window is empty."""
         c, s = math.cos(rect.yaw), math.sin(rect.yaw)
         ex = abs(c) * rect.length / 2 + abs(s) * rect.width / 2
         ey = abs(s) * rect.length / 2 + abs(c) * rect.width / 2
@@ -77,19 +87,20 @@ class FloorGrid:
         j0 = max(math.floor((rect.y - ey - self.y0) / self.res), 0)
         j1 = min(math.ceil((rect.y + ey - self.y0) / self.res), ny)
         if i0 >= i1 or j0 >= j1:
-            return np.zeros(0, dtype=int), np.zeros(0, dtype=int)
+            return None
         xs = self.x0 + (np.arange(i0, i1) + 0.5) * self.res - rect.x
         ys = self.y0 + (np.arange(j0, j1) + 0.5) * self.res - rect.y
-        gx, gy = np.meshgrid(xs, ys)
+        gx, gy = xs[np.newaxis, :], ys[:, np.newaxis]  # broadcast to the window's cells
         u = gx * c + gy * s
         v = -gx * s + gy * c
         inside = (np.abs(u) <= rect.length / 2) & (np.abs(v) <= rect.width / 2)
-        rows, cols = np.nonzero(inside)
-        return rows + j0, cols + i0
+        return j0, i0, inside
 
     def block(self, rect: Rect) -> None:
-        rows, cols = self.cells(rect)
-        self.blocked[rows, cols] = True
+        found = self._window(rect)
+        if found is not None:
+            j0, i0, inside = found
+            self.blocked[j0:j0 + inside.shape[0], i0:i0 + inside.shape[1]] |= inside
         self._clearance = None
         self._labels.clear()
         self._trees.clear()

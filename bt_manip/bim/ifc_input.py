@@ -2,13 +2,17 @@
 
 An IFC file in the STEP physical format (ISO 10303-21) holds one entity per line
 (``#42=IFCWALL('2O2Fr$t4X7Zf8NOew3FLOH',$,'Wall 1',...);``), so a problem about an entity is
-reported as ``file:line: #42 IfcWall 'Wall 1': message``, the line found by scanning the file
-for ``#42=`` only when a problem is reported.
+reported as ``file:line: #42 IfcWall 'Wall 1': message``. The line is found only when a problem
+is reported: the entity's ``#42=`` is searched for in the bytes and the newlines before it are
+counted; after a few problems, the offsets of every entity and the line starts are indexed at
+once (a line is then a bisection). A problem thus costs about one pass over the file, however
+many entities it holds.
 """
 
 from __future__ import annotations
 
 import re
+from bisect import bisect_right
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -22,6 +26,8 @@ SCHEMAS = ("IFC2X3", "IFC4", "IFC4X3")
 """Schemas read: ``IFC4X3`` and its addenda are read like IFC4."""
 
 _ENTITY_LINE = re.compile(rb"^[ \t]*#(\d+)[ \t]*=", re.MULTILINE)
+DIRECT_LOOKUPS = 8
+"""Entities looked up one by one (a search of the bytes each) before all are indexed."""
 
 
 @dataclass
@@ -34,15 +40,35 @@ class IfcSource:
     scale: float
     schema: str
     problems: list[Problem] = field(default_factory=list)
-    _lines: dict[int, int] | None = None
+    _starts: Any = None
+    _offsets: dict[int, int] | None = None
+    _lookups: int = 0
 
     def line_of(self, step_id: int) -> int | None:
         """1-based line on which entity ``#step_id`` is defined (None if not found)."""
-        if self._lines is None:
-            self._lines = {}
+        offset = self.offset_of(step_id)
+        if offset is None:
+            return None
+        if self._starts is None and self._lookups <= DIRECT_LOOKUPS:
+            return self.data.count(b"\n", 0, offset) + 1  # a few: count, no index
+        if self._starts is None:
+            import numpy as np
+
+            newlines = np.flatnonzero(np.frombuffer(self.data, dtype=np.uint8) == 10)
+            self._starts = newlines.tolist()
+        return bisect_right(self._starts, offset) + 1
+
+    def offset_of(self, step_id: int) -> int | None:
+        """Byte offset of the line defining ``#step_id`` (None if not found)."""
+        if self._offsets is not None:
+            return self._offsets.get(step_id)
+        self._lookups += 1
+        if self._lookups > DIRECT_LOOKUPS:
+            self._offsets = {}
             for m in _ENTITY_LINE.finditer(self.data):
-                self._lines.setdefault(int(m.group(1)), self.data.count(b"\n", 0, m.start()) + 1)
-        return self._lines.get(step_id)
+                self._offsets.setdefault(int(m.group(1)), m.start())
+            return self._offsets.get(step_id)
+        return _find_definition(self.data, step_id)
 
     def problem(self, entity: Any, message: str) -> Problem:
         """``file:line: #id IfcClass 'Name': message`` about ``entity``."""
@@ -59,6 +85,20 @@ class IfcSource:
         """Raise the collected problems, if any, as one InputError."""
         if self.problems:
             raise InputError(list(self.problems))
+
+
+def _find_definition(data: bytes, step_id: int) -> int | None:
+    """Offset of the line starting ``#step_id=`` (blanks allowed around the ``=``)."""
+    needle = b"#%d" % step_id
+    at = data.find(needle)
+    while at >= 0:
+        end = at + len(needle)
+        rest = data[end:end + 16].lstrip(b" \t")
+        line_start = data.rfind(b"\n", 0, at) + 1
+        if rest.startswith(b"=") and not data[line_start:at].strip(b" \t\r"):
+            return line_start
+        at = data.find(needle, end)
+    return None
 
 
 def open_ifc(path: str | Path) -> IfcSource:

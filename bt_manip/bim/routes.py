@@ -1,8 +1,8 @@
 """Routes from the stock to where each element is installed, through the building's doors.
 
 :func:`floor_grid` paints the storey on a :class:`~bt_manip.bim.floor_grid.FloorGrid`: walls
-between their passages, closed openings (their sills), and the furniture and raised walls lower
-than :data:`~bt_manip.bim.building.PASSAGE_HEIGHT`; each passage is labelled as a door.
+between their passages, closed openings (their sills), and the obstacles, furniture and raised
+walls within the robot's height band; each passage is labelled as a door.
 :func:`check_routes` then asks, for each element, whether the robot carrying it crosswise (as
 wide as the robot or the element, whichever is wider, plus :data:`CLEARANCE` each side) can go
 from the stock's apron to within :data:`REACH_PLACE` of its place, and reports the doors that are
@@ -45,10 +45,12 @@ def floor_grid(building: Building) -> FloorGrid:
                 cx, cy = wall.point_at((o.start + o.end) / 2)
                 grid.mark_door(Rect(cx, cy, o.width, wall.thickness + 0.1, yaw), door_index)
                 door_index += 1
-    for f in building.raised + building.furniture:
-        if f.box.bottom < PASSAGE_HEIGHT:
-            grid.block(Rect(f.box.centre[0], f.box.centre[1], f.box.size[0], f.box.size[1],
-                            f.box.yaw))
+    band_top = building.band_top or PASSAGE_HEIGHT
+    for f in building.raised + building.curtain_walls + building.obstacles + building.furniture:
+        for box in f.boxes:
+            if box.bottom < band_top:
+                grid.block(Rect(box.centre[0], box.centre[1], box.size[0], box.size[1],
+                                box.yaw))
     return grid
 
 
@@ -67,27 +69,35 @@ def check_routes(
     source: IfcSource, building: Building, grid: FloorGrid, elements: list[InstallElement],
     apron: tuple[float, float, float], robot_width: float,
 ) -> None:
-    """Each element can be carried from the stock to its place (see :mod:`floor_grid`)."""
+    """Each element can be carried from the stock to its place (see :mod:`floor_grid`); the
+    problems are collected in ``source``."""
+    for element, message in route_problems(building, grid, elements, apron, robot_width):
+        if element is None:
+            source.problems.append(Problem("--stock", None, message))
+        else:
+            source.fail(source.model.by_id(element.step_id), message)
+
+
+def route_problems(
+    building: Building, grid: FloorGrid, elements: list[InstallElement],
+    apron: tuple[float, float, float], robot_width: float,
+) -> list[tuple[InstallElement | None, str]]:
+    """The elements that cannot be carried to their places, each with its reason (None: the
+    stock's apron itself has no room, and nothing is checked further)."""
     doors = doors_of(building)
     bare = robot_width / 2 + CLEARANCE
     a = (apron[0], apron[1])
     if not grid.joined(a, a, bare, REACH_STOCK):
-        source.problems.append(
-            Problem("--stock", None, "the robot has no room to stand at the stock's apron")
-        )
-        return
+        return [(None, "the robot has no room to stand at the stock's apron")]
+    out: list[tuple[InstallElement | None, str]] = []
     for e in elements:
         need = max(robot_width, e.size[0]) + 2 * CLEARANCE
         b = (e.target["x"], e.target["y"])
         if grid.joined(a, b, need / 2, REACH_PLACE):
             continue
-        entity = source.model.by_id(e.step_id)
         if not grid.joined(a, b, bare, REACH_PLACE):
-            source.fail(
-                entity,
-                f"its place ({b[0]:.2f}, {b[1]:.2f}) cannot be reached: no route for the robot "
-                "joins the stock to it",
-            )
+            out.append((e, f"its place ({b[0]:.2f}, {b[1]:.2f}) cannot be reached: no route for "
+                           "the robot joins the stock to it"))
             continue
         route = grid.doors_on_route(a, b, bare, REACH_PLACE) or []
         narrow = [doors[i] for i in route if doors[i][1] < need]
@@ -98,8 +108,6 @@ def check_routes(
             if narrow
             else "; a passage on its route from the stock is narrower"
         )
-        source.fail(
-            entity,
-            f"{e.size[0]:.2f} m long, it needs a passage {need:.2f} m wide when carried, wider "
-            f"than any door on its route{where}",
-        )
+        out.append((e, f"{e.size[0]:.2f} m long, it needs a passage {need:.2f} m wide when "
+                       f"carried, wider than any door on its route{where}"))
+    return out

@@ -4,9 +4,20 @@
 coordinates and metres. Simple bodies (extrusions of a rectangle or a polygon, the form walls,
 slabs, plates and openings usually take) are read directly from their placement and profile;
 anything else (meshes, mapped items, booleans, sweeps) goes through ifcopenshell's geometry
-kernel. :func:`footprint_box` fits the upright box of least footprint around the points: its
-centre, size (length along its yaw, width, height) and yaw; a body whose volume is much less
-than that box's is not box-like (a curved or L-shaped wall, a tilted element).
+kernel. A body clipped by half-spaces (IfcBooleanClippingResult: a wall cut under a sloped
+roof) is read as its uncut first operand: the cut only lowers its top.
+
+:meth:`ShapeReader.points` gives an obstacle's points only (its footprint is their hull): read
+directly from extrusions, clipped bodies, mapped items (each mapped representation read once and
+kept for the next element that maps it), faceted breps and face sets, and from the kernel only
+for anything else (curved sweeps, revolved solids). :meth:`ShapeReader.mesh` gives the kernel's
+triangles, for a wall whose holes matter. :func:`footprint_box` fits the upright box of least
+footprint around the points: its centre, size (length along its yaw, width, height) and yaw; a
+body whose volume is much less than that box's is not box-like (a curved or L-shaped wall, a
+tilted element).
+
+A reader computes each placement once (object placements up their chains, the
+IfcAxis2Placements of items and mapping origins), as elements share them.
 """
 
 from __future__ import annotations
@@ -16,6 +27,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from bt_manip.bim.hulls import hull_xy, unique_rows
+
+__all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
+           "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
 
 BOX_FILL = 0.9
 """A body is box-like when its volume is at least this share of its upright bounding box's
@@ -61,9 +77,49 @@ class Box:
 class ShapeReader:
     """Reads element bodies of one IFC file; ``scale`` converts file lengths to metres."""
 
-    def __init__(self, scale: float) -> None:
+    def __init__(self, scale: float, model: Any = None) -> None:
         self.scale = scale
+        self.model = model
         self._settings: Any = None
+        self._mapped: dict[int, np.ndarray | None] = {}
+        self._placements: dict[int, np.ndarray] = {}
+        self._axes: dict[int, np.ndarray] = {}
+
+    def placement(self, placement: Any) -> np.ndarray:
+        """The 4x4 matrix (file units) of an object placement, each placement of a chain
+        computed once per reader (elements share their storey's and building's)."""
+        import ifcopenshell.util.placement as util
+
+        key = int(placement.id())
+        found = self._placements.get(key)
+        if found is None:
+            parent = getattr(placement, "PlacementRelTo", None)
+            if placement.is_a("IfcLocalPlacement") and parent is not None:
+                found = self.placement(parent) @ self.axis(placement.RelativePlacement)
+            else:
+                found = np.asarray(util.get_local_placement(placement), dtype=float)
+            self._placements[key] = found
+        return found
+
+    def axis(self, placement: Any) -> np.ndarray:
+        """The 4x4 matrix of an IfcAxis2Placement, computed once per reader (items and
+        mapping origins often share theirs)."""
+        import ifcopenshell.util.placement as util
+
+        key = int(placement.id())
+        found = self._axes.get(key)
+        if found is None:
+            found = _axis_matrix(placement)
+            if found is None:
+                found = np.asarray(util.get_axis2placement(placement), dtype=float)
+            self._axes[key] = found
+        return found
+
+    def yaw(self, element: Any) -> float | None:
+        """:func:`placement_yaw` of ``element`` from the placements computed once per reader."""
+        if getattr(element, "ObjectPlacement", None) is None:
+            return None
+        return _yaw_of(self.placement(element.ObjectPlacement))
 
     def solid(self, element: Any) -> Solid:
         """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
@@ -75,25 +131,20 @@ class ShapeReader:
 
     # -- simple extrusions, read directly -------------------------------------------------
     def _extrusions(self, element: Any, rep: Any) -> Solid | None:
-        import ifcopenshell.util.placement as placement
 
-        items = list(rep.Items)
+        items = [_uncut(item) for item in rep.Items]
         if not items or any(not item.is_a("IfcExtrudedAreaSolid") for item in items):
             return None
         if element.ObjectPlacement is None:
             return None
-        world = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+        world = self.placement(element.ObjectPlacement)
         all_points: list[np.ndarray] = []
         volume = 0.0
         for item in items:
-            profile = _profile_points(item.SweptArea)
+            profile = _profile_points(item.SweptArea, self.axis)
             if profile is None:
                 return None
-            local = (
-                np.asarray(placement.get_axis2placement(item.Position), dtype=float)
-                if item.Position is not None
-                else np.eye(4)
-            )
+            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
             direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
             norm = float(np.linalg.norm(direction))
             if norm < 1e-12 or len(direction) != 3:
@@ -110,8 +161,18 @@ class ShapeReader:
 
     # -- anything else, through the geometry kernel -----------------------------------------
     def _kernel(self, element: Any) -> Solid:
+        verts, faces = self.mesh(element)
+        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+        volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6.0)
+        return Solid(verts, volume)
+
+    def mesh(self, element: Any) -> tuple[np.ndarray, np.ndarray]:
+        """The kernel's triangles of the element's body: vertices (N x 3, metres, world) and
+        faces (M x 3 indices); openings are not subtracted."""
         import ifcopenshell.geom
 
+        if body_representation(element) is None:
+            raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
         if self._settings is None:
             settings = ifcopenshell.geom.settings()
             settings.set("use-world-coords", True)
@@ -125,14 +186,169 @@ class ShapeReader:
         faces = np.asarray(shape.geometry.faces, dtype=int).reshape(-1, 3)
         if len(verts) == 0 or len(faces) == 0:
             raise UnsupportedGeometry("its body geometry is empty")
-        a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
-        volume = abs(float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum()) / 6.0)
-        return Solid(verts, volume)
+        return verts, faces
+
+    # -- points only, for obstacles ------------------------------------------------------------
+    def points(self, element: Any) -> np.ndarray:
+        """The points (N x 3, metres, world) of the element's body, read directly where the
+        items allow it, else from the kernel; UnsupportedGeometry when there is no body."""
+
+        rep = body_representation(element)
+        if rep is None:
+            raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
+        if element.ObjectPlacement is not None:
+            world = self.placement(element.ObjectPlacement)
+            parts = [self._item_points(item) for item in rep.Items]
+            if parts and all(p is not None and len(p) for p in parts):
+                local = np.vstack([p for p in parts if p is not None])
+                pts: np.ndarray = (local @ world[:3, :3].T + world[:3, 3]) * self.scale
+                return pts
+        return self.mesh(element)[0]
+
+    def _source_points(self, representation: Any) -> np.ndarray | None:
+        """A mapped representation's points, read once per file: directly, else from the
+        kernel's mesh of the representation itself (not of each element mapping it); only
+        the corners of their footprint's hull are kept, at the lowest and highest z."""
+        parts = [self._item_points(i) for i in representation.Items]
+        if parts and all(p is not None and len(p) for p in parts):
+            pts = np.vstack([p for p in parts if p is not None])
+        else:
+            import ifcopenshell.geom
+
+            try:
+                shape: Any = ifcopenshell.geom.create_shape(ifcopenshell.geom.settings(),
+                                                            representation)
+            except Exception:  # the kernel raises RuntimeError and others
+                return None
+            verts = getattr(shape, "verts", None)
+            if verts is None:
+                verts = shape.geometry.verts
+            pts = np.asarray(verts, dtype=float).reshape(-1, 3) / self.scale
+            if len(pts) == 0:
+                return None
+        return hull_prism(pts)
+
+    def _mapping(self, item: Any) -> np.ndarray:
+        """The transformation of a mapped item (as ifcopenshell.util.placement's
+        get_mappeditem_transformation, its mapping origin's matrix kept per reader)."""
+        import ifcopenshell.util.placement as placement
+
+        origin = self.axis(item.MappingSource.MappingOrigin)
+        target = item.MappingTarget
+        if target.is_a("IfcCartesianTransformationOperator3D"):
+            found: np.ndarray = np.asarray(
+                placement.get_cartesiantransformationoperator3d(target) @ origin, dtype=float)
+            return found
+        return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+
+    def _item_points(self, item: Any) -> np.ndarray | None:
+        """Points of one representation item in its representation's frame (file units)."""
+
+        item = _uncut(item)
+        if item.is_a("IfcExtrudedAreaSolid"):
+            profile = _profile_points(item.SweptArea, self.axis)
+            if profile is None:
+                return None
+            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
+            direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
+            norm = float(np.linalg.norm(direction))
+            if norm < 1e-12 or len(direction) != 3:
+                return None
+            base = np.column_stack([profile, np.zeros(len(profile))])
+            prism = np.vstack([base, base + direction / norm * float(item.Depth)])
+            out: np.ndarray = prism @ local[:3, :3].T + local[:3, 3]
+            return out
+        if item.is_a("IfcMappedItem"):
+            source = item.MappingSource
+            key = int(source.id())
+            if key not in self._mapped:
+                self._mapped[key] = self._source_points(source.MappedRepresentation)
+            mapped = self._mapped[key]
+            if mapped is None:
+                return None
+            m = self._mapping(item)
+            moved: np.ndarray = mapped @ m[:3, :3].T + m[:3, 3]
+            return moved
+        if item.is_a("IfcTessellatedFaceSet"):
+            return np.asarray(item.Coordinates.CoordList, dtype=float)
+        if item.is_a() in _POINT_SETS and self.model is not None:
+            coords = _loop_points(item)
+            if coords is None:  # not polygon loops only: every point the item refers to
+                coords = [p.Coordinates for p in self.model.traverse(item)
+                          if p.is_a("IfcCartesianPoint")]
+            if not coords or any(len(c) != 3 for c in coords):
+                return None
+            return np.asarray(coords, dtype=float)
+        return None
 
 
 NOT_BODY = {"Axis", "FootPrint", "Box", "Annotation", "Profile", "Plan", "Reference",
             "Clearance", "CoG", "Surface", "Lighting"}
 """Representation identifiers that are not an element's body."""
+
+
+_POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurfaceModel",
+               "IfcShellBasedSurfaceModel"}
+"""Items whose points are their polygon loops' points (no curved faces)."""
+
+
+def _axis_matrix(placement: Any) -> np.ndarray | None:
+    """An IfcAxis2Placement3D's matrix, the same numbers as ifcopenshell.util.placement's
+    ``get_axis2placement`` (the same operations in the same order, the cross product written
+    out); None for any other placement."""
+    if not placement.is_a("IfcAxis2Placement3D"):
+        return None
+    origin = getattr(placement.Location, "Coordinates", None)
+    if not origin:
+        return None
+    axis, ref = placement.Axis, placement.RefDirection
+    z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
+    x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    x = x / np.linalg.norm(x)
+    z = z / np.linalg.norm(z)
+    y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
+                  z[0] * x[1] - z[1] * x[0]])
+    y = y / np.linalg.norm(y)
+    m = np.eye(4)
+    m[:-1, :-1] = x, y, z
+    m[-1, :-1] = origin
+    out: np.ndarray = m.T
+    return out
+
+
+def _loop_points(item: Any) -> list[Any] | None:
+    """The coordinates of the polygon loops of a faceted brep or face-based surface model
+    (each point as often as loops use it); None when a face is bounded by anything else."""
+    if item.is_a("IfcFacetedBrep"):
+        shells = [item.Outer, *(getattr(item, "Voids", None) or ())]
+    elif item.is_a("IfcFaceBasedSurfaceModel"):
+        shells = list(item.FbsmFaces)
+    elif item.is_a("IfcShellBasedSurfaceModel"):
+        shells = list(item.SbsmBoundary)
+    else:
+        return None
+    coords: list[Any] = []
+    # by attribute index (several times faster than by name): IfcConnectedFaceSet.CfsFaces,
+    # IfcFace.Bounds, IfcFaceBound.Bound, IfcPolyLoop.Polygon, IfcCartesianPoint.Coordinates
+    for shell in shells:
+        if not shell.is_a("IfcConnectedFaceSet"):
+            return None
+        for face in shell.get_argument(0):
+            for bound in face.get_argument(0):
+                loop = bound.get_argument(0)
+                if not loop.is_a("IfcPolyLoop"):
+                    return None
+                coords.extend(p.get_argument(0) for p in loop.get_argument(0))
+    return coords
+
+
+def _uncut(item: Any) -> Any:
+    """The first operand under half-space clippings (the body before the cut)."""
+    for _ in range(64):
+        if not item.is_a("IfcBooleanClippingResult"):
+            return item
+        item = item.FirstOperand
+    return item
 
 
 def body_representation(element: Any) -> Any:
@@ -151,13 +367,19 @@ def body_representation(element: Any) -> Any:
     return None
 
 
-def _profile_points(profile: Any) -> np.ndarray | None:
-    """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise."""
+def _profile_points(profile: Any, axis: Any = None) -> np.ndarray | None:
+    """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise.
+    ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without)."""
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
         hx, hy = float(profile.XDim) / 2, float(profile.YDim) / 2
         pts = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
+    elif profile.is_a("IfcCircleProfileDef") and not profile.is_a("IfcCircleHollowProfileDef"):
+        # the 32-gon round the circle, its sides tangent to it (and four of them upright)
+        angles = (np.arange(32) + 0.5) * (2 * math.pi / 32)
+        radius = float(profile.Radius) / math.cos(math.pi / 32)
+        pts = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
     elif profile.is_a("IfcArbitraryClosedProfileDef") and not profile.is_a(
         "IfcArbitraryProfileDefWithVoids"
     ):
@@ -176,7 +398,8 @@ def _profile_points(profile: Any) -> np.ndarray | None:
         return None
     position = getattr(profile, "Position", None)
     if position is not None:
-        m = np.asarray(placement.get_axis2placement(position), dtype=float)
+        m = (axis(position) if axis is not None
+             else np.asarray(placement.get_axis2placement(position), dtype=float))
         pts = pts @ m[:2, :2].T + m[:2, 3]
     return pts
 
@@ -194,18 +417,22 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
     """
     xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
-    best: tuple[float, float, np.ndarray, np.ndarray] | None = None
-    for angle in _candidate_angles(xy):
-        c, s = math.cos(angle), math.sin(angle)
-        u = xy @ np.array([c, s])
-        v = xy @ np.array([-s, c])
-        lo = np.array([u.min(), v.min()])
-        hi = np.array([u.max(), v.max()])
-        area = float(np.prod(hi - lo))
-        if best is None or area < best[0] - 1e-9:
-            best = (area, angle, lo, hi)
-    assert best is not None
-    _, angle, lo, hi = best
+    angles = _candidate_angles(xy)
+    # every candidate at once: the points' coordinates along (u) and across (v) each angle
+    c = np.array([math.cos(a) for a in angles])
+    s = np.array([math.sin(a) for a in angles])
+    x, y = xy[:, :1], xy[:, 1:2]
+    u = x * c + y * s
+    v = y * c - x * s
+    lows = np.stack([u.min(axis=0), v.min(axis=0)], axis=1)
+    highs = np.stack([u.max(axis=0), v.max(axis=0)], axis=1)
+    areas = (highs[:, 0] - lows[:, 0]) * (highs[:, 1] - lows[:, 1])
+    pick = 0
+    for k in range(1, len(angles)):  # the first of the least, as 1e-9 apart
+        if areas[k] < areas[pick] - 1e-9:
+            pick = k
+    angle, lo, hi = angles[pick], lows[pick], highs[pick]
+    best = (float(areas[pick]), angle)
     length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
     if width > length:
         angle += math.pi / 2
@@ -224,7 +451,7 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     """Edge directions of the convex hull of ``xy`` (one of them bounds the least box)."""
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = np.unique(np.round(xy, 6), axis=0)
+    pts = unique_rows(np.round(xy, 6))
     if len(pts) < 3:
         if len(pts) == 2:
             d = pts[1] - pts[0]
@@ -239,13 +466,28 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
 
 
+def hull_prism(points: np.ndarray) -> np.ndarray:
+    """The corners of the hull of the points' footprint, each at their lowest and highest z:
+    the points an upright obstacle's footprint and height depend on (as long as it is only
+    turned about z)."""
+    xy = hull_xy(points[:, :2])
+    z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
+    return np.vstack([np.column_stack([xy, np.full(len(xy), z0)]),
+                      np.column_stack([xy, np.full(len(xy), z1)])])
+
+
 def placement_yaw(element: Any) -> float | None:
     """Heading of the element's placement x axis, when it is not vertical."""
     import ifcopenshell.util.placement as placement
 
     if getattr(element, "ObjectPlacement", None) is None:
         return None
-    m = np.asarray(placement.get_local_placement(element.ObjectPlacement), dtype=float)
+    return _yaw_of(np.asarray(placement.get_local_placement(element.ObjectPlacement),
+                              dtype=float))
+
+
+def _yaw_of(m: np.ndarray) -> float | None:
+    """Heading of a placement matrix's x axis, None when it is vertical."""
     x = m[:3, 0]
     if math.hypot(x[0], x[1]) < 1e-6:
         return None

@@ -3,7 +3,9 @@
 The document follows ``worlds/README.md``: walls with ``doors`` cut where the building has
 openings (a window's cut is closed below and above by a sill and a lintel, static boxes named
 ``<wall>_sill_<i>`` and ``<wall>_lintel_<i>``), furniture as boxes, the elements to install as
-movable boxes standing in slotted stands at the stock, the robot and named poses.
+movable boxes standing in slotted stands at the stock, the robot and named poses. An obstacle
+that is no box (a round column, a curved desk) is one entry of ``parts``: the strips of its
+footprint, turned with it.
 """
 
 from __future__ import annotations
@@ -11,7 +13,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from bt_manip.bim.building import Building, Wall
+from bt_manip.bim.building import Building, Furniture, Wall
 from bt_manip.bim.shapes import Box
 
 DIGITS = 4
@@ -35,6 +37,24 @@ def box_entry(name: str, box: Box, colour: str) -> dict[str, Any]:
         "pose": pose3(*box.centre, box.yaw),
         "colour": colour,
     }
+
+
+def obstacle_entry(item: Furniture, colour: str) -> dict[str, Any]:
+    """A static obstacle: one box, or the boxes of its footprint as parts."""
+    if not item.parts:
+        return box_entry(item.name, item.box, colour)
+    c, s = item.box.axis()
+    cx, cy, cz = item.box.centre
+    parts = []
+    for b in item.parts:
+        dx, dy = b.centre[0] - cx, b.centre[1] - cy
+        parts.append({
+            "shape": "box",
+            "size": [r(max(v, 0.001)) for v in b.size],
+            "xyz": [r(c * dx + s * dy), r(-s * dx + c * dy), r(b.centre[2] - cz)],
+        })
+    return {"name": item.name, "parts": parts, "pose": pose3(cx, cy, cz, item.box.yaw),
+            "colour": colour}
 
 
 def wall_entries(wall: Wall) -> tuple[dict[str, Any], list[dict[str, Any]]]:
@@ -89,6 +109,8 @@ def building_entries(building: Building) -> tuple[list[dict[str, Any]], list[dic
         entry, boxes = wall_entries(wall)
         walls.append(entry)
         furniture += boxes
-    furniture += [box_entry(f.name, f.box, "beige") for f in building.raised]
-    furniture += [box_entry(f.name, f.box, "wood") for f in building.furniture]
+    furniture += [obstacle_entry(f, "beige") for f in building.raised]
+    furniture += [obstacle_entry(f, "cyan") for f in building.curtain_walls]
+    furniture += [obstacle_entry(f, "grey") for f in building.obstacles]
+    furniture += [obstacle_entry(f, "wood") for f in building.furniture]
     return walls, furniture

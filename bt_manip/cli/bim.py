@@ -14,6 +14,7 @@ from bt_manip.bim.as_built import table_text
 from bt_manip.bim.as_built_plot import plot, read_report
 from bt_manip.bim.convert import BimOptions, convert
 from bt_manip.bim.seeds import check_seeds
+from bt_manip.bim.world_plot import plot_world
 from bt_manip.cli.args import payload, seed_range, stock_pose
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_file
@@ -39,6 +40,21 @@ def add_bim_arguments(bim: argparse.ArgumentParser) -> None:
         help="heaviest element the robot may carry (default: the robot's rated payload, 3 kg "
         "for husky_ur3)",
     )
+    bim.add_argument(
+        "--storey", metavar="NAME|INDEX",
+        help="storey to build: its name, or its index (0-based, by ascending elevation); "
+        "default: the ground storey (elevation nearest 0, then the most walls)",
+    )
+    bim.add_argument(
+        "--skip-uninstallable", action="store_true",
+        help="leave out the elements the robot cannot install (listed in schedule.json's "
+        "'refused') instead of stopping",
+    )
+    bim.add_argument(
+        "--require-install", action="store_true",
+        help="exit 2 when there is nothing to install (by default the world alone is written)",
+    )
+    bim.add_argument("--png", metavar="FILE.png", help="draw the world's top view to FILE.png")
     bim.add_argument(
         "--seed-range", type=seed_range, metavar="FIRST:END",
         help="load the world with each seed FIRST..END-1 and check every randomised start",
@@ -76,6 +92,9 @@ def cmd_bim_report(args: argparse.Namespace) -> int:
 
 def cmd_bim(args: argparse.Namespace) -> int:
     require_ifcopenshell()
+    png = Path(args.png) if args.png else None
+    if png is not None:
+        check_output_file("--png", png)
     conversion = convert(
         BimOptions(
             ifc=Path(args.ifc),
@@ -85,9 +104,15 @@ def cmd_bim(args: argparse.Namespace) -> int:
             stock=args.stock,
             start_space=args.start,
             payload=args.payload,
+            storey=args.storey,
+            skip_uninstallable=args.skip_uninstallable,
+            require_install=args.require_install,
         )
     )
     print(conversion.summary())
+    if png is not None:
+        plot_world(conversion, png)
+        print(f"wrote {png}")
     if args.seed_range is not None:
         check_seeds(conversion.world_path, args.seed_range)
         print(

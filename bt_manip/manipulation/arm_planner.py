@@ -21,7 +21,9 @@ advances one a few thousand checks per tick.
 from __future__ import annotations
 
 import hashlib
+import itertools
 import json
+import math
 from collections import OrderedDict
 from collections.abc import Generator
 from dataclasses import dataclass
@@ -77,6 +79,11 @@ class ArmPlanner:
         self._quiet: set[frozenset[str]] | None = None
         self.options = PlanOptions(max_checks=60_000)
         self.plans = 0
+        """Plans started."""
+        self.samples = 0
+        """Samples drawn by the plans that ended."""
+        self.wall_time = 0.0
+        """Wall-clock seconds spent planning (for the run report; never for a decision)."""
 
     # -- the scene ----------------------------------------------------------------------------
     def _locked(self) -> dict[str, float]:
@@ -183,6 +190,25 @@ class ArmPlanner:
         for shape, link in world.carried:
             scene.hold(shape, link, world.touching)
         scene.add_obstacles(world.shapes, padding, world.allowed | extra)
+
+    def tool_path(self, path: list[np.ndarray], step: float = 0.05) -> np.ndarray:
+        """World points (N x 3) the grasp frame passes along the joint ``path`` (straight
+        segments sampled ``step`` rad apart at most): what the viewer draws of a plan."""
+        scene = self.scene()
+        model, data = scene.model, scene.model.createData()
+        frame = model.getFrameId(self.robot.description.grasp_frame)
+        if frame >= len(model.frames):
+            frame = len(model.frames) - 1
+        world_from_root = self._root(scene)
+        points = []
+        qs = [np.asarray(q, dtype=float) for q in path]
+        for a, b in itertools.pairwise(qs):
+            n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
+            for k in range(n + (b is qs[-1])):
+                pin.framesForwardKinematics(model, data, a + (b - a) * (k / n))
+                p = world_from_root @ np.append(data.oMf[frame].translation, 1.0)
+                points.append(p[:3])
+        return np.asarray(points, dtype=float).reshape(-1, 3)
 
     # -- plans --------------------------------------------------------------------------------
     def direct_is_free(self, scene: CollisionScene, a: np.ndarray, b: np.ndarray) -> bool:

@@ -112,27 +112,26 @@ def _key(urdf: Path, package_dirs: tuple[str, ...]) -> bytes:
 
 
 def _loaded(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
-    """The URDF's model and its collision geometry with the meshes themselves (the geometry
-    kept in the cache folder: read back in a sixth of the time the meshes take to read and
-    index)."""
-    raw = _key(urdf, package_dirs)
-    key = bytes_key(raw)
+    """The URDF's model and its collision geometry with the meshes themselves."""
+    key = bytes_key(_key(urdf, package_dirs))
     known = _LOADED.get(key)
     if known is None:
         full = pin.buildModelFromUrdf(str(urdf))
-        path = cache_dir() / f"meshes-{hashlib.sha256(raw).hexdigest()[:24]}.bin"
-        geometry = _read(path)
-        if geometry is None:
-            dirs = [str(urdf.resolve().parent), *package_dirs]
-            try:
-                geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION,
-                                                 package_dirs=dirs)
-            except (ValueError, RuntimeError) as exc:
-                raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
-            _save(geometry, path)
+        dirs = [str(urdf.resolve().parent), *package_dirs]
+        try:
+            geometry = pin.buildGeomFromUrdf(full, str(urdf), pin.COLLISION, package_dirs=dirs)
+        except (ValueError, RuntimeError) as exc:
+            raise SceneError(f"{urdf}: collision geometry does not load: {exc}") from None
         known = (full, geometry)
         _LOADED.put(key, known)
     return known[0], known[1].clone()
+
+
+def _age(path: Path) -> float:
+    try:
+        return path.stat().st_mtime
+    except OSError:
+        return 0.0
 
 
 def _read(path: Path) -> pin.GeometryModel | None:
@@ -176,6 +175,9 @@ def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.Ge
 
 
 _EXACT_REQUEST = coal.CollisionRequest()
+PAIRWISE_CONFIRMS = 16
+"""Hull contacts a scene confirms pair by pair, reading only the meshes involved, before it
+reads every mesh of the robot and confirms through the broad phase."""
 _MESHES: Memo[coal.BVHModelOBBRSS] = Memo(64)
 """Collision meshes read in this process, by file, stamp and scale."""
 
@@ -203,9 +205,19 @@ def _mesh(path: str, scale: tuple[float, ...]) -> coal.BVHModelOBBRSS:
     return known
 
 
+CACHE_FILES_KEPT = 64
+"""Files of each kind (hulls, meshes) kept in the cache folder; the oldest go first."""
+
+
 def _save(geometry: pin.GeometryModel | coal.CollisionGeometry, path: Path) -> None:
-    """Write ``geometry`` to ``path`` so that other processes see the whole file or none."""
+    """Write ``geometry`` to ``path`` so that other processes see the whole file or none; the
+    oldest files of its kind beyond :data:`CACHE_FILES_KEPT` are removed."""
     path.parent.mkdir(parents=True, exist_ok=True)
+    kind = path.name.split("-", 1)[0]
+    others = sorted(path.parent.glob(f"{kind}-*.bin"), key=_age)
+    for old in others[: max(0, len(others) - CACHE_FILES_KEPT + 1)]:
+        with contextlib.suppress(OSError):
+            old.unlink()
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
@@ -251,8 +263,11 @@ class CollisionScene:
         q0 = pin.neutral(full)
         for name, value in (locked or {}).items():
             if name in names:
-                jid = full.getJointId(name)
-                q0[full.joints[jid].idx_q] = value
+                joint = full.joints[full.getJointId(name)]
+                if joint.nq == 2:  # a continuous joint: its angle as (cos, sin)
+                    q0[joint.idx_q:joint.idx_q + 2] = (math.cos(value), math.sin(value))
+                else:
+                    q0[joint.idx_q] = value
         lock = [full.getJointId(n) for n in names if n not in joints]
         self._reduce = (full, lock, q0)
         self.model, self.geometry = pin.buildReducedModel(full, geometry, lock, q0)
@@ -266,6 +281,7 @@ class CollisionScene:
         self.exact = exact
         """Whether the scene checks the meshes only (no hull pass)."""
         self._meshes: pin.GeometryModel | None = None
+        self._confirms = 0
         # per robot shape, what the exact pass tests: the primitive as the URDF gives it, or
         # the mesh a hull stands for (read when first needed)
         self._exact_shape: list[coal.CollisionGeometry | None] = [
@@ -478,12 +494,22 @@ class CollisionScene:
             return False  # the hulls are free: so are the meshes inside them
         if self.exact:
             return True
+        if self._meshes is not None:
+            return bool(pin.computeCollisions(self.model, self._mesh_data, self._mesh_broad, q,
+                                              True))
+        self._confirms += 1
+        if self._confirms > PAIRWISE_CONFIRMS:
+            self.mesh_geometry  # noqa: B018 (read now: many confirms to come)
+            return self._hit(q)
         return self._confirmed(q)
 
     def _confirmed(self, q: np.ndarray) -> bool:
         """After the hulls touched at ``q``: whether the shapes themselves do. A mesh lies
         inside its hull, so only the pairs whose hulls touch can touch; each is tested again
-        with the robot's meshes (each read the first time it is needed) and primitives."""
+        with the robot's meshes (each read the first time it is needed) and primitives. (Once
+        a scene has confirmed :data:`PAIRWISE_CONFIRMS` contacts, it reads every mesh and
+        confirms on all of them through the broad phase, which is faster when contacts are
+        many, as in a planner's search.)"""
         gdata = self._gdata
         pin.computeCollisions(self.model, self.data, self.geometry, gdata, q, False)
         results = gdata.collisionResults

@@ -26,6 +26,10 @@ it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cel
 improved, one byte per cell. Each search records, per row, the columns of ``g`` it wrote, and
 a search asked to clean up sets them back to zero before it returns, so the next search can
 reuse the same memory without touching the rest of the grid.
+
+The bucket search's loop (:func:`_bucket_rounds`, :func:`_relax`) is compiled without numba's
+runtime: it allocates nothing and counts no references, and its eight moves are written out
+one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool.
 """
 
 from __future__ import annotations
@@ -33,6 +37,7 @@ from __future__ import annotations
 import math
 import mmap
 from dataclasses import dataclass
+from typing import Any
 
 import numba
 import numpy as np
@@ -96,17 +101,12 @@ def _prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba int
 
 
 @numba.njit(cache=True, inline="always")
-def _prefetch_around(
-    g: np.ndarray, flat: np.ndarray, parent: np.ndarray, q: int, cols: int
-) -> None:
-    """Prefetch the g, cost and parent rows that expanding cell ``q`` will read or write."""
+def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
+    """Prefetch the rows above and below cell ``q`` of ``g`` and the cost grid."""
     _prefetch(g, q - cols)  # type: ignore[call-arg]  # numba body, as for _load_g
-    _prefetch(g, q)  # type: ignore[call-arg]
     _prefetch(g, q + cols)  # type: ignore[call-arg]
     _prefetch(flat, q - cols)  # type: ignore[call-arg]
-    _prefetch(flat, q)  # type: ignore[call-arg]
     _prefetch(flat, q + cols)  # type: ignore[call-arg]
-    _prefetch(parent, q)  # type: ignore[call-arg]
 
 
 @numba.njit(cache=True, inline="always")
@@ -285,14 +285,79 @@ def _move_costs(
     return 8
 
 
+_NO_REFCOUNT: dict[str, Any] = {"_nrt": False}
+"""numba option: compile without the runtime (no reference counting; no allocation inside)."""
+
 # Indices into the bucket search's state vectors (it runs in rounds between pool growths).
 _CUR, _USED, _FREE, _OPEN, _EXPANDED = 0, 1, 2, 3, 4
 _G_GOAL, _BOUND = 0, 1
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, **_NO_REFCOUNT)
+def _relax(
+    k: int,
+    nb: int,
+    nr: int,
+    nc: int,
+    ng_: float,
+    g: np.ndarray,
+    parent: np.ndarray,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    heads: np.ndarray,
+    pn: np.ndarray,
+    pg: np.ndarray,
+    pnext: np.ndarray,
+    goal: int,
+    gr: int,
+    gc: int,
+    diagonal: bool,
+    hmin: float,
+    inv_delta: float,
+    mask: int,
+    cur: int,
+    free: int,
+    used: int,
+    n_open: int,
+    g_goal: float,
+    bound: float,
+) -> tuple[int, int, int, float, float]:
+    """Offer cell ``nb`` (row ``nr``, col ``nc``) the cost ``ng_`` by move ``k``.
+
+    If it beats the stored g, store it and push the cell into its f-bucket (the goal is not
+    pushed: it sets the bound instead). Returns the updated ``(free, used, n_open, g_goal,
+    bound)``. Compiled without reference counting, like its caller, so that passing the
+    arrays costs nothing.
+    """
+    # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
+    if ng_ < _load_g(g, nb) * KEEP:
+        _store_g(g, nb, ng_)
+        parent[nb] = k
+        _mark(lo, hi, nr, nc)
+        if nb == goal:
+            return free, used, n_open, ng_, ng_ * KEEP
+        f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
+        if f < bound:
+            kb = max(math.floor(f * inv_delta), cur) & mask
+            if free != -1:
+                s = free
+                free = pnext[s]
+            else:
+                s = used
+                used += 1
+            pn[s] = nb
+            pg[s] = ng_
+            pnext[s] = heads[kb]
+            heads[kb] = s
+            n_open += 1
+    return free, used, n_open, g_goal, bound
+
+
+@numba.njit(cache=True, **_NO_REFCOUNT)
 def _bucket_rounds(
-    cost: np.ndarray,
+    flat: np.ndarray,
+    rows: int,
+    cols: int,
     start: int,
     goal: int,
     diagonal: bool,
@@ -312,20 +377,17 @@ def _bucket_rounds(
 ) -> bool:
     """Run the bucket search until it ends (True) or its pool may run out of slots (False).
 
-    The pool (``pn``, ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the
-    state vectors are the caller's, so that no array changes hands inside the loop.
+    ``flat`` is the cost grid as one row-major vector of ``rows x cols``. The pool (``pn``,
+    ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the state vectors
+    are the caller's. The function allocates nothing and is compiled without reference
+    counting (``_nrt=False``): the moves are written out one by one (no per-move arrays),
+    and :func:`_relax` takes the arrays at no cost.
     """
-    rows, cols = cost.shape
-    flat = cost.ravel()
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
     inv_delta = 1.0 / delta
     inf = np.inf
-    off = DR * cols + DC
-    w8 = np.empty(8, np.float64)
-    cand_k = np.empty(8, np.int64)
-    cand_g = np.empty(8, np.float64)
     room = pn.shape[0] - 8  # an expansion pushes at most 8 entries
     cur = ints[_CUR]
     used = ints[_USED]
@@ -352,13 +414,9 @@ def _bucket_rounds(
         gn = pg[slot]
         pnext[slot] = free
         free = slot
-        # the next two entries of this bucket are likely the next pops: start their loads
-        nxt = heads[b]
+        nxt = heads[b]  # likely the next pop: start loading its rows
         if nxt != -1:
-            _prefetch_around(g, flat, parent, pn[nxt], cols)
-            nxt = pnext[nxt]
-            if nxt != -1:
-                _prefetch_around(g, flat, parent, pn[nxt], cols)
+            _prefetch_rows(g, flat, pn[nxt], cols)
         if gn > _load_g(g, node):
             continue  # stale entry
         r = node // cols
@@ -366,43 +424,64 @@ def _bucket_rounds(
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
         expanded += 1
-        nmoves = _move_costs(flat, node, r, c, rows, cols, diagonal, off, w8)
-        n_cand = 0
-        for k in range(nmoves):
-            ng_ = gn + w8[k] if k < 4 else gn + sqrt2 * w8[k]
-            # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
-            if ng_ < _load_g(g, node + off[k]) * KEEP:
-                cand_k[n_cand] = k
-                cand_g[n_cand] = ng_
-                n_cand += 1
-        for j in range(n_cand):
-            k = cand_k[j]
-            ng_ = cand_g[j]
-            nb = node + off[k]
-            nr = r + DR[k]
-            nc = c + DC[k]
-            _store_g(g, nb, ng_)
-            parent[nb] = k
-            _mark(lo, hi, nr, nc)
-            if nb == goal:
-                g_goal = ng_
-                bound = ng_ * KEEP
-                continue
-            f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
-            if f >= bound:
-                continue
-            kb = max(np.int64(math.floor(f * inv_delta)), cur) & mask
-            if free != -1:
-                s = free
-                free = pnext[s]
-            else:
-                s = used
-                used += 1
-            pn[s] = nb
-            pg[s] = ng_
-            pnext[s] = heads[kb]
-            heads[kb] = s
-            n_open += 1
+        # costs of the four side cells (inf outside the grid)
+        if r == 0 or r == rows - 1 or c == 0 or c == cols - 1:
+            wu = flat[node - cols] if r > 0 else inf
+            wd = flat[node + cols] if r < rows - 1 else inf
+            wl = flat[node - 1] if c > 0 else inf
+            wr = flat[node + 1] if c < cols - 1 else inf
+        else:
+            wu = flat[node - cols]
+            wd = flat[node + cols]
+            wl = flat[node - 1]
+            wr = flat[node + 1]
+        # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
+        # allowed only when both side cells beside it are free
+        free, used, n_open, g_goal, bound = _relax(
+            0, node - cols, r - 1, c, gn + wu, g, parent, lo, hi, heads, pn, pg, pnext,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        )  # fmt: skip
+        free, used, n_open, g_goal, bound = _relax(
+            1, node + cols, r + 1, c, gn + wd, g, parent, lo, hi, heads, pn, pg, pnext,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        )  # fmt: skip
+        free, used, n_open, g_goal, bound = _relax(
+            2, node - 1, r, c - 1, gn + wl, g, parent, lo, hi, heads, pn, pg, pnext,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        )  # fmt: skip
+        free, used, n_open, g_goal, bound = _relax(
+            3, node + 1, r, c + 1, gn + wr, g, parent, lo, hi, heads, pn, pg, pnext,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        )  # fmt: skip
+        if diagonal:
+            if wu != inf and wl != inf:
+                free, used, n_open, g_goal, bound = _relax(
+                    4, node - cols - 1, r - 1, c - 1, gn + sqrt2 * flat[node - cols - 1],
+                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+                    free, used, n_open, g_goal, bound,
+                )  # fmt: skip
+            if wu != inf and wr != inf:
+                free, used, n_open, g_goal, bound = _relax(
+                    5, node - cols + 1, r - 1, c + 1, gn + sqrt2 * flat[node - cols + 1],
+                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+                    free, used, n_open, g_goal, bound,
+                )  # fmt: skip
+            if wd != inf and wl != inf:
+                free, used, n_open, g_goal, bound = _relax(
+                    6, node + cols - 1, r + 1, c - 1, gn + sqrt2 * flat[node + cols - 1],
+                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+                    free, used, n_open, g_goal, bound,
+                )  # fmt: skip
+            if wd != inf and wr != inf:
+                free, used, n_open, g_goal, bound = _relax(
+                    7, node + cols + 1, r + 1, c + 1, gn + sqrt2 * flat[node + cols + 1],
+                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+                    free, used, n_open, g_goal, bound,
+                )  # fmt: skip
     ints[_CUR] = cur
     ints[_USED] = used
     ints[_FREE] = free
@@ -460,8 +539,9 @@ def search_buckets(
     heads[cur & (size - 1)] = 0
     ints = np.array([cur, 1, -1, 1, 0], np.int64)
     floats = np.array([np.inf, np.inf])
-    while not _bucket_rounds(cost, start, goal, diagonal, hmin, delta, size - 1, g, parent, lo,
-                             hi, heads, pn, pg, pnext, ints, floats):
+    flat = cost.ravel()
+    while not _bucket_rounds(flat, cost.shape[0], cols, start, goal, diagonal, hmin, delta,
+                             size - 1, g, parent, lo, hi, heads, pn, pg, pnext, ints, floats):
         used = ints[_USED]
         pn, pg, pnext = _grown(pn, used), _grown(pg, used), _grown(pnext, used)
     _clean(g, lo, hi, cost.shape[0], cols, zero)

@@ -159,6 +159,17 @@ class RunContext(TreeContext):
         """A context ticking on ``world``'s sim clock."""
         return cls(clock=world.clock, world=world, faults=faults)
 
+    def arm_planning(self) -> dict[str, dict[str, float]]:
+        """Per robot whose arm planned in this run: the plans made, the samples drawn and the
+        wall time spent planning (s); empty when no arm planned."""
+        out: dict[str, dict[str, float]] = {}
+        for name, services in sorted(self._robots.items()):
+            planner = services.arm_planner
+            if planner is not None and planner.plans:
+                out[name] = {"plans": planner.plans, "samples": planner.samples,
+                             "wall_time_s": round(planner.wall_time, 4)}
+        return out
+
     def robot_services(self, name: str) -> RobotServices:
         """The services of the world's robot ``name`` (KeyError when there is none)."""
         services = self._robots.get(name)

@@ -88,7 +88,11 @@ HOLONOMIC_KEYS = {
     "max_force",
     "max_torque",
 }
-ARM_KEYS = {"base_link", "joints", "velocity_limits", "efforts", "position_gain"}
+ARM_KEYS = {
+    "base_link", "joints", "velocity_limits", "acceleration_limits", "efforts", "position_gain",
+}
+ACCELERATION_PER_VELOCITY = 2.0
+"""1/s: a joint without an acceleration limit reaches its velocity limit in half a second."""
 GRIPPER_KEYS = {
     "kind",
     "width",
@@ -164,6 +168,8 @@ class ArmSpec:
     lower: tuple[float, ...] = ()
     upper: tuple[float, ...] = ()
     position_gain: float = 0.3
+    acceleration_limits: tuple[float, ...] = ()
+    """rad/s^2 (or m/s^2) per joint: how a planned path is timed."""
 
 
 @dataclass(frozen=True)
@@ -451,6 +457,12 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
     efforts: tuple[float | None, ...] = (None,) * len(joints)
     if "efforts" in a:
         efforts = f.vector(a["efforts"], len(joints), a.line_of("efforts"), "arm.efforts") or ()
+    accel = tuple(ACCELERATION_PER_VELOCITY * v for v in vel)
+    if "acceleration_limits" in a:
+        accel = f.vector(a["acceleration_limits"], len(joints), a.line_of("acceleration_limits"),
+                         "arm.acceleration_limits") or ()
+        if any(v <= 0 for v in accel):
+            f.fail(a.line_of("acceleration_limits"), "arm.acceleration_limits must all be > 0")
     arm_base = f.text(a, "base_link", "arm")
     gain = f.real(a, "position_gain", "arm", 0.3, positive=True)
 
@@ -499,7 +511,7 @@ def load_description(name_or_path: str | Path) -> RobotDescription:
         path,
         urdf,
         base,
-        ArmSpec(arm_base, joints, vel, efforts, position_gain=gain),
+        ArmSpec(arm_base, joints, vel, efforts, position_gain=gain, acceleration_limits=accel),
         gripper,
         end_effector,
         grasp_frame,

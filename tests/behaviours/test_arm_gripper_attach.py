@@ -79,7 +79,9 @@ def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
     with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
         # facing the west wall of the workshop, 25 cm from it, arm unfolding towards it
         place_robot(world, "husky", -2.25, -2.0, np.pi)
-        report, _ = run_xml(world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3"/>')
+        # without a planner the arm moves and stops on the contact
+        report, _ = run_xml(
+            world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3" planner="none"/>')
         assert report.status == "FAILURE"
         why = reasons(report)["MoveJoints"]
         assert "touched 'wall_x_m3'" in why
@@ -87,6 +89,40 @@ def test_arm_stops_and_fails_when_it_hits_a_wall() -> None:
         q = world.robots["husky"].arm_positions()
         world.step(240)
         assert np.allclose(world.robots["husky"].arm_positions(), q, atol=0.02)
+
+
+def test_the_planner_refuses_a_goal_inside_a_wall_before_the_arm_moves() -> None:
+    from bhelpers import ROOT
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        place_robot(world, "husky", -2.25, -2.0, np.pi)
+        q0 = world.robots["husky"].arm_positions()
+        report, _ = run_xml(world, '<MoveJoints targets="90;-20;10;-90;0;0" speed="0.3"/>')
+        assert report.status == "FAILURE"
+        why = reasons(report)["MoveJoints"]
+        assert "the goal is in collision" in why and "wall_x_m3" in why
+        assert np.allclose(world.robots["husky"].arm_positions(), q0, atol=0.02)
+
+
+def test_a_joint_whose_sweep_meets_the_wall_is_refused_before_it_moves() -> None:
+    from bhelpers import ROOT
+
+    with World(ROOT / "worlds" / "tb3_house.yaml", seed=0) as world:
+        place_robot(world, "husky", -2.25, -2.0, np.pi)
+        robot = world.robots["husky"]
+        q0 = robot.arm_positions()
+        # from the tuck the shoulder rises freely; unfolding the elbow then would swing the
+        # forearm into the wall
+        report, _ = run_xml(world, '<MoveJointsSequentially targets="90;-20;10;-90;0;0" '
+                                   'order="1;2;3;4;5;0"/>')
+        assert report.status == "FAILURE"
+        why = reasons(report)["MoveJointsSequentially"]
+        assert why.startswith("joint 2 (elbow_joint) would collide on its way: ")
+        assert "wall_x_m3" in why
+        world.step(240)
+        q = robot.arm_positions()
+        assert abs(q[2] - q0[2]) < 0.02  # the elbow never moved
+        assert abs(q[1] - np.radians(-20)) < 0.02  # the shoulder did
 
 
 def test_close_on_nothing_reports_not_holding(table: World) -> None:

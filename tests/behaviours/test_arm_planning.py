@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from bt_manip.episode import Episode, EpisodeSpec
@@ -72,3 +73,56 @@ def test_goal_inside_the_post_fails_with_the_reason(tmp_path: Path) -> None:
 @pytest.mark.parametrize("seed", [0, 1])
 def test_same_seed_same_motion(tmp_path: Path, seed: int) -> None:
     assert _run(tmp_path / "a", "auto", seed=seed) == _run(tmp_path / "b", "auto", seed=seed)
+
+
+def test_a_planned_move_keeps_within_the_joint_speed_limits(tmp_path: Path) -> None:
+    """The planned path is timed within each joint's velocity (and acceleration) limits; the
+    arm follows it at no more than the speed asked, with the tracking margin, at every step."""
+    from bhelpers import run_xml, sample_every_step
+
+    from bt_manip.behaviours.arm import TRACK_MARGIN
+    from bt_manip.sim.world import World
+
+    (tmp_path / "world.yaml").write_text(WORLD)
+    with World(tmp_path / "world.yaml", seed=0) as world:
+        robot = world.robots["sawyer"]
+        report, _ = run_xml(world, f'<MoveJoints targets="{LEFT}"/>')
+        assert report.status == "SUCCESS"
+        speeds = sample_every_step(world, lambda: robot.arm_motion()[1])
+        report, tree = run_xml(world, f'<MoveJoints targets="{RIGHT}" speed="0.5" '
+                                      'plan_samples="{n}"/>')
+        assert report.status == "SUCCESS", report.reason
+        assert tree.blackboard.as_dict()["n"] > 0
+        limits = [0.5 * v * TRACK_MARGIN for v in robot.description.arm.velocity_limits]
+        peak = [max(abs(s[j]) for s in speeds) for j in range(len(limits))]
+        assert all(p <= lim * 1.05 for p, lim in zip(peak, limits, strict=True)), (peak, limits)
+        assert max(peak) > 0.1  # it did move
+
+
+def test_a_plan_is_drawn_and_its_wall_time_reported(tmp_path: Path) -> None:
+    from bhelpers import ROOT
+    from jsonschema import validate
+
+    (tmp_path / "world.yaml").write_text(WORLD)
+    (tmp_path / "tree.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>\n'
+        f'  <MoveJoints name="left" targets="{LEFT}"/>\n'
+        f'  <MoveJoints name="right" targets="{RIGHT}"/>\n'
+        "</Sequence></BehaviorTree></root>\n")
+    spec = EpisodeSpec(tree=str(tmp_path / "tree.xml"), world=str(tmp_path / "world.yaml"))
+    with Episode(spec) as episode:
+        report = episode.run()
+        assert report.status == "SUCCESS", report.reason
+        planning = report.extra["arm_planning"]["sawyer"]
+        assert planning["plans"] == 1 and planning["samples"] > 0
+        assert planning["wall_time_s"] > 0
+        drawn = episode.context.overlay.items["arm_plan"]
+        assert episode.world is not None
+        robot = episode.world.robots["sawyer"]
+        # the drawn path ends where the grasp frame ended up (within the arm's tolerance)
+        end = robot.link_transform(robot.description.grasp_frame)[:3, 3]
+        assert np.linalg.norm(drawn.points[-1] - end) < 0.03
+        assert len(drawn.points) > 10
+    import json
+    schema = json.loads((ROOT / "docs" / "schemas" / "run-report.schema.json").read_text())
+    validate(report.to_json(), schema)

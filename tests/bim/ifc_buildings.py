@@ -222,3 +222,69 @@ def three_rooms(*, schema: str = "IFC4", panels: list[Panel] | None = None,
         api("sequence.assign_sequence", f, relating_process=out.tasks[a],
             related_process=out.tasks[b])
     return out
+
+
+def _mesh_element(f: Any, body: Any, cls: str, name: str,
+                  boxes: list[tuple[tuple[float, float, float], tuple[float, float, float]]],
+                  container: Any) -> Any:
+    """An element whose body is a mesh of closed boxes, each (low corner, high corner) in
+    metres (the api converts them to the file's units), placed at the origin."""
+    el = api("root.create_entity", f, ifc_class=cls, name=name)
+    verts: list[tuple[float, float, float]] = []
+    faces: list[list[int]] = []
+    for lo, hi in boxes:
+        k = len(verts)
+        verts += [(x, y, z) for z in (lo[2], hi[2])
+                  for x, y in ((lo[0], lo[1]), (hi[0], lo[1]), (hi[0], hi[1]), (lo[0], hi[1]))]
+        faces += [[k + i for i in face] for face in
+                  ([0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6],
+                   [3, 0, 4, 7])]
+    rep = api("geometry.add_mesh_representation", f, context=body, vertices=[verts],
+              faces=[faces])
+    api("geometry.assign_representation", f, product=el, representation=rep)
+    api("geometry.edit_object_placement", f, product=el, matrix=np.eye(4))
+    if container is not None:
+        api("spatial.assign_container", f, products=[el], relating_structure=container)
+    return el
+
+
+HOLE = (7.0, 8.2, 2.1)
+"""The doorway cut into the body of the office-store wall: from x, to x, height (m)."""
+
+
+def real_features(b: Building) -> Building:
+    """The three rooms (in millimetres) with what real exports hold: the office-store wall's
+    body with a doorway cut into it (:data:`HOLE`, no IfcOpeningElement), a curtain wall of two
+    plates and three members outside the north wall, a gable piece 3.0-4.8 m above the west
+    wall and a wall with no body."""
+    f = b.file
+    store = b.walls["Store"]
+    for rep in list(store.Representation.Representations):
+        api("geometry.unassign_representation", f, product=store, representation=rep)
+    half = WALL_T / 2
+    x0, x1, top = HOLE
+    b.walls["Store"] = _mesh_element(
+        f, b.body, "IfcWall", "Store", [
+            ((5.0, 3.0 - half, 0.0), (x0, 3.0 + half, WALL_H)),
+            ((x1, 3.0 - half, 0.0), (10.0, 3.0 + half, WALL_H)),
+            ((x0, 3.0 - half, top), (x1, 3.0 + half, WALL_H)),
+        ], b.storey)
+    api("root.remove_product", f, product=store)
+    curtain = api("root.create_entity", f, ifc_class="IfcCurtainWall", name="Glazing")
+    api("spatial.assign_container", f, products=[curtain], relating_structure=b.storey)
+    parts = [
+        _mesh_element(f, b.body, "IfcPlate", f"Glass {i}",
+                      [((1.0 + 1.5 * i, 6.55, 0.1), (2.5 + 1.5 * i, 6.57, 2.4))], None)
+        for i in range(2)
+    ] + [
+        _mesh_element(f, b.body, "IfcMember", f"Mullion {i}",
+                      [((0.95 + 1.5 * i, 6.5, 0.0), (1.05 + 1.5 * i, 6.62, 2.5))], None)
+        for i in range(3)
+    ]
+    api("aggregate.assign_object", f, products=parts, relating_object=curtain)
+    b.walls["Gable"] = _mesh_element(f, b.body, "IfcWall", "Gable",
+                                     [((-0.1, 0.0, 3.0), (0.1, 6.0, 4.8))], b.storey)
+    bodiless = api("root.create_entity", f, ifc_class="IfcWall", name="Sketch")
+    api("spatial.assign_container", f, products=[bodiless], relating_structure=b.storey)
+    b.walls["Sketch"] = bodiless
+    return b

@@ -7,6 +7,7 @@ import re
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("ifcopenshell")
@@ -15,6 +16,7 @@ import ifcopenshell.api
 from ifc_buildings import PANELS, Panel, three_rooms
 
 from bt_manip.cli import main
+from bt_manip.sim.world_reader import parse_world
 
 
 def _run(capsys, *argv: str) -> tuple[int, str]:
@@ -52,18 +54,23 @@ def test_no_storey(tmp_path, capsys):
 
 
 def test_unsupported_geometry_of_a_round_wall(tmp_path, capsys):
-    b = three_rooms()
+    # a round wall to install is refused; the same wall as part of the building is an obstacle
+    b = three_rooms(with_tasks=False)
     f = b.file
     wall = ifcopenshell.api.run("root.create_entity", f, ifc_class="IfcWall", name="Round")
     profile = f.createIfcCircleProfileDef("AREA", None, None, 300.0)
     rep = ifcopenshell.api.run("geometry.add_profile_representation", f, context=b.body,
                                profile=profile, depth=2.5)
     ifcopenshell.api.run("geometry.assign_representation", f, product=wall, representation=rep)
-    ifcopenshell.api.run("geometry.edit_object_placement", f, product=wall)
+    matrix = np.eye(4)
+    matrix[:3, 3] = [2.5, 3.0, 0.0]  # metres: the api converts to the file's millimetres
+    ifcopenshell.api.run("geometry.edit_object_placement", f, product=wall, matrix=matrix)
     ifcopenshell.api.run("spatial.assign_container", f, products=[wall],
                          relating_structure=b.storey)
     path = b.write(tmp_path / "round.ifc")
-    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    csv = tmp_path / "s.csv"
+    csv.write_text(f"{wall.GlobalId},1\n")
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"), "--schedule", str(csv))
     assert code == 2
     line = _line_of(path, wall.id())
     prefix = f"{path}:{line}: #{wall.id()} IfcWall 'Round': unsupported geometry:"
@@ -71,6 +78,22 @@ def test_unsupported_geometry_of_a_round_wall(tmp_path, capsys):
     # a 0.3 m circle fills about pi/4 of its square
     m = re.search(r"fills (\d+)% of its upright bounding box \(0.600 x 0.600 x 2.500 m\)", err)
     assert m is not None and 75 <= int(m.group(1)) < 90, err
+    assert not (tmp_path / "o").exists()
+
+    code, _ = _run(capsys, str(path), "--out", str(tmp_path / "world"))
+    assert code == 0
+    spec = parse_world(tmp_path / "world" / "world.yaml")
+    (round_wall,) = [item for item in spec.furniture if item.name == "round"]
+    assert len(round_wall.parts) > 3  # strips across the circle
+    centre = np.array(round_wall.pose.xyz[:2])
+    assert centre == pytest.approx((2.5, 3.0), abs=0.01)
+    for part in round_wall.parts:  # every strip within the circle's square, none far outside
+        assert abs(part.xyz[0]) + part.size[0] / 2 <= 0.31
+        assert abs(part.xyz[1]) + part.size[1] / 2 <= 0.31
+        assert part.size[2] == pytest.approx(2.5, abs=1e-3)
+    # the strips cover the circle, and less than its square
+    area = sum(p.size[0] * p.size[1] for p in round_wall.parts)
+    assert math.pi * 0.3**2 <= area < 0.95 * 0.6**2
 
 
 def test_element_wider_than_the_doors_on_its_route(tmp_path, capsys):
@@ -90,8 +113,9 @@ def test_element_wider_than_the_doors_on_its_route(tmp_path, capsys):
 
 
 def test_unreachable_place(tmp_path, capsys):
-    # outside the building, which has no door to the outside
-    panels = [*PANELS[:2], Panel("Panel X", (12.0, 3.0, 1.0), 0.0, "2026-03-10")]
+    # outside the building, which has no door to the outside (standing on the ground, within
+    # the arm's reach)
+    panels = [*PANELS[:2], Panel("Panel X", (12.0, 3.0, 0.15), 0.0, "2026-03-10")]
     b = three_rooms(panels=panels)
     path = b.write(tmp_path / "outside.ifc")
     panel = b.panels[-1]
@@ -123,10 +147,20 @@ def test_schedule_naming_unknown_global_ids(tmp_path, capsys):
 def test_ifc2x3_needs_a_csv(tmp_path, capsys):
     b = three_rooms(schema="IFC2X3")
     path = b.write(tmp_path / "old.ifc")
-    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"), "--require-install")
     assert code == 2
     assert "no element to install: schedules are read from IFC4 files only" in err
     assert "--schedule FILE.csv" in err
+    assert not (tmp_path / "o").exists()
+    # without --require-install, the building alone becomes a world, and the note says why
+    code = main(["bim", str(path), "--out", str(tmp_path / "w")])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "no element to install: schedules are read from IFC4 files only" in out
+    assert sorted(p.name for p in (tmp_path / "w").iterdir()) == ["world.yaml"]
+    spec = parse_world(tmp_path / "w" / "world.yaml")
+    assert {"workshop", "office", "store", "start"} <= set(spec.poses)
+    assert spec.objects == [] and len(spec.walls) == 6
 
 
 def test_file_and_element_count_bounds(tmp_path, capsys, monkeypatch):

@@ -32,9 +32,14 @@ def test_husky_tuck_folds_the_arm_onto_itself_and_the_descriptor_allows_it() -> 
     listed = desc.planning.allowed
     assert listed is not None and touching <= listed["default"]
     assert not _tuck_scene(desc, allowed_pairs(desc)).collides(tuck)
-    # found again from the URDF and the states, the same pairs as shipped
+
+
+@pytest.mark.parametrize("robot", ["husky_ur3", "sawyer", "panda", "omni_sawyer", "tiago"])
+def test_every_shipped_descriptor_lists_what_robot_init_finds(robot: str) -> None:
+    desc = RobotDescription.load(robot)
     found = find_allowed_collisions(desc)
-    assert found.default == listed["default"] and found.never == listed["never"]
+    assert desc.planning.allowed == {"default": found.default, "never": found.never,
+                                     "user": frozenset()}
 
 
 def test_never_pairs_stay_apart_in_other_configurations() -> None:
@@ -87,3 +92,19 @@ def test_bad_planning_sections_name_file_and_line(
         load_description(path)
     text = str(err.value)
     assert f"{path}:{line}" in text and message in text
+
+
+def test_a_continuous_joint_is_locked_at_its_angle() -> None:
+    """The holonomic base's yaw is a continuous joint (cos, sin in Pinocchio): locked at 0.7
+    rad it turns the arm by 0.7 rad, and leaves the arm's own links where they were."""
+    import pinocchio as pin
+
+    desc = RobotDescription.load("omni_sawyer")
+    tuck = np.asarray(desc.state("tuck"))
+    turned = CollisionScene(desc.urdf_path, list(desc.arm.joints),
+                            locked={"base_yaw": 0.7}, allowed=allowed_pairs(desc))
+    assert not turned.collides(tuck)
+    data = turned.model.createData()
+    pin.framesForwardKinematics(turned.model, data, tuck)
+    base = data.oMf[turned.model.getFrameId("right_arm_base_link")].rotation
+    assert np.arctan2(base[1, 0], base[0, 0]) == pytest.approx(0.7, abs=1e-9)

@@ -1,0 +1,68 @@
+"""Convex hulls of 2D points, as footprints need them: the corners of the hull of a few
+points (an obstacle's outline, a mapped shape's) and the distinct points under it.
+
+Qhull (scipy) finds any hull, but its setup costs far more than the hull of the tens of
+points a footprint has: those go through :func:`monotone_chain` in Python instead.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+SMALL_HULL = 256
+"""Hulls of at most this many distinct points are found by :func:`monotone_chain`, larger
+ones by Qhull."""
+
+
+def monotone_chain(pts: np.ndarray) -> np.ndarray:
+    """The corners (counter-clockwise) of the convex hull of distinct points sorted by x then
+    y (Andrew's monotone chain); points on an edge, or within the rounding of one, are left
+    out, as Qhull leaves them (the two may differ on a point within about 1e-15 of the
+    coordinates' size of an edge)."""
+    rows = pts.tolist()
+    # a turn this small is rounding, not a corner: about where Qhull draws the line
+    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
+
+    def half(points: list[list[float]]) -> list[list[float]]:
+        out: list[list[float]] = []
+        for p in points:
+            while len(out) >= 2:
+                (ax, ay), (bx, by) = out[-2], out[-1]
+                if (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax) > eps:
+                    break
+                out.pop()
+            out.append(p)
+        return out
+
+    lower, upper = half(rows), half(rows[::-1])
+    return np.array(lower[:-1] + upper[:-1], dtype=float).reshape(-1, 2)
+
+
+def unique_rows(xy: np.ndarray) -> np.ndarray:
+    """The distinct rows of an N x 2 array, sorted by x then y (``np.unique(xy, axis=0)``,
+    without its structured-array round trip)."""
+    if len(xy) == 0:
+        return np.empty((0, 2), dtype=float)
+    ordered = xy[np.lexsort((xy[:, 1], xy[:, 0]))]
+    keep = np.ones(len(ordered), dtype=bool)
+    keep[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
+    out: np.ndarray = ordered[keep]
+    return out
+
+
+def hull_xy(xy: np.ndarray) -> np.ndarray:
+    """The corners of the convex hull of 2D points (the points themselves when they are
+    fewer than three or collinear)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    pts = unique_rows(np.round(xy, 9))
+    if len(pts) < 3:
+        return pts
+    if len(pts) <= SMALL_HULL:
+        chain = monotone_chain(pts)
+        return chain if len(chain) >= 3 else pts
+    try:
+        corners: np.ndarray = pts[ConvexHull(pts).vertices]
+        return corners
+    except QhullError:
+        return pts
