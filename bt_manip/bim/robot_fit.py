@@ -16,11 +16,10 @@ in the shared cache, keyed by the robot's composed URDF and descriptor, and reus
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import math
-import os
-import tempfile
 from dataclasses import asdict, dataclass
 from typing import Any
 
@@ -30,6 +29,7 @@ from bt_manip.kinematics.arm_model import ArmModel
 from bt_manip.kinematics.compiled import cache_dir
 from bt_manip.kinematics.ik import IKOptions, IKSolver
 from bt_manip.manipulation.grasps import GRASP_DEPTH, OPENING_MARGIN
+from bt_manip.sim.compose import write_atomic_bytes
 from bt_manip.sim.robot_description import RobotDescription
 
 APPROACH = 0.12
@@ -109,17 +109,8 @@ def _key(robot: RobotDescription) -> str:
 
 def _store(path: Any, fit: RobotFit) -> None:
     """Write the survey atomically; a cache that cannot be written is skipped."""
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=".fit-", suffix=".tmp", dir=path.parent)
-    except OSError:
-        return
-    try:
-        with os.fdopen(fd, "w") as fh:
-            json.dump(asdict(fit), fh)
-        os.replace(tmp, path)
-    except OSError:
-        os.unlink(tmp)
+    with contextlib.suppress(OSError):
+        write_atomic_bytes(path, json.dumps(asdict(fit)).encode())
 
 
 def _survey(robot: RobotDescription) -> RobotFit:
