@@ -143,7 +143,7 @@ TOUCH = """<root BTCPP_format="4" main_tree_to_execute="Touch">
   <BehaviorTree ID="Touch">
     <Sequence>
       <SubTree ID="FetchElement" element="panel_w2" opening="0.021"/>
-      <ForceSuccess><MoveToolBy name="push_down" offset="0;0;-0.3"/></ForceSuccess>
+      <ForceSuccess><MoveToolBy name="push_down" offset="0;0;-0.3" CHECK/></ForceSuccess>
       <Place name="place_touched" object="panel_w2" target="{target}"/>
     </Sequence>
   </BehaviorTree>
@@ -196,11 +196,17 @@ def test_place_and_fasten_succeed_and_fail_with_their_reasons(two_panels, tmp_pa
 def test_place_fails_when_the_carried_panel_touched_something(two_panels, tmp_path):
     conversion = two_panels[0]
     t = conversion.elements[0].target
-    report, _ = _run(tmp_path, conversion, TOUCH, "touch",
-                     f"target={t['x']};{t['y']};{t['z']};{t['yaw']}")
-    assert report["status"] == "FAILURE"
+    target = f"target={t['x']};{t['y']};{t['z']};{t['yaw']}"
+    # the push down is refused before the arm moves: the panel would meet the ground
+    report, _ = _run(tmp_path, conversion, TOUCH.replace("CHECK", ""), "refused", target)
     (pushed,) = _reasons(report, "push_down")
-    assert "carried 'panel_w2' touched 'ground'" in pushed
+    assert pushed.startswith("the tool's straight move would collide: ")
+    assert "panel_w2 touches ground" in pushed
+    # pushed down regardless (no checks), the panel touches the ground: Place refuses
+    report, _ = _run(tmp_path, conversion,
+                     TOUCH.replace("CHECK", 'check_collisions="false" joint_timeout="2"'),
+                     "touch", target)
+    assert report["status"] == "FAILURE"
     (reason,) = _reasons(report, "place_touched")
     assert reason == (
         "'panel_w2' touched 'ground' while carried, before the final placing motion"
