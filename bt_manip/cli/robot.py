@@ -41,6 +41,11 @@ def add_robot_arguments(robot: argparse.ArgumentParser) -> None:
         help="a mobile base: skid or diff (wheels found from its continuous joints), or "
         "holonomic (virtual x, y, yaw joints above --base-link); default: fixed base",
     )
+    init.add_argument(
+        "--lidar", default="", metavar="LINK",
+        help="a planar laser at the origin of LINK, scanning in its x-y plane (a sensors: entry "
+        "with the default 270 deg, 541 beams, 12 m; edit xyz and rpy there)",
+    )
     init.add_argument("--name", default="", help="robot name (default: the --out file name)")
     init.add_argument("--out", required=True, help="descriptor to write, e.g. robots/NAME.yaml")
     init.set_defaults(func=cmd_robot_init)
@@ -68,6 +73,7 @@ def cmd_robot_init(args: argparse.Namespace) -> int:
             name=args.name,
             grasp_frame=args.grasp_frame,
             approach_axis=args.approach_axis,
+            lidar=args.lidar,
         ),
         notes,
     )

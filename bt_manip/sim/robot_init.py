@@ -105,6 +105,8 @@ class InitOptions:
     grasp_frame: str = ""
     approach_axis: str = ""
     """``x``, ``-y``, ...: the grasp frame's axis the gripper approaches along; "" = found."""
+    lidar: str = ""
+    """A link carrying a planar laser (its origin, scanning in its x-y plane); "" = none."""
 
 
 @dataclass(frozen=True)
@@ -371,6 +373,10 @@ def _check_names(urdf: _Urdf, opts: InitOptions) -> list[Problem]:
                     "must be prismatic or revolute",
                 )
             )
+    if opts.lidar and opts.lidar not in urdf.links:
+        problems.append(
+            urdf.problem(root_line, f"--lidar: no link '{opts.lidar}' in the URDF")
+        )
     if opts.approach_axis and opts.approach_axis not in APPROACH_AXES:
         problems.append(urdf.problem(
             None, f"--approach-axis must be one of {', '.join(APPROACH_AXES)}"
@@ -553,6 +559,18 @@ def _descriptor_text(
         f"  ready: {_state(ready, lower, upper)}   # middle of each joint's range",
     ]
     lines += geometry.footprint_lines()
+    if opts.lidar:
+        notes.append(f"the laser at the origin of '{opts.lidar}', scanning in its x-y plane "
+                     "(270 deg, 541 beams, 12 m: the sensor defaults of robots/README.md); set "
+                     "xyz and rpy in sensors: if it sits elsewhere")
+        lines += [
+            "sensors:                  # format: robots/README.md (unset keys: the defaults)",
+            "  - type: lidar2d",
+            "    name: laser",
+            f"    link: {opts.lidar}",
+            "    xyz: [0.0, 0.0, 0.0]",
+            "    rpy: [0.0, 0.0, 0.0]",
+        ]
     return "\n".join(lines) + "\n"
 
 

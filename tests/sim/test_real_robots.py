@@ -257,3 +257,16 @@ def test_mimic_joint_follows_its_leader(tmp_path: Path) -> None:
     assert desc.gripper.joints == ("panda_finger_joint1", "panda_finger_joint2")
     assert desc.gripper.kind == "parallel" and desc.gripper.max_opening == pytest.approx(0.08)
     assert any("'panda_finger_joint2' mimics 'panda_finger_joint1'" in n for n in notes)
+
+
+def test_lidar_link_gives_a_laser_in_the_descriptor(tmp_path: Path) -> None:
+    notes: list[str] = []
+    desc = init_descriptor(_tiago(tmp_path, lidar="base_link"), notes)
+    (laser,) = desc.sensors
+    assert (laser.name, laser.link, laser.xyz, laser.rpy) == (
+        "laser", "base_link", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    assert (laser.fov_deg, laser.beams) == (270.0, 541)
+    assert any("the laser at the origin of 'base_link'" in n for n in notes)
+    with pytest.raises(InputError, match="--lidar: no link 'nowhere_link'"):
+        init_descriptor(_tiago(tmp_path / "bad", lidar="nowhere_link"))
+    assert not (tmp_path / "bad" / "tiago.yaml").exists()
