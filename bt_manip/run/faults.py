@@ -164,19 +164,28 @@ def parse_fault(text: str) -> FaultSpec:
     return FaultSpec(kind, p, target)
 
 
+def _bounded(text: str, name: str, top: float, bad: Callable[[str], InputError],
+             unit: str = "") -> float:
+    """``text`` as a number within 0..``top`` (``unit`` for the message), else ``bad``."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise bad(f"{name} '{text}' is not a number") from None
+    if not 0.0 <= value <= top:  # also refuses nan
+        unit = f" {unit}" if unit else ""
+        raise bad(f"{name} {text}{unit} is not within 0..{top:g}{unit}")
+    return value
+
+
 def _parse_pose_noise(values: list[str], bad: Callable[[str], InputError]) -> FaultSpec:
     """The sigmas of ``pose_noise:SIGMA_M[:SIGMA_DEG]`` (``values`` after the kind)."""
     if len(values) not in (1, 2):
         raise bad("pose_noise takes a position sigma in metres and optionally a yaw sigma in deg")
-    sigmas = []
-    for v, (unit, top) in zip(values, (("m", MAX_SIGMA_M), ("deg", MAX_SIGMA_DEG)), strict=False):
-        try:
-            sigma = float(v)
-        except ValueError:
-            raise bad(f"sigma '{v}' is not a number") from None
-        if not 0.0 <= sigma <= top:  # also refuses nan
-            raise bad(f"sigma {v} {unit} is not within 0..{top:g} {unit}")
-        sigmas.append(sigma)
+    sigmas = [
+        _bounded(v, "sigma", top, bad, unit)
+        for v, (unit, top) in zip(values, (("m", MAX_SIGMA_M), ("deg", MAX_SIGMA_DEG)),
+                                  strict=False)
+    ]
     sigma_deg = sigmas[1] if len(sigmas) == 2 else DEFAULT_SIGMA_DEG
     return FaultSpec(POSE_NOISE, 0.0, sigma_m=sigmas[0], sigma_deg=sigma_deg)
 
@@ -197,15 +206,7 @@ def _parse_localization_fault(
     what, shape = _LOCALIZATION_SHAPES[kind]
     if not 1 <= len(values) <= len(shape):
         raise bad(f"{kind} {what}")
-    out = []
-    for v, (name, top) in zip(values, shape, strict=False):
-        try:
-            x = float(v)
-        except ValueError:
-            raise bad(f"{name} '{v}' is not a number") from None
-        if not 0.0 <= x <= top:  # also refuses nan
-            raise bad(f"{name} {v} is not within 0..{top:g}")
-        out.append(x)
+    out = [_bounded(v, name, top, bad) for v, (name, top) in zip(values, shape, strict=False)]
     if kind == ODOM_NOISE and len(out) == 1:
         out.append(out[0])
     return FaultSpec(kind, 0.0, values=tuple(out))
