@@ -28,7 +28,8 @@ from bt_manip.kinematics.reasons import BEYOND_REACH, JOINT_LIMITS, NOT_CONVERGE
 from bt_manip.manipulation import cartesian
 from bt_manip.manipulation.arm_planner import PLANNERS, ArmPlanner
 from bt_manip.manipulation.base_search import object_grasp
-from bt_manip.manipulation.rrt_connect import PlanError, path_length
+from bt_manip.manipulation.collision_scene import named_contacts
+from bt_manip.manipulation.rrt_connect import PlanError, check_end, path_length
 from bt_manip.manipulation.trajectory import Trajectory, time_parameterise
 from bt_manip.sim.randomize import entity_rng
 
@@ -55,8 +56,6 @@ VIA = Port(
 )
 CORRECTION_SPEED = 0.2
 """Every joint may correct at no less than this fraction of its allowed speed."""
-PLANNED_VIA = 0.01
-"""rad: how close each joint passes a planned waypoint."""
 IK_GOAL_TRIES = 12
 """Other IK seeds tried when the first solution for a pose is in collision."""
 ARM_PATH_COLOUR = (0.95, 0.45, 0.1, 1.0)
@@ -98,9 +97,6 @@ class Stage:
     """A free joint move that may be replaced by a planned, collision-free one."""
     goal_checked: bool = False
     """A plannable stage whose command the node already found free in the planning scene."""
-    planned: bool = False
-    """A waypoint of a planned path: passed within :data:`PLANNED_VIA` rad, so the arm keeps
-    to the checked path."""
     trajectory: Trajectory | None = None
     """A planned path to this stage's command, timed within the joints' limits: the arm is
     given the trajectory's position a tick ahead, tick after tick, then the command."""
@@ -152,12 +148,7 @@ class JointMove(RobotAction):
         """The robot's arm planner, or None when this node does not plan."""
         if not self.PLANS or self.get_input("planner") == "none":
             return None
-        services = self.services()
-        if services.arm_planner is None:
-            robot = self.robot()
-            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
-        planner: ArmPlanner = services.arm_planner
-        return planner
+        return self.arm_planner()
 
     def _free_goal(
         self, tip: str, pose: np.ndarray, q: np.ndarray, q_now: np.ndarray, free: bool,
@@ -220,9 +211,10 @@ class JointMove(RobotAction):
         scene = planner.scene()
         if not self.stages[index].goal_checked:  # a goal must be free without padding
             planner.sync(scene, self.grasping(), (start,), movables=False)
-            if scene.collides(goal):
-                pairs = ", ".join(f"{a} touches {b}" for a, b in scene.contacts(goal)[:4])
-                raise ActionFailed(f"planning the arm's move: the goal is in collision: {pairs}")
+            try:
+                check_end(scene, goal, "goal")
+            except PlanError as exc:
+                raise ActionFailed(f"planning the arm's move: {exc}") from None
         padding = self.get_input("padding", None)
         if padding is None:
             padding = self.robot().description.planning.padding
@@ -340,9 +332,10 @@ class JointMove(RobotAction):
         planning scene before it moves (what it touches at ``q`` already may stay)."""
         hits = self._world_hits(q, [stage.command])
         if hits:
-            joints = self.robot().description.arm.joints
+            robot = self.robot()
+            joints = robot.description.arm.joints
             moving = ", ".join(f"{j} ({joints[j]})" for j in stage.joints)
-            self.robot().hold_arm()
+            robot.hold_arm()
             raise ActionFailed(f"joint {moving} would collide on its way: {hits}")
 
     def _check_lines(self, q_now: np.ndarray, stages: list[Stage]) -> None:
@@ -367,11 +360,7 @@ class JointMove(RobotAction):
         the planning scene at the planner's validation step. The arm against itself is not
         checked (nor is it while it moves), nor are movable objects (it may push them); what it
         touches at ``q`` already may stay."""
-        services = self.services()
-        if services.arm_planner is None:
-            robot = self.robot()
-            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
-        planner: ArmPlanner = services.arm_planner
+        planner = self.arm_planner()
         scene = planner.scene()
         planner.sync(scene, "", (q,), movables=False)
         step = planner.options.validate_step
@@ -384,7 +373,7 @@ class JointMove(RobotAction):
                     hits = [p for p in scene.contacts(here)
                             if p[0] in scene.obstacles or p[1] in scene.obstacles]
                     if hits:
-                        return ", ".join(f"{a} touches {b}" for a, b in hits[:4])
+                        return named_contacts(hits)
             here_from = there
         return ""
 
@@ -457,8 +446,7 @@ class JointMove(RobotAction):
         err = list(map(abs, map(operator.sub, q, self._command)))
         # "every e < tol" as tol > e on each (False for a NaN, as numpy's comparison)
         if self.stages[self.stage].via:
-            tol = PLANNED_VIA if self.stages[self.stage].planned else self.via_tol
-            arrived = all(map(float(tol).__gt__, err))
+            arrived = all(map(float(self.via_tol).__gt__, err))
         else:
             arrived = all(map(float(self.tol).__gt__, err)) and all(
                 map(SETTLE_SPEED.__gt__, map(abs, qd))

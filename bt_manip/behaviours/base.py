@@ -20,6 +20,7 @@ from py_trees.ports import PortInformation
 from bt_manip.bt import ActionNode, ConditionNode, PortError, TreeContext
 from bt_manip.kinematics.reasons import SOLVER_KNOBS
 from bt_manip.localization.frames import compose, inverse
+from bt_manip.manipulation.arm_planner import ArmPlanner
 from bt_manip.manipulation.errors import ManipulationError
 from bt_manip.manipulation.grasps import grasped_object
 from bt_manip.manipulation.perception import PerceptionError, movable_body, perceived_pose
@@ -119,6 +120,16 @@ class WorldAccess:
         """The navigator and arm IK of the robot this node acts on."""
         robot = self.robot()
         return self.run_context.robot_services(self.robot_name_of(robot))
+
+    def arm_planner(self) -> ArmPlanner:
+        """The arm planner (planning scene and plans) of the robot this node acts on, made on
+        first use and kept with the robot's services for the run."""
+        services = self.services()
+        if services.arm_planner is None:
+            robot = self.robot()
+            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
+        planner: ArmPlanner = services.arm_planner
+        return planner
 
     @property
     def overlay(self) -> Overlay:

@@ -35,7 +35,7 @@ from bt_manip.bt import SyncActionNode, registry
 from bt_manip.bt.node import closest
 from bt_manip.bt.ports import NON_NEGATIVE, Accepts, Port, count_of
 from bt_manip.geometry import quat_from_matrix, rotation_matrix
-from bt_manip.manipulation.arm_planner import ArmPlanner
+from bt_manip.manipulation.collision_scene import named_contacts
 from bt_manip.manipulation.reach import Reached, ReachOptions, UnreachableError, first_reached
 from bt_manip.sim import pybullet_queries as pbq
 
@@ -281,10 +281,7 @@ class DropPoint(WorldAccess, SyncActionNode):
                orientation: list[float]) -> Reached:
         """The first of ``cells`` the robot's arm reaches (see the class docstring)."""
         robot = self.robot()
-        services = self.services()
-        if services.arm_planner is None:
-            services.arm_planner = ArmPlanner(self.world, robot, self.robot_name_of(robot))
-        planner: ArmPlanner = services.arm_planner
+        planner = self.arm_planner()
         scene = planner.scene()
         seed = robot.arm_positions()
         planner.sync(scene, "", (seed,), movables=False)
@@ -292,14 +289,14 @@ class DropPoint(WorldAccess, SyncActionNode):
         def free(q: np.ndarray) -> str | None:
             if not scene.collides(q):
                 return None
-            return ", ".join(f"{a} touches {b}" for a, b in scene.contacts(q)[:3])
+            return named_contacts(scene.contacts(q), 3)
 
         rows = int(self.get_input("rows"))
         cols = int(self.get_input("cols"))
         options = ReachOptions(math.radians(float(self.get_input("max_tilt"))), TILT_STEPS)
         try:
             return first_reached(
-                services, robot.description.grasp_frame, [p for _, p in cells],
+                self.services(), robot.description.grasp_frame, [p for _, p in cells],
                 rotation_matrix(orientation), seed, options, free,
                 lambda i: f"cell {cells[i][0]}",
             )

@@ -76,7 +76,7 @@ class ArmPlanner:
         self.robot = robot
         self.robot_name = robot_name
         self._scenes: OrderedDict[tuple[tuple[str, float], ...], CollisionScene] = OrderedDict()
-        self._quiet: set[frozenset[str]] | None = None
+        self._allowed: set[frozenset[str]] | None = None
         self.options = PlanOptions(max_checks=60_000)
         self.plans = 0
         """Plans started."""
@@ -106,9 +106,9 @@ class ArmPlanner:
         if scene is None:
             desc = self.robot.description
             scene = CollisionScene(desc.urdf_path, list(desc.arm.joints), locked=locked)
-            if self._quiet is None:
-                self._quiet = allowed_pairs(desc)
-            scene.allow(self._quiet)
+            if self._allowed is None:
+                self._allowed = allowed_pairs(desc)
+            scene.allow(self._allowed)
             self._scenes[key] = scene
             while len(self._scenes) > SCENES_KEPT:
                 self._scenes.popitem(last=False)

@@ -43,7 +43,14 @@ import pinocchio as pin
 from bt_manip.cache import Memo, bytes_key
 from bt_manip.sim.compose import cache_dir, composed_urdf, file_stamp
 
-__all__ = ["CollisionScene", "Obstacle", "SceneError", "never_colliding_pairs", "srdf_pairs"]
+__all__ = [
+    "CollisionScene",
+    "Obstacle",
+    "SceneError",
+    "named_contacts",
+    "never_colliding_pairs",
+    "srdf_pairs",
+]
 
 
 HULL_MARGIN = 1e-4
@@ -97,8 +104,8 @@ def _se3(pose: Sequence[Sequence[float]] | np.ndarray) -> pin.SE3:
 
 _LOADED: Memo[tuple[pin.Model, pin.GeometryModel]] = Memo(8)
 """Models and collision geometry read in this process, by URDF bytes."""
-_HULLS: Memo[pin.GeometryModel] = Memo(8)
-"""Collision geometry with each mesh replaced by its convex hull, by URDF bytes."""
+_HULLS: Memo[tuple[pin.Model, pin.GeometryModel]] = Memo(8)
+"""Models and collision geometry with each mesh replaced by its convex hull, by URDF bytes."""
 _MESH_FILE = re.compile(rb'filename\s*=\s*"([^"]+)"')
 
 
@@ -154,14 +161,13 @@ def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.Ge
     are read only when a check needs them."""
     raw = _key(urdf, package_dirs)
     key = bytes_key(raw)
-    full = pin.buildModelFromUrdf(str(urdf))
     known = _HULLS.get(key)
     if known is None:
         path = cache_dir() / f"hulls-{hashlib.sha256(raw).hexdigest()[:24]}.bin"
-        known = _read(path)
-        if known is None:
-            _, known = _loaded(urdf, package_dirs)
-            for g in known.geometryObjects:
+        hulls = _read(path)
+        if hulls is None:
+            _, hulls = _loaded(urdf, package_dirs)
+            for g in hulls.geometryObjects:
                 shape = g.geometry
                 if isinstance(shape, coal.BVHModelBase):
                     # the convex hull itself: buildConvexRepresentation keeps the mesh's
@@ -169,9 +175,10 @@ def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.Ge
                     # concave mesh and can find it free where the mesh touches
                     shape.buildConvexHull(True, "Qt")
                     g.geometry = shape.convex
-            _save(known, path)
+            _save(hulls, path)
+        known = (pin.buildModelFromUrdf(str(urdf)), hulls)
         _HULLS.put(key, known)
-    return full, known.clone()
+    return known[0], known[1].clone()
 
 
 _EXACT_REQUEST = coal.CollisionRequest()
@@ -226,6 +233,11 @@ def _save(geometry: pin.GeometryModel | coal.CollisionGeometry, path: Path) -> N
     finally:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
+
+
+def named_contacts(pairs: Sequence[tuple[str, str]], most: int = 4) -> str:
+    """``a touches b, c touches d``: the first ``most`` pairs in contact, for a reason."""
+    return ", ".join(f"{a} touches {b}" for a, b in pairs[:most])
 
 
 def srdf_pairs(path: Path) -> set[frozenset[str]]:

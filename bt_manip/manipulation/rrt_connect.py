@@ -24,10 +24,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bt_manip.manipulation.collision_scene import CollisionScene
+from bt_manip.manipulation.collision_scene import CollisionScene, named_contacts
 
 __all__ = [
-    "PlanError", "PlanOptions", "PlanResult", "path_length", "plan", "plan_steps", "shortcut",
+    "PlanError", "PlanOptions", "PlanResult", "check_end", "path_length", "plan", "plan_steps",
+    "shortcut",
 ]
 
 
@@ -100,15 +101,15 @@ def _steer(a: np.ndarray, b: np.ndarray, extend: float) -> np.ndarray:
     return b.copy() if dist <= extend else a + d * (extend / dist)
 
 
-def _check_end(scene: CollisionScene, q: np.ndarray, which: str) -> None:
+def check_end(scene: CollisionScene, q: np.ndarray, which: str) -> None:
+    """PlanError when the path's ``which`` end (start, goal) is outside the joint limits
+    (naming the joints) or in collision (naming what touches)."""
     if not scene.within_limits(q):
         bad = [scene.joint_names[i] for i in range(q.size)
                if not scene.lower[i] - 1e-9 <= q[i] <= scene.upper[i] + 1e-9]
         raise PlanError(f"the {which} is outside the joint limits of {', '.join(bad)}")
     if scene.collides(q):
-        pairs = scene.contacts(q)
-        named = ", ".join(f"{a} touches {b}" for a, b in pairs[:4])
-        raise PlanError(f"the {which} is in collision: {named}")
+        raise PlanError(f"the {which} is in collision: {named_contacts(scene.contacts(q))}")
 
 
 def plan(
@@ -145,8 +146,8 @@ def plan_steps(
     start = np.asarray(start, dtype=float)
     goal = np.asarray(goal, dtype=float)
     first = scene.checks
-    _check_end(scene, start, "start")
-    _check_end(scene, goal, "goal")
+    check_end(scene, start, "start")
+    check_end(scene, goal, "goal")
     if scene.segment_free(start, goal, options.step):
         # checked again at the validation step, as every path is
         direct = _validated(scene, [start, goal], rng, options, first, stop)
