@@ -15,7 +15,7 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.behaviours.base import ActionFailed, RobotAction, WorldAccess, WorldCondition
-from bt_manip.behaviours.navigate import _goal_text, parse_goal
+from bt_manip.behaviours.navigate import goal_text_problem, parse_goal
 from bt_manip.bt.ports import NON_NEGATIVE, POSITIVE, Accepts, Port
 from bt_manip.bt.registry import registry
 
@@ -88,7 +88,7 @@ class SetInitialPose(RobotAction):
     INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "pose": Port(str, True, "named world pose, or x;y;yaw (m, rad; map)",
-                     accepts=Accepts(check=_goal_text)),
+                     accepts=Accepts(check=goal_text_problem)),
         "xy_std": Port(float, False, "standard deviation in x and y (m)", 0.25, NON_NEGATIVE),
         "yaw_std": Port(float, False, "standard deviation in yaw (rad)", math.radians(15.0),
                         NON_NEGATIVE),

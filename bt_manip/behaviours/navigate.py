@@ -72,7 +72,7 @@ def parse_goal(world: Any, text: str) -> tuple[float, float, float]:
     return (values[0], values[1], values[2])
 
 
-def _goal_text(text: Any) -> str | None:
+def goal_text_problem(text: Any) -> str | None:
     """What is wrong with a goal written as numbers (a pose name is checked at run time)."""
     if not isinstance(text, str) or ";" not in text:
         return None
@@ -104,7 +104,7 @@ class Navigate(RobotAction):
     INPUT_PORTS: dict[str, PortInformation] = {
         **RobotAction.INPUT_PORTS,
         "goal": Port(str, True, "named world pose, or x;y;yaw (m, rad; world)",
-                     accepts=Accepts(check=_goal_text)),
+                     accepts=Accepts(check=goal_text_problem)),
         "xy_tolerance": Port(
             float, False, "distance to the goal that counts (m)", 0.1, POSITIVE
         ),

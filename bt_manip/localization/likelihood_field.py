@@ -131,17 +131,17 @@ class SensorModel:
         return table
 
     def beam_ends(self, scan: Scan, max_beams: int) -> np.ndarray:
-        """End points (m, 2) in the base frame of up to ``max_beams`` evenly spaced usable
-        beams of ``scan``."""
-        n = scan.ranges.size
+        """End points (m, 2) in the base frame of up to ``max_beams`` usable beams of
+        ``scan``, evenly spaced among the usable ones (a scan whose returns are partly
+        left out, by the robot's own body or a load across the laser, still gives the filter
+        ``max_beams`` of them)."""
+        r = scan.ranges
+        usable = np.flatnonzero(np.isfinite(r) & (r > 0.0) & (r < scan.range_max))
+        n = usable.size
         if n > max_beams:
-            pick = np.round(np.linspace(0.0, n - 1.0, max_beams)).astype(np.intp)
-        else:
-            pick = np.arange(n)
-        r = scan.ranges[pick]
-        a = scan.angles[pick]
-        ok = np.isfinite(r) & (r > 0.0) & (r < scan.range_max)
-        r, a = r[ok], a[ok]
+            usable = usable[np.round(np.linspace(0.0, n - 1.0, max_beams)).astype(np.intp)]
+        r = r[usable]
+        a = scan.angles[usable]
         sx, sy, syaw = scan.sensor_pose
         return np.column_stack([sx + r * np.cos(syaw + a), sy + r * np.sin(syaw + a)])
 
@@ -167,18 +167,28 @@ def _sum_logs(  # pragma: no cover - compiled
     poses: np.ndarray, ends: np.ndarray, table: np.ndarray, x0: float, y0: float, inv: float,
     rows: int, cols: int, out: np.ndarray,
 ) -> None:
-    """Per pose, the sum over the beam ends of the table's value at the end's cell (the border
-    cell when off the map); the table is the padded grid, flat."""
+    """Per pose, the sum over the beam ends of the table's value at the end, interpolated
+    bilinearly between the four nearest cell centres (the border cells' value off the map);
+    the table is the padded grid, flat."""
     stride = cols + 2
+    hi_col, hi_row = cols + 0.0, rows + 0.0
     for i in range(poses.shape[0]):
         px, py = poses[i, 0], poses[i, 1]
         c, s = np.cos(poses[i, 2]), np.sin(poses[i, 2])
         total = 0.0
         for j in range(ends.shape[0]):
             bx, by = ends[j, 0], ends[j, 1]
-            col = np.floor((px + c * bx - s * by - x0) * inv) + 1.0
-            row = np.floor((py + s * bx + c * by - y0) * inv) + 1.0
-            col = min(max(col, 0.0), cols + 1.0)
-            row = min(max(row, 0.0), rows + 1.0)
-            total += table[int(row) * stride + int(col)]
+            # position in padded cell-centre units: cell k's centre (padded index k) at k
+            u = (px + c * bx - s * by - x0) * inv + 0.5
+            v = (py + s * bx + c * by - y0) * inv + 0.5
+            u = min(max(u, 0.0), hi_col)
+            v = min(max(v, 0.0), hi_row)
+            cu = np.floor(u)
+            cv = np.floor(v)
+            fu = u - cu
+            fv = v - cv
+            k = int(cv) * stride + int(cu)
+            a = table[k] + fu * (table[k + 1] - table[k])
+            b = table[k + stride] + fu * (table[k + stride + 1] - table[k + stride])
+            total += a + fv * (b - a)
         out[i] = total

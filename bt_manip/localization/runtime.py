@@ -77,6 +77,9 @@ travel error after 1 m, 0.02 rad of heading error per radian turned, 0.01 rad pe
 MIN_RETURN_M = 0.4
 """Returns nearer than this to the laser are left out of what the filter reads (the robot's
 own wheels and bumpers, as a ROS laser filter would leave them out)."""
+SELF_FILTER_PADDING = 0.05
+"""A return within this (m) of where the robot's own model (its load included) would stop
+the beam is taken as the robot itself and left out."""
 MAP_RESOLUTION = 0.05
 """Cell side (m) of the localisation map."""
 SCAN_HALF_BAND = 0.03
@@ -245,7 +248,7 @@ class Localizer:
         """Scan, give the scan to the filter, and set ``map -> odom`` from its estimate."""
         scan = self.lidar.scan(self.faults.lidar_dropout)
         self.last_scan = scan
-        ranges = np.where(scan.ranges < MIN_RETURN_M, scan.range_max, scan.ranges)
+        ranges = np.where(self._own_returns(scan), scan.range_max, scan.ranges)
         reading = FilterScan(ranges, scan.angle_min, scan.angle_increment, scan.range_max,
                              sensor_pose=scan.sensor_pose, time=now)
         if self.filter.update(OdomPose(odom.x, odom.y, odom.yaw, now), reading):
@@ -255,6 +258,19 @@ class Localizer:
             self._last_update = (odom.x, odom.y, odom.yaw)
             if self.overlay is not None:
                 self.draw(self.overlay, scan)
+
+    def _own_returns(self, scan: Scan) -> np.ndarray:
+        """The beams of ``scan`` that end on the robot itself or on what it holds (a self
+        filter): nearer than :data:`MIN_RETURN_M`, or within :data:`SELF_FILTER_PADDING` of
+        where the robot's own model, in its current joint state with its held objects,
+        stops the beam. A load carried across the scan plane is not a wall to the filter."""
+        own = scan.ranges < MIN_RETURN_M
+        bodies = [self.robot.body] + [a.object_body
+                                      for a in self.world.attachments.held_by(self.name)]
+        model = self.lidar.model_ranges(bodies)
+        own |= scan.ranges >= model - SELF_FILTER_PADDING
+        own &= ~scan.no_return
+        return own
 
     def draw(self, overlay: Overlay, scan: Scan) -> None:
         """Draw on ``overlay``: the scan's returns where the robot believes it is (red, at the

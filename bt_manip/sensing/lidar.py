@@ -21,6 +21,7 @@ Readings, as a ROS driver gives them and AMCL reads them:
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -146,6 +147,17 @@ class Lidar:
             sensor=spec.name,
             true_pose=(float(origin[0]), float(origin[1]), heading),
         )
+
+    def model_ranges(self, bodies: Collection[int]) -> np.ndarray:
+        """Exact ranges (``beams``,) from the sensor now to ``bodies`` alone (``inf`` where a
+        beam misses them): where the robot's own model, and what it holds, would stop each
+        beam. A self filter compares a scan with these to leave out the returns from the robot
+        itself (what the robot knows of its own shape, joints and grasp, not of the world)."""
+        spec = self.spec
+        origin, heading = self.sensor_pose()
+        cut = self.scene.bodies_section(float(origin[2]), bodies)
+        return cast(origin[0], origin[1], heading, spec.angle_min, spec.angle_increment,
+                    spec.beams, cut.segments, cut.circles)
 
     def _in_base(self, origin: np.ndarray, heading: float) -> tuple[float, float, float]:
         bx, by, byaw = self.robot.base_pose2d()

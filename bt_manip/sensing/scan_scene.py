@@ -20,6 +20,7 @@ The ground plane is never part of a section.
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -163,6 +164,17 @@ class ScanScene:
         parts = [static] + [m for m in moving if m is not None]
         if len(parts) == 1:
             return static
+        return Segments(np.concatenate([p.segments for p in parts]),
+                        np.concatenate([p.circles for p in parts]))
+
+    def bodies_section(self, height: float, bodies: Collection[int]) -> Segments:
+        """What the plane ``z = height`` cuts of the moving ``bodies`` alone (a robot and what
+        it holds: the model a laser's self filter compares returns with), world frame."""
+        self._sync_bodies()
+        parts = [m for body in bodies if body in self._pieces
+                 if (m := self._moving_section(body, self._pieces[body], height)) is not None]
+        if not parts:
+            return Segments(np.zeros((0, 4)), np.zeros((0, 3)))
         return Segments(np.concatenate([p.segments for p in parts]),
                         np.concatenate([p.circles for p in parts]))
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -85,3 +86,41 @@ def test_slip_against_a_wall_fools_odometry(room: World) -> None:
     truth = _moved(room, start)
     assert truth[0] < 0.25  # the wall stopped it
     assert odo.x > truth[0] + 0.3  # the wheels kept turning
+
+
+def test_holonomic_base_odometry_follows_sideways_and_turning_moves(tmp_path: Path) -> None:
+    """The omni base's odometry reads its virtual x, y and yaw joints: a sideways drive and a
+    drive while turning come out in the base's own frame as the truth has them."""
+    world = World(write(tmp_path, """\
+name: omni_room
+walls:
+  - {name: south, from: [-3.05, -3.05], to: [3.05, -3.05], thickness: 0.1, height: 1.0}
+robots:
+  - name: omni
+    description: omni_sawyer
+    pose: [-1.0, -1.0, 0.7]
+    arm_state: tuck
+"""))
+    try:
+        robot = world.robots["omni"]
+        start = robot.base_pose2d()
+        odo = WheelOdometry(robot, time=world.time)
+        moves = [(0.0, 0.4, 0.0), (0.3, 0.0, 0.5), (0.2, -0.2, -0.4)]
+        for vx, vy, w in moves:
+            robot.set_base_velocity(vx, vy, w)
+            for _ in range(40):
+                world.step(12)
+                odo.update(world.time)
+        robot.set_base_velocity(0.0, 0.0, 0.0)
+        world.step(48)
+        odo.update(world.time)
+        x, y, yaw = robot.base_pose2d()
+        c, s = math.cos(start[2]), math.sin(start[2])
+        dx, dy = x - start[0], y - start[1]
+        truth = (c * dx + s * dy, -s * dx + c * dy, yaw - start[2])
+        assert math.hypot(truth[0], truth[1]) > 0.8  # it really went somewhere
+        assert abs(truth[2]) > 0.1
+        assert math.hypot(odo.x - truth[0], odo.y - truth[1]) < 0.01
+        assert abs(odo.yaw - truth[2]) < 0.005
+    finally:
+        world.close()
