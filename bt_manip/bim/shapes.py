@@ -293,17 +293,31 @@ _POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurface
 
 
 def _axis_matrix(placement: Any) -> np.ndarray | None:
-    """An IfcAxis2Placement3D's matrix, the same numbers as ifcopenshell.util.placement's
-    ``get_axis2placement`` (the same operations in the same order, the cross product written
-    out); None for any other placement."""
-    if not placement.is_a("IfcAxis2Placement3D"):
-        return None
+    """An IfcAxis2Placement3D's or IfcAxis2Placement2D's matrix, the same numbers as
+    ifcopenshell.util.placement's ``get_axis2placement`` (the same operations in the same
+    order, the cross product written out); None for any other placement, or one whose
+    coordinates are not of its dimension.
+
+    A 2D placement's direction is padded with a zero here, where ifcopenshell resizes the
+    array in place: that raises whenever a profiler or a tracer holds a reference to it."""
+    kind = placement.is_a()
     origin = getattr(placement.Location, "Coordinates", None)
     if not origin:
         return None
-    axis, ref = placement.Axis, placement.RefDirection
-    z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
-    x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    ref = placement.RefDirection
+    if kind == "IfcAxis2Placement3D":
+        axis = placement.Axis
+        z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
+        x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    elif kind == "IfcAxis2Placement2D":
+        ratios = tuple(ref.DirectionRatios) if ref else (1, 0)
+        if len(origin) != 2 or len(ratios) != 2:
+            return None
+        z = np.array((0, 0, 1))
+        x = np.array((*ratios, 0.0) if ref else (1, 0, 0))
+        origin = (*origin, 0.0)
+    else:
+        return None
     x = x / np.linalg.norm(x)
     z = z / np.linalg.norm(z)
     y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
