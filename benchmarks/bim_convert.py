@@ -8,7 +8,8 @@ each file, the median over ``--repeat`` runs (after one warm-up conversion that 
 modules and the robot's reach map) of the time to parse it (reading the bytes and
 ifcopenshell's parse: the peer every other figure is compared with), to convert it (parse
 included; these exports schedule nothing, so the world alone is written), and to report the
-first error (``--require-install``, which names the file's IfcProject by its line). One JSON
+first error of the same file with one line broken near its end (a copy whose last entity's
+class name is misspelt, ``#9= XIFCWALL(...)``: the error must name that line). One JSON
 line per file, with the ratios conversion / parse and first error / parse, in wall time and in
 CPU time (the process's, also medians: on a shared machine the steadier of the two).
 
@@ -128,15 +129,31 @@ def generate(rooms: int, path: Path) -> dict[str, int]:
     return counts
 
 
-def _median_time(run: Any, repeat: int) -> tuple[float, float]:
-    """Median wall and median CPU seconds of ``run`` over ``repeat`` runs."""
-    wall, cpu = [], []
+def _median_times(runs: list[Any], repeat: int) -> list[tuple[float, float]]:
+    """Median wall and median CPU seconds of each of ``runs`` over ``repeat`` rounds, the
+    runs taking turns within each round (so that a change of the machine's load falls on
+    all of them alike)."""
+    wall: list[list[float]] = [[] for _ in runs]
+    cpu: list[list[float]] = [[] for _ in runs]
     for _ in range(repeat):
-        t0, c0 = time.perf_counter(), time.process_time()
-        run()
-        wall.append(time.perf_counter() - t0)
-        cpu.append(time.process_time() - c0)
-    return sorted(wall)[len(wall) // 2], sorted(cpu)[len(cpu) // 2]
+        for k, run in enumerate(runs):
+            t0, c0 = time.perf_counter(), time.process_time()
+            run()
+            wall[k].append(time.perf_counter() - t0)
+            cpu[k].append(time.process_time() - c0)
+    return [(sorted(w)[len(w) // 2], sorted(c)[len(c) // 2])
+            for w, c in zip(wall, cpu, strict=True)]
+
+
+def broken_copy(path: Path, out: Path) -> tuple[Path, int]:
+    """A copy of ``path`` in ``out`` whose last entity line has its class name misspelt (an
+    ``X`` put before it), and the number of that line."""
+    lines = path.read_bytes().split(b"\n")
+    last = max(i for i, text in enumerate(lines) if text.lstrip().startswith(b"#"))
+    lines[last] = lines[last].replace(b"=", b"= X", 1)
+    broken = out / f"{path.stem}-broken.ifc"
+    broken.write_bytes(b"\n".join(lines))
+    return broken, last + 1
 
 
 def time_samples(folder: Path, out: Path, repeat: int) -> None:
@@ -147,19 +164,20 @@ def time_samples(folder: Path, out: Path, repeat: int) -> None:
 
     for path in sorted(folder.glob("*.ifc")):
         convert(BimOptions(path, out / f"{path.stem}-warm"))
+        broken, line = broken_copy(path, out)
 
-        def first_error(path: Path = path) -> None:
+        def first_error(broken: Path = broken, line: int = line) -> None:
             try:
-                convert(BimOptions(path, out / f"{path.stem}-err", require_install=True))
+                convert(BimOptions(broken, out / f"{broken.stem}-err"))
             except InputError as exc:
-                str(exc)  # the message, with its line number
+                if f"{broken}:{line}:" not in str(exc):  # the message, with its line number
+                    raise AssertionError(f"{broken}: not reported at line {line}: {exc}") from None
             else:
-                raise AssertionError(f"{path}: --require-install did not fail")
+                raise AssertionError(f"{broken}: the broken line {line} was not reported")
 
-        (parse, parse_cpu) = _median_time(lambda path=path: open_ifc(path), repeat)
-        (conversion, conversion_cpu) = _median_time(
-            lambda path=path: convert(BimOptions(path, out / path.stem)), repeat)
-        (error, error_cpu) = _median_time(first_error, repeat)
+        (parse, parse_cpu), (conversion, conversion_cpu), (error, error_cpu) = _median_times(
+            [lambda path=path: open_ifc(path),
+             lambda path=path: convert(BimOptions(path, out / path.stem)), first_error], repeat)
         print(json.dumps({
             "bench": "bim_convert", "file": path.name, "ifc_bytes": path.stat().st_size,
             "parse_s": round(parse, 3), "convert_s": round(conversion, 3),

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from bt_manip.bim.parse_log import clear_log, parse_problems
 from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import MIB, read_bounded
 
@@ -102,7 +103,8 @@ def _find_definition(data: bytes, step_id: int) -> int | None:
 
 
 def open_ifc(path: str | Path) -> IfcSource:
-    """Read and parse an IFC file (STEP format, at most :data:`MAX_IFC_BYTES`)."""
+    """Read and parse an IFC file (STEP format, at most :data:`MAX_IFC_BYTES`); an entity the
+    parser cannot read is a problem at its line (:mod:`~bt_manip.bim.parse_log`)."""
     import ifcopenshell
     import ifcopenshell.util.unit
 
@@ -127,10 +129,15 @@ def open_ifc(path: str | Path) -> IfcSource:
         raise InputError.single(
             str(path), line, f"schema {schema} is not read; IFC2X3 and IFC4 files are"
         )
+    text = data.decode("utf-8", errors="replace")
+    clear_log()
     try:
-        model = ifcopenshell.file.from_string(data.decode("utf-8", errors="replace"))
+        model = ifcopenshell.file.from_string(text)
     except Exception as exc:
         raise InputError.single(str(path), None, f"cannot parse the IFC file: {exc}") from None
+    problems = parse_problems(str(path), text)
+    if problems:
+        raise InputError(problems)
     scale = float(ifcopenshell.util.unit.calculate_unit_scale(model))
     return IfcSource(path, data, model, scale, model.schema)
 

@@ -236,8 +236,7 @@ class ShapeReader:
         origin = self.axis(item.MappingSource.MappingOrigin)
         target = item.MappingTarget
         if target.is_a("IfcCartesianTransformationOperator3D"):
-            found: np.ndarray = np.asarray(
-                placement.get_cartesiantransformationoperator3d(target) @ origin, dtype=float)
+            found: np.ndarray = np.asarray(_operator_matrix(target) @ origin, dtype=float)
             return found
         return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
 
@@ -293,17 +292,38 @@ _POINT_SETS = {"IfcFacetedBrep", "IfcFacetedBrepWithVoids", "IfcFaceBasedSurface
 
 
 def _axis_matrix(placement: Any) -> np.ndarray | None:
-    """An IfcAxis2Placement3D's matrix, the same numbers as ifcopenshell.util.placement's
-    ``get_axis2placement`` (the same operations in the same order, the cross product written
-    out); None for any other placement."""
-    if not placement.is_a("IfcAxis2Placement3D"):
-        return None
+    """An IfcAxis2Placement3D's or IfcAxis2Placement2D's matrix, the same numbers as
+    ifcopenshell.util.placement's ``get_axis2placement`` (the same operations in the same
+    order, the cross product written out); None for any other placement, or one whose
+    coordinates are not of its dimension.
+
+    A 2D placement's direction is padded with a zero here, where ifcopenshell resizes the
+    array in place: that raises whenever a profiler or a tracer holds a reference to it."""
+    kind = placement.is_a()
     origin = getattr(placement.Location, "Coordinates", None)
     if not origin:
         return None
-    axis, ref = placement.Axis, placement.RefDirection
-    z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
-    x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    ref = placement.RefDirection
+    if kind == "IfcAxis2Placement3D":
+        axis = placement.Axis
+        z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
+        x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
+    elif kind == "IfcAxis2Placement2D":
+        ratios = tuple(ref.DirectionRatios) if ref else (1, 0)
+        if len(origin) != 2 or len(ratios) != 2:
+            return None
+        z = np.array((0, 0, 1))
+        x = np.array((*ratios, 0.0) if ref else (1, 0, 0))
+        origin = (*origin, 0.0)
+    else:
+        return None
+    return _frame(origin, z, x)
+
+
+def _frame(origin: Any, z: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The 4x4 matrix of the frame at ``origin`` whose z and x axes point along ``z`` and
+    ``x``: ifcopenshell.util.placement's ``a2p``, its operations in the same order (the cross
+    product written out, the same numbers as numpy's)."""
     x = x / np.linalg.norm(x)
     z = z / np.linalg.norm(z)
     y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
@@ -314,6 +334,29 @@ def _axis_matrix(placement: Any) -> np.ndarray | None:
     m[-1, :-1] = origin
     out: np.ndarray = m.T
     return out
+
+
+def _operator_matrix(operator: Any) -> np.ndarray:
+    """An IfcCartesianTransformationOperator3D's matrix (and its non-uniform subtype's): the
+    same numbers as ifcopenshell.util.placement's ``get_cartesiantransformationoperator3d``,
+    from the same operations in the same order."""
+    origin = np.array(operator.LocalOrigin.Coordinates)
+    axes = [np.array((1.0, 0.0, 0.0)), np.array((0.0, 1.0, 0.0)), np.array((0.0, 0.0, 1.0))]
+    for k, given in enumerate((operator.Axis1, operator.Axis2, operator.Axis3)):
+        if given:
+            axes[k][0:3] = given.DirectionRatios
+    m = _frame(origin, axes[2], axes[0])
+    if m.T[1][0:3].dot(axes[1]) < 0.0:  # a mirrored y axis
+        m.T[1] *= -1.0
+    scale1 = operator.Scale if operator.Scale else 1.0
+    scale2 = scale3 = scale1
+    if operator.is_a("IfcCartesianTransformationOperator3DnonUniform"):
+        scale2 = operator.Scale2 if operator.Scale2 is not None else scale1
+        scale3 = operator.Scale3 if operator.Scale3 is not None else scale1
+    m.T[0] *= scale1
+    m.T[1] *= scale2
+    m.T[2] *= scale3
+    return m
 
 
 def _loop_points(item: Any) -> list[Any] | None:
