@@ -40,7 +40,7 @@ from bt_manip.localization.estimate import PoseEstimate, best_cluster
 from bt_manip.localization.inputs import OdomPose, Scan
 from bt_manip.localization.kld import bin_keys, kld_prefix, standard_normal_quantile
 from bt_manip.localization.likelihood_field import LikelihoodField, SensorModel
-from bt_manip.localization.motion_model import sample_motion
+from bt_manip.localization.motion_model import sample_motion, sample_motion_planar
 from bt_manip.localization.options import LocalizationOptions, OptionsError
 from bt_manip.localization.resampling import low_variance
 
@@ -119,8 +119,9 @@ class ParticleFilter:
             turned = abs((new[2] - old[2] + math.pi) % (2.0 * math.pi) - math.pi)
             if moved < o.update_min_d and turned < o.update_min_a:
                 return False
-            poses = sample_motion(self._set.poses, old, new, (o.alpha1, o.alpha2, o.alpha3,
-                                                              o.alpha4), self.rng)
+            model = sample_motion_planar if o.motion_model == "planar" else sample_motion
+            poses = model(self._set.poses, old, new, (o.alpha1, o.alpha2, o.alpha3,
+                                                              o.alpha4, o.alpha5), self.rng)
         else:
             poses = self._set.poses
         self._last_odom = new

@@ -9,6 +9,12 @@ table 5.6), with the variances
 - ``trans``: ``alpha3 * trans^2 + alpha4 * (rot1^2 + rot2^2)``
 - ``rot2``: ``alpha1 * rot2^2 + alpha2 * trans^2``
 
+A fifth parameter, ``alpha5`` (0 gives AMCL's model exactly), adds a sideways slip from
+turning: each particle is also moved across its final heading by a normal draw of variance
+``alpha5 * (rot1^2 + rot2^2)``. A skid-steer base turning on the spot slides sideways about a
+pivot its wheels do not measure well, and more so with a load held out in front; the diff
+model alone spreads a turn's translation error only along the direction of travel.
+
 As in AMCL, the turns that enter the variances are measured modulo a half turn, so that
 driving backwards does not count as two half turns, and ``rot1`` is taken as 0 for a move
 shorter than a centimetre (the direction of a tiny move is noise).
@@ -53,14 +59,16 @@ def sample_motion(
     poses: np.ndarray,
     old: tuple[float, float, float],
     new: tuple[float, float, float],
-    alphas: tuple[float, float, float, float],
+    alphas: tuple[float, ...],
     rng: np.random.Generator,
 ) -> np.ndarray:
-    """``poses`` (n, 3) moved by a noisy copy each of the odometry move ``old`` -> ``new``.
+    """``poses`` (n, 3) moved by a noisy copy each of the odometry move ``old`` -> ``new``;
+    ``alphas``: ``(alpha1, alpha2, alpha3, alpha4)`` or with ``alpha5`` after them.
 
     Returns a new array; yaw wrapped into [-pi, pi).
     """
-    a1, a2, a3, a4 = alphas
+    a1, a2, a3, a4 = alphas[:4]
+    a5 = alphas[4] if len(alphas) > 4 else 0.0
     rot1, trans, rot2 = odometry_delta(old, new)
     r1 = _turn_for_noise(rot1)
     r2 = _turn_for_noise(rot2)
@@ -77,4 +85,51 @@ def sample_motion(
     out[:, 0] = poses[:, 0] + trans_hat * np.cos(heading)
     out[:, 1] = poses[:, 1] + trans_hat * np.sin(heading)
     out[:, 2] = wrap(heading + rot2_hat)
+    if a5 > 0.0:
+        sd_side = math.sqrt(a5 * (r1 * r1 + r2 * r2))
+        if sd_side > 0.0:
+            side = sd_side * rng.standard_normal(n)
+            out[:, 0] -= side * np.sin(out[:, 2])
+            out[:, 1] += side * np.cos(out[:, 2])
+    return out
+
+
+def sample_motion_planar(
+    poses: np.ndarray,
+    old: tuple[float, float, float],
+    new: tuple[float, float, float],
+    alphas: tuple[float, ...],
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """``poses`` (n, 3) moved by a noisy copy each of the odometry move ``old`` -> ``new``,
+    the move taken as a translation (forward ``dx``, sideways ``dy``) and a turn ``dyaw`` in
+    the base's frame at ``old``, each part with its own noise (the "planar" model):
+
+    - forward: variance ``alpha3 * trans^2 + alpha4 * dyaw^2``;
+    - sideways: variance ``alpha3 * dy^2 + alpha5 * dyaw^2`` (a base that turns also slips
+      across, by more than its odometry says);
+    - turn: variance ``alpha1 * dyaw^2 + alpha2 * trans^2``.
+
+    Unlike the diff model, a short move to the side (a skid-steer sliding about its pivot as
+    it turns on the spot) is not read as a large turn towards it followed by a turn back,
+    whose noise would scatter the particles over metres.
+    """
+    a1, a2, a3, a4 = alphas[:4]
+    a5 = alphas[4] if len(alphas) > 4 else 0.0
+    c, s = math.cos(old[2]), math.sin(old[2])
+    ddx, ddy = new[0] - old[0], new[1] - old[1]
+    dx, dy = c * ddx + s * ddy, -s * ddx + c * ddy
+    dyaw = _wrap_f(new[2] - old[2])
+    trans2 = dx * dx + dy * dy
+    turn2 = dyaw * dyaw
+    n = poses.shape[0]
+    noise = rng.standard_normal((n, 3))
+    fx = dx + math.sqrt(a3 * trans2 + a4 * turn2) * noise[:, 0]
+    fy = dy + math.sqrt(a3 * dy * dy + a5 * turn2) * noise[:, 1]
+    fyaw = dyaw + math.sqrt(a1 * turn2 + a2 * trans2) * noise[:, 2]
+    cp, sp = np.cos(poses[:, 2]), np.sin(poses[:, 2])
+    out = np.empty_like(poses)
+    out[:, 0] = poses[:, 0] + cp * fx - sp * fy
+    out[:, 1] = poses[:, 1] + sp * fx + cp * fy
+    out[:, 2] = wrap(poses[:, 2] + fyaw)
     return out

@@ -14,9 +14,15 @@ Departures from Nav2's defaults, on purpose:
   nor on the random ones just injected: injection stops once the filter has found the robot.
 - ``beam_weight`` (not in Nav2) tempers the product of the beam likelihoods; AMCL's
   ``1 + sum(pz^3)`` weighs poses more flatly (see :mod:`bt_manip.localization.likelihood_field`).
-- ``sigma_hit`` is 0.1 m (Nav2: 0.2 m): a simulated LiDAR's ranges are good to about a
-  centimetre, and the sharper field makes the estimate better than 5 cm on an 11 m route;
-  ``z_hit`` / ``z_rand`` are 0.95 / 0.05 (Nav2: 0.5 / 0.5) for the same reason.
+- ``sigma_hit`` is 0.05 m (Nav2: 0.2 m): a simulated LiDAR's ranges are good to about a
+  centimetre; ``z_hit`` / ``z_rand`` are 0.95 / 0.05 (Nav2: 0.5 / 0.5) for the same reason.
+  ``max_beams`` is 120 (Nav2: 60), spread over the usable returns only (the robot's own body
+  hides a third of the Husky's 270 deg, a carried panel half of the rest).
+- ``motion_model`` is ``"planar"`` (Nav2: ``DifferentialMotionModel``): AMCL's diff model
+  reads a skid-steer's sideways slide while turning on the spot (a few centimetres) as a
+  large turn towards it and back, and its noise then scatters the particles over a metre;
+  the planar model (:mod:`bt_manip.localization.motion_model`) adds noise to the forward,
+  sideways and turning parts of the move in the base's frame. ``"diff"`` is AMCL's model.
 """
 
 from __future__ import annotations
@@ -55,6 +61,9 @@ class LocalizationOptions:
     """Histogram bin width (rad) in yaw."""
 
     # -- motion model (differential drive, AMCL's sample_motion_model_odometry) -----------------
+    motion_model: str = "planar"
+    """``"diff"`` (AMCL's differential-drive model) or ``"planar"`` (the move taken apart in
+    the base's frame: see :mod:`bt_manip.localization.motion_model`)."""
     alpha1: float = 0.2
     """Rotation noise from rotation."""
     alpha2: float = 0.2
@@ -63,19 +72,23 @@ class LocalizationOptions:
     """Translation noise from translation."""
     alpha4: float = 0.2
     """Translation noise from rotation."""
+    alpha5: float = 0.05
+    """Sideways slip from rotation (not in Nav2's diff model; 0 turns it off): the variance of
+    a move across the heading per squared radian turned (see
+    :mod:`bt_manip.localization.motion_model`)."""
 
     # -- likelihood-field sensor model ---------------------------------------------------------
     z_hit: float = 0.95
     """Weight of the Gaussian around the nearest obstacle."""
     z_rand: float = 0.05
     """Weight of the uniform (random reading) part."""
-    sigma_hit: float = 0.1
+    sigma_hit: float = 0.05
     """Standard deviation (m) of a reading's distance to the nearest obstacle."""
     laser_likelihood_max_dist: float = 2.0
     """Distances to the nearest obstacle are capped here (m)."""
-    max_beams: int = 60
-    """Beams used per update, evenly spaced over the scan."""
-    beam_weight: float = 0.1
+    max_beams: int = 120
+    """Beams used per update, evenly spaced over the usable returns."""
+    beam_weight: float = 0.2
     """Each beam's log-likelihood counts this much (neighbouring beams are not independent
     evidence: under 1, one scan cannot make the filter sure of a wrong place at once)."""
 
@@ -125,8 +138,10 @@ _COUNTS = ("min_particles", "max_particles", "max_beams", "resample_interval")
 _POSITIVE = ("pf_err", "beam_weight", "kld_bin_xy", "kld_bin_yaw", "sigma_hit",
              "laser_likelihood_max_dist", "cluster_radius", "cluster_yaw", "lost_std_xy",
              "lost_std_yaw")
-_NON_NEGATIVE = ("alpha1", "alpha2", "alpha3", "alpha4", "z_hit", "z_rand", "update_min_d",
-                 "update_min_a", "initial_sigma_xy", "initial_sigma_yaw")
+_NON_NEGATIVE = ("alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "z_hit", "z_rand",
+                 "update_min_d", "update_min_a", "initial_sigma_xy", "initial_sigma_yaw")
+MOTION_MODELS = ("diff", "planar")
+"""The motion models :attr:`LocalizationOptions.motion_model` names."""
 _UNIT = ("recovery_alpha_slow", "recovery_alpha_fast", "lost_likelihood_ratio",
          "lost_cluster_weight")
 
@@ -136,7 +151,10 @@ def _problems(o: LocalizationOptions) -> list[str]:
     out: list[str] = []
     for f in fields(o):
         v = getattr(o, f.name)
-        if f.name in _COUNTS:
+        if f.name == "motion_model":
+            if v not in MOTION_MODELS:
+                out.append(f"motion_model must be one of {', '.join(MOTION_MODELS)}, not {v!r}")
+        elif f.name in _COUNTS:
             if isinstance(v, bool) or not isinstance(v, int):
                 out.append(f"{f.name} must be a whole number, not {v!r}")
             elif v < 1:

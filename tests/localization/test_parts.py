@@ -14,7 +14,7 @@ from bt_manip.localization import LikelihoodField, LocalizationOptions, OptionsE
 from bt_manip.localization.estimate import best_cluster
 from bt_manip.localization.inputs import OdomPose
 from bt_manip.localization.kld import bin_keys, kld_bound, kld_prefix
-from bt_manip.localization.motion_model import sample_motion
+from bt_manip.localization.motion_model import sample_motion, sample_motion_planar
 from bt_manip.localization.particles import ParticleSet, even
 from bt_manip.localization.resampling import low_variance
 
@@ -34,6 +34,8 @@ from bt_manip.localization.resampling import low_variance
         ({"recovery_alpha_fast": 0.0005}, "recovery_alpha_fast (0.0005) must exceed"),
         ({"recovery_alpha_slow": 1.5}, "recovery_alpha_slow must be between 0 and 1"),
         ({"max_particles": 10**7}, "max_particles must be at most"),
+        ({"motion_model": "omni"}, "motion_model must be one of diff, planar, not 'omni'"),
+        ({"alpha5": -1.0}, "alpha5 must be >= 0"),
     ],
 )
 def test_bad_options_are_refused_by_name(changes: dict, words: str) -> None:
@@ -114,6 +116,42 @@ def test_the_motion_model_spreads_as_the_alphas_say() -> None:
     # only alpha3: the travel's standard deviation is sqrt(0.04) x 1 m, along x only
     assert np.std(moved[:, 0]) == pytest.approx(0.2, rel=0.05)
     assert np.allclose(moved[:, 1:], 0.0)
+
+
+def test_the_planar_model_without_noise_moves_each_particle_in_its_own_frame() -> None:
+    rng = np.random.default_rng(0)
+    poses = np.array([[1.0, 1.0, math.pi / 2], [0.0, 0.0, 0.0]])
+    # from (0, 0, 0) to (0.3, 0.1, 0.4): 0.3 forward, 0.1 to the left, a 0.4 rad turn
+    moved = sample_motion_planar(poses, (0.0, 0.0, 0.0), (0.3, 0.1, 0.4), (0,) * 5, rng)
+    assert moved[0] == pytest.approx([0.9, 1.3, math.pi / 2 + 0.4])
+    assert moved[1] == pytest.approx([0.3, 0.1, 0.4])
+    # the same move seen from an odometry frame turned by 1 rad: the same in the base's frame
+    c, s = math.cos(1.0), math.sin(1.0)
+    again = sample_motion_planar(poses, (0.0, 0.0, 1.0), (0.3 * c - 0.1 * s, 0.3 * s + 0.1 * c,
+                                                          1.4), (0,) * 5, rng)
+    assert again == pytest.approx(moved)
+
+
+def test_a_turn_on_the_spot_with_a_slide_scatters_the_diff_model_not_the_planar_one() -> None:
+    """A skid-steer turning 0.2 rad slides 3 cm sideways: the diff model reads a 90 deg turn
+    there and back, whose noise throws the particles metres away and turns them by half a
+    radian; the planar model spreads them as a 0.2 rad turn alone would (alpha4: about 9 cm
+    along the heading; alpha1: 0.09 rad)."""
+    rng = np.random.default_rng(2)
+    poses = np.zeros((20000, 3))
+    alphas = (0.2, 0.2, 0.2, 0.2, 0.0)
+    move = ((0.0, 0.0, 0.0), (0.0, -0.03, 0.2))
+    diff = sample_motion(poses, *move, alphas, rng)
+    planar = sample_motion_planar(poses, *move, alphas, rng)
+    spread = lambda p: float(np.percentile(np.hypot(p[:, 0], p[:, 1] + 0.03), 95))  # noqa: E731
+    assert spread(diff) > 1.0
+    assert spread(planar) < 0.25
+    assert float(np.std(diff[:, 2])) > 0.5
+    assert float(np.std(planar[:, 2])) == pytest.approx(0.09, rel=0.05)
+    # alpha5 spreads the planar model across the heading in proportion to the turn
+    side = sample_motion_planar(poses, *move, (0.0, 0.0, 0.0, 0.0, 0.25), rng)
+    across = -np.sin(side[:, 2]) * side[:, 0] + np.cos(side[:, 2]) * (side[:, 1] + 0.03)
+    assert float(np.std(across)) == pytest.approx(0.5 * 0.2, rel=0.05)
 
 
 def test_the_likelihood_field_is_the_distance_to_the_nearest_wall() -> None:
