@@ -67,6 +67,9 @@ class ParticleFilter:
         self.options = options
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.sensor = SensorModel(field, options.z_hit, options.z_rand, options.sigma_hit)
+        self.wide_sensor = SensorModel(field, options.z_hit, options.z_rand,
+                                       max(options.sigma_hit, options.sigma_hit_wide))
+        """The broader field used while the particles are spread (see :meth:`_spread`)."""
         self._z = standard_normal_quantile(options.pf_z)
         self._set: pset.ParticleSet | None = None
         self._last_odom: tuple[float, float, float] | None = None
@@ -74,6 +77,9 @@ class ParticleFilter:
         self._w_fast = 0.0
         self._updates = 0
         self._estimate: PoseEstimate | None = None
+        self.weighed_wide = False
+        """Whether the last scan taken was weighed with the wider field (see
+        :meth:`_spread`)."""
 
     # -- starting ------------------------------------------------------------------------------
     def set_initial_pose(
@@ -125,9 +131,11 @@ class ParticleFilter:
         else:
             poses = self._set.poses
         self._last_odom = new
-        ends = self.sensor.beam_ends(scan, o.max_beams)
-        logs = self.sensor.log_likelihoods(poses, ends, scan.range_max)
-        t = logs * o.beam_weight
+        wide = self.weighed_wide = self._spread()
+        sensor = self.wide_sensor if wide else self.sensor
+        ends = sensor.beam_ends(scan, o.max_beams)
+        logs = sensor.log_likelihoods(poses, ends, scan.range_max)
+        t = logs * (min(o.beam_weight, o.beam_weight_wide) if wide else o.beam_weight)
         like = np.exp(t - t.max())
         w = self._set.weights * like
         total = float(w.sum())
@@ -147,6 +155,20 @@ class ParticleFilter:
             current = self._resample(current)
         self._set = current
         return True
+
+    def _spread(self) -> bool:
+        """Whether the particles are spread over more than one place (the last estimate's
+        cluster holds under ``lost_cluster_weight`` of the weight, or its position spread is
+        over ``lost_std_xy``): after a global localisation, or while the filter is finding
+        the robot again. The scan is then weighed with the wider field (``sigma_hit_wide``,
+        ``beam_weight_wide``): with few particles near the true pose, the sharp field would
+        let the best of the wrong places win before any particle lands in its narrow basin."""
+        est = self._estimate
+        if est is None:
+            return False
+        o = self.options
+        sx, sy, _ = est.std
+        return est.cluster_weight < o.lost_cluster_weight or max(sx, sy) > o.lost_std_xy
 
     def _average_likelihood(self, w_avg: float) -> None:
         """Update the slow and fast averages of the weighted mean likelihood (both start at

@@ -84,6 +84,11 @@ class LocalizationOptions:
     """Weight of the uniform (random reading) part."""
     sigma_hit: float = 0.05
     """Standard deviation (m) of a reading's distance to the nearest obstacle."""
+    sigma_hit_wide: float = 0.1
+    """``sigma_hit`` (m) while the particles are spread over several places (after a global
+    localisation; see :mod:`bt_manip.localization.filter`)."""
+    beam_weight_wide: float = 0.1
+    """``beam_weight`` while the particles are spread over several places."""
     laser_likelihood_max_dist: float = 2.0
     """Distances to the nearest obstacle are capped here (m)."""
     max_beams: int = 120
@@ -135,7 +140,8 @@ class LocalizationOptions:
 
 
 _COUNTS = ("min_particles", "max_particles", "max_beams", "resample_interval")
-_POSITIVE = ("pf_err", "beam_weight", "kld_bin_xy", "kld_bin_yaw", "sigma_hit",
+_POSITIVE = ("pf_err", "beam_weight", "beam_weight_wide", "kld_bin_xy", "kld_bin_yaw",
+             "sigma_hit", "sigma_hit_wide",
              "laser_likelihood_max_dist", "cluster_radius", "cluster_yaw", "lost_std_xy",
              "lost_std_yaw")
 _NON_NEGATIVE = ("alpha1", "alpha2", "alpha3", "alpha4", "alpha5", "z_hit", "z_rand",

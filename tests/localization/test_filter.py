@@ -5,6 +5,7 @@ travel thresholds and determinism per seed."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -29,10 +30,11 @@ def make(options: LocalizationOptions | None = None, seed: int = 0) -> ParticleF
 
 
 def track(pf: ParticleFilter, truth: np.ndarray, seed: int,
-          shift: tuple[int, np.ndarray] | None = None) -> list[tuple[int, float, float, bool]]:
+          shift: tuple[int, np.ndarray] | None = None,
+          after_update: Callable[[], None] | None = None) -> list[tuple[int, float, float, bool]]:
     """Feed ``pf`` the route's readings; after each update taken, (step, position error, yaw
-    error, lost). ``shift`` = (step, offset): from that step on the robot really is at
-    truth + offset, which odometry never hears of (a kidnap)."""
+    error, lost), and ``after_update()`` called. ``shift`` = (step, offset): from that step on
+    the robot really is at truth + offset, which odometry never hears of (a kidnap)."""
     rng = np.random.default_rng(100 + seed)
     odom = odometry(truth, rng)
     seen = truth.copy()
@@ -43,6 +45,8 @@ def track(pf: ParticleFilter, truth: np.ndarray, seed: int,
     for k, o, scan in readings(seen, odom, rng):
         if pf.update(o, scan):
             e = pf.estimate
+            if after_update is not None:
+                after_update()
             out.append((k, *pose_error((e.x, e.y, e.yaw), seen[k]), e.lost))
     return out
 
@@ -66,9 +70,12 @@ def test_global_localisation_finds_the_robot() -> None:
     pf = make(replace(LocalizationOptions(), max_particles=6000), seed=3)
     pf.global_localization()
     assert pf.estimate.lost  # spread over the whole room
-    errors = track(pf, truth, 3)
+    wide: list[bool] = []
+    errors = track(pf, truth, 3, after_update=lambda: wide.append(pf.weighed_wide))
     _, pos, yaw, lost = errors[-1]
     assert pos < 0.05 and yaw < math.radians(3) and not lost
+    # the spread particles were weighed with the wide field, the found robot with the sharp one
+    assert wide[0] and not wide[-1]
     # found well before the end of the route, and kept from then on
     assert all(e[1] < 0.1 for e in errors[len(errors) // 2:])
 
