@@ -44,6 +44,7 @@ import numpy as np
 from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
+from numba.np.arrayobj import load_item, store_item
 
 KEEP = 1.0 - 1e-13
 """A new g must be below ``KEEP x`` the known g to count as an improvement."""
@@ -56,6 +57,11 @@ SIDE_ROW = np.array([0, 0, 1, 1], dtype=np.int64)
 SIDE_COL = np.array([2, 3, 2, 3], dtype=np.int64)
 INF_BITS = np.int64(0x7FF0000000000000)
 """Bits of float64 ``+inf``: stored g words are the value's bits XOR these."""
+CLOSED = np.uint8(8)
+"""Bit of a ``parent`` byte set when the bucket search expands the cell with its current g
+(cleared when g improves, as the new move is written)."""
+MOVE = np.uint8(7)
+"""Bits of a ``parent`` byte holding the move."""
 
 
 @intrinsic
@@ -224,7 +230,7 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
     n = 1
     node = goal
     while node != start:
-        k = parent[node]
+        k = parent[node] & MOVE
         node -= DR[k] * cols + DC[k]
         n += 1
     out = np.empty((n, 2), np.int64)
@@ -233,7 +239,7 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
         out[i, 0] = node // cols
         out[i, 1] = node % cols
         if i > 0:
-            k = parent[node]
+            k = parent[node] & MOVE
             node -= DR[k] * cols + DC[k]
     return out
 
@@ -285,8 +291,41 @@ def _move_costs(
     return 8
 
 
+@intrinsic
+def _get(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx]`` for a 1-D array and an index known to be inside it (no negative wrap)."""
+    sig = arr.dtype(arr, idx)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        return load_item(context, builder, arrty, ptr)
+
+    return sig, codegen
+
+
+@intrinsic
+def _put(typingctx, arr, idx, value):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx] = value`` for a 1-D array and an index known to be inside it."""
+    sig = types.void(arr, idx, value)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty, valty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        store_item(context, builder, arrty, context.cast(builder, args[2], valty, arrty.dtype), ptr)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 _NO_REFCOUNT: dict[str, Any] = {"_nrt": False}
 """numba option: compile without the runtime (no reference counting; no allocation inside)."""
+
+_LOW = np.int64(0xFFFFFFFF)
 
 # Indices into the bucket search's state vectors (it runs in rounds between pool growths).
 _CUR, _USED, _FREE, _OPEN, _EXPANDED = 0, 1, 2, 3, 4
@@ -305,9 +344,7 @@ def _relax(
     lo: np.ndarray,
     hi: np.ndarray,
     heads: np.ndarray,
-    pn: np.ndarray,
-    pg: np.ndarray,
-    pnext: np.ndarray,
+    pool: np.ndarray,
     goal: int,
     gr: int,
     gc: int,
@@ -332,7 +369,7 @@ def _relax(
     # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
     if ng_ < _load_g(g, nb) * KEEP:
         _store_g(g, nb, ng_)
-        parent[nb] = k
+        _put(parent, nb, k)  # type: ignore[call-arg]  # numba body, as for _load_g
         _mark(lo, hi, nr, nc)
         if nb == goal:
             return free, used, n_open, ng_, ng_ * KEEP
@@ -341,14 +378,12 @@ def _relax(
             kb = max(math.floor(f * inv_delta), cur) & mask
             if free != -1:
                 s = free
-                free = pnext[s]
+                free = _get(pool, s) >> 32  # type: ignore[call-arg]
             else:
                 s = used
                 used += 1
-            pn[s] = nb
-            pg[s] = ng_
-            pnext[s] = heads[kb]
-            heads[kb] = s
+            _put(pool, s, nb | (np.int64(_get(heads, kb)) << 32))  # type: ignore[call-arg]
+            _put(heads, kb, s)  # type: ignore[call-arg]
             n_open += 1
     return free, used, n_open, g_goal, bound
 
@@ -369,26 +404,25 @@ def _bucket_rounds(
     lo: np.ndarray,
     hi: np.ndarray,
     heads: np.ndarray,
-    pn: np.ndarray,
-    pg: np.ndarray,
-    pnext: np.ndarray,
+    pool: np.ndarray,
     ints: np.ndarray,
     floats: np.ndarray,
 ) -> bool:
     """Run the bucket search until it ends (True) or its pool may run out of slots (False).
 
-    ``flat`` is the cost grid as one row-major vector of ``rows x cols``. The pool (``pn``,
-    ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the state vectors
-    are the caller's. The function allocates nothing and is compiled without reference
-    counting (``_nrt=False``): the moves are written out one by one (no per-move arrays),
-    and :func:`_relax` takes the arrays at no cost.
+    ``flat`` is the cost grid as one row-major vector of ``rows x cols``. A pool entry is one
+    int64: the cell in the low 32 bits, the next slot of its bucket (or of the free list) in
+    the high 32 bits (-1: none). The pool and the state vectors are the caller's. The
+    function allocates nothing and is compiled without reference counting (``_nrt=False``):
+    the moves are written out one by one (no per-move arrays), :func:`_relax` takes the
+    arrays at no cost, and the array reads and writes skip numba's negative-index wrap.
     """
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
     inv_delta = 1.0 / delta
     inf = np.inf
-    room = pn.shape[0] - 8  # an expansion pushes at most 8 entries
+    room = pool.shape[0] - 8  # an expansion pushes at most 8 entries
     cur = ints[_CUR]
     used = ints[_USED]
     free = ints[_FREE]
@@ -402,83 +436,90 @@ def _bucket_rounds(
             done = False
             break
         b = cur & mask
-        while heads[b] == -1:
+        while _get(heads, b) == -1:  # type: ignore[call-arg]  # numba body, as for _load_g
             cur += 1
             b = cur & mask
         if cur * delta >= g_goal:
             break  # every open entry has f >= g_goal
-        slot = heads[b]
-        heads[b] = pnext[slot]
-        n_open -= 1
-        node = pn[slot]
-        gn = pg[slot]
-        pnext[slot] = free
+        slot = _get(heads, b)  # type: ignore[call-arg]
+        entry = _get(pool, slot)  # type: ignore[call-arg]
+        nxt = entry >> 32
+        _put(heads, b, nxt)  # type: ignore[call-arg]
+        _put(pool, slot, np.int64(free) << 32)  # type: ignore[call-arg]
         free = slot
-        nxt = heads[b]  # likely the next pop: start loading its rows
-        if nxt != -1:
-            _prefetch_rows(g, flat, pn[nxt], cols)
-        if gn > _load_g(g, node):
-            continue  # stale entry
+        n_open -= 1
+        node = entry & _LOW
+        if nxt != -1:  # likely the next pop: start loading its rows
+            _prefetch_rows(g, flat, _get(pool, nxt) & _LOW, cols)  # type: ignore[call-arg]
+        move = _get(parent, node)  # type: ignore[call-arg]
+        if move & CLOSED:
+            continue  # expanded already with this g: a stale entry
+        gn = _load_g(g, node)
         r = node // cols
         c = node - r * cols
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
+        _put(parent, node, move | CLOSED)  # type: ignore[call-arg]
         expanded += 1
         # costs of the four side cells (inf outside the grid)
         if r == 0 or r == rows - 1 or c == 0 or c == cols - 1:
-            wu = flat[node - cols] if r > 0 else inf
-            wd = flat[node + cols] if r < rows - 1 else inf
-            wl = flat[node - 1] if c > 0 else inf
-            wr = flat[node + 1] if c < cols - 1 else inf
+            wu = _get(flat, node - cols) if r > 0 else inf  # type: ignore[call-arg]
+            wd = _get(flat, node + cols) if r < rows - 1 else inf  # type: ignore[call-arg]
+            wl = _get(flat, node - 1) if c > 0 else inf  # type: ignore[call-arg]
+            wr = _get(flat, node + 1) if c < cols - 1 else inf  # type: ignore[call-arg]
         else:
-            wu = flat[node - cols]
-            wd = flat[node + cols]
-            wl = flat[node - 1]
-            wr = flat[node + 1]
+            wu = _get(flat, node - cols)  # type: ignore[call-arg]
+            wd = _get(flat, node + cols)  # type: ignore[call-arg]
+            wl = _get(flat, node - 1)  # type: ignore[call-arg]
+            wr = _get(flat, node + 1)  # type: ignore[call-arg]
         # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
         # allowed only when both side cells beside it are free
         free, used, n_open, g_goal, bound = _relax(
-            0, node - cols, r - 1, c, gn + wu, g, parent, lo, hi, heads, pn, pg, pnext,
+            0, node - cols, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            1, node + cols, r + 1, c, gn + wd, g, parent, lo, hi, heads, pn, pg, pnext,
+            1, node + cols, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            2, node - 1, r, c - 1, gn + wl, g, parent, lo, hi, heads, pn, pg, pnext,
+            2, node - 1, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            3, node + 1, r, c + 1, gn + wr, g, parent, lo, hi, heads, pn, pg, pnext,
+            3, node + 1, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         if diagonal:
             if wu != inf and wl != inf:
                 free, used, n_open, g_goal, bound = _relax(
-                    4, node - cols - 1, r - 1, c - 1, gn + sqrt2 * flat[node - cols - 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    4, node - cols - 1, r - 1, c - 1,
+                    gn + sqrt2 * _get(flat, node - cols - 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
                     free, used, n_open, g_goal, bound,
                 )  # fmt: skip
             if wu != inf and wr != inf:
                 free, used, n_open, g_goal, bound = _relax(
-                    5, node - cols + 1, r - 1, c + 1, gn + sqrt2 * flat[node - cols + 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    5, node - cols + 1, r - 1, c + 1,
+                    gn + sqrt2 * _get(flat, node - cols + 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
                     free, used, n_open, g_goal, bound,
                 )  # fmt: skip
             if wd != inf and wl != inf:
                 free, used, n_open, g_goal, bound = _relax(
-                    6, node + cols - 1, r + 1, c - 1, gn + sqrt2 * flat[node + cols - 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    6, node + cols - 1, r + 1, c - 1,
+                    gn + sqrt2 * _get(flat, node + cols - 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
                     free, used, n_open, g_goal, bound,
                 )  # fmt: skip
             if wd != inf and wr != inf:
                 free, used, n_open, g_goal, bound = _relax(
-                    7, node + cols + 1, r + 1, c + 1, gn + sqrt2 * flat[node + cols + 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                    7, node + cols + 1, r + 1, c + 1,
+                    gn + sqrt2 * _get(flat, node + cols + 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
                     free, used, n_open, g_goal, bound,
                 )  # fmt: skip
@@ -519,31 +560,28 @@ def search_buckets(
 
     ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
     ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
-    entry; with ``zero`` the written part of ``g`` is zero again on return.
+    entry; with ``zero`` the written part of ``g`` is zero again on return. The ``parent``
+    bytes it leaves may carry the :data:`CLOSED` bit besides the move.
     """
     cols = cost.shape[1]
     size = 1
     while size < span:  # a power of two: the bucket of a key is key & mask
         size *= 2
     heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
-    pn = np.empty(4096, np.int32)
-    pg = np.empty(4096, np.float64)
-    pnext = np.empty(4096, np.int32)
+    pool = np.empty(4096, np.int64)
     _store_g(g, start, 0.0)
+    parent[start] = 0  # not closed (the byte may hold a bit from an earlier search)
     _mark(lo, hi, start // cols, start % cols)
     h0 = _h(start // cols, start % cols, goal // cols, goal % cols, diagonal, hmin)
     cur = np.int64(math.floor(h0 * (1.0 / delta)))
-    pn[0] = start
-    pg[0] = 0.0
-    pnext[0] = -1
+    pool[0] = start | (np.int64(-1) << 32)
     heads[cur & (size - 1)] = 0
     ints = np.array([cur, 1, -1, 1, 0], np.int64)
     floats = np.array([np.inf, np.inf])
     flat = cost.ravel()
     while not _bucket_rounds(flat, cost.shape[0], cols, start, goal, diagonal, hmin, delta,
-                             size - 1, g, parent, lo, hi, heads, pn, pg, pnext, ints, floats):
-        used = ints[_USED]
-        pn, pg, pnext = _grown(pn, used), _grown(pg, used), _grown(pnext, used)
+                             size - 1, g, parent, lo, hi, heads, pool, ints, floats):
+        pool = _grown(pool, ints[_USED])
     _clean(g, lo, hi, cost.shape[0], cols, zero)
     return floats[_G_GOAL], ints[_EXPANDED]
 
