@@ -106,6 +106,37 @@ def _prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba int
     return sig, codegen
 
 
+@intrinsic
+def _get(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx]`` for a 1-D array and an index known to be inside it (no negative wrap)."""
+    sig = arr.dtype(arr, idx)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        return load_item(context, builder, arrty, ptr)
+
+    return sig, codegen
+
+
+@intrinsic
+def _put(typingctx, arr, idx, value):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx] = value`` for a 1-D array and an index known to be inside it."""
+    sig = types.void(arr, idx, value)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty, valty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        store_item(context, builder, arrty, context.cast(builder, args[2], valty, arrty.dtype), ptr)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 @numba.njit(cache=True, inline="always")
 def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
     """Prefetch the rows above and below cell ``q`` of ``g`` and the cost grid."""
@@ -119,12 +150,12 @@ def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
 def _load_g(g: np.ndarray, i: int) -> float:
     """g of cell ``i`` (``inf`` when not reached)."""
     # numba body: mypy reads the intrinsic as taking the typing context too
-    return _bits_to_float(g[i] ^ INF_BITS)  # type: ignore[call-arg, no-any-return]
+    return _bits_to_float(_get(g, i) ^ INF_BITS)  # type: ignore[call-arg, no-any-return]
 
 
 @numba.njit(cache=True, inline="always")
 def _store_g(g: np.ndarray, i: int, value: float) -> None:
-    g[i] = _float_to_bits(value) ^ INF_BITS  # type: ignore[call-arg]  # numba body, as above
+    _put(g, i, _float_to_bits(value) ^ INF_BITS)  # type: ignore[call-arg]  # numba body, as above
 
 
 @numba.njit(cache=True, inline="always")
@@ -206,10 +237,10 @@ class Scratch:
 @numba.njit(cache=True, inline="always")
 def _mark(lo: np.ndarray, hi: np.ndarray, r: int, c: int) -> None:
     """Remember that the search wrote g at (r, c)."""
-    if c < lo[r]:
-        lo[r] = c
-    if c > hi[r]:
-        hi[r] = c
+    if c < _get(lo, r):  # type: ignore[call-arg]  # numba body, as for _load_g
+        _put(lo, r, c)  # type: ignore[call-arg]
+    if c > _get(hi, r):  # type: ignore[call-arg]
+        _put(hi, r, c)  # type: ignore[call-arg]
 
 
 @numba.njit(cache=True)
@@ -289,37 +320,6 @@ def _move_costs(
         else:
             w8[k] = flat[node + off[k]]
     return 8
-
-
-@intrinsic
-def _get(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
-    """``arr[idx]`` for a 1-D array and an index known to be inside it (no negative wrap)."""
-    sig = arr.dtype(arr, idx)
-
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
-        arrty, idxty = signature.args
-        ary = context.make_array(arrty)(context, builder, args[0])
-        i = context.cast(builder, args[1], idxty, types.intp)
-        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
-        return load_item(context, builder, arrty, ptr)
-
-    return sig, codegen
-
-
-@intrinsic
-def _put(typingctx, arr, idx, value):  # type: ignore[no-untyped-def]  # numba intrinsic
-    """``arr[idx] = value`` for a 1-D array and an index known to be inside it."""
-    sig = types.void(arr, idx, value)
-
-    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
-        arrty, idxty, valty = signature.args
-        ary = context.make_array(arrty)(context, builder, args[0])
-        i = context.cast(builder, args[1], idxty, types.intp)
-        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
-        store_item(context, builder, arrty, context.cast(builder, args[2], valty, arrty.dtype), ptr)
-        return context.get_dummy_value()
-
-    return sig, codegen
 
 
 _NO_REFCOUNT: dict[str, Any] = {"_nrt": False}
@@ -421,6 +421,7 @@ def _bucket_rounds(
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
     inv_delta = 1.0 / delta
+    inv_cols = 1.0 / cols
     inf = np.inf
     room = pool.shape[0] - 8  # an expansion pushes at most 8 entries
     cur = ints[_CUR]
@@ -455,8 +456,16 @@ def _bucket_rounds(
         if move & CLOSED:
             continue  # expanded already with this g: a stale entry
         gn = _load_g(g, node)
-        r = node // cols
+        # row and column without an integer division: the float quotient is off by at
+        # most one, and the remainder says which way
+        r = np.int64(node * inv_cols)
         c = node - r * cols
+        if c < 0:
+            r -= 1
+            c += cols
+        elif c >= cols:
+            r += 1
+            c -= cols
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
         _put(parent, node, move | CLOSED)  # type: ignore[call-arg]
