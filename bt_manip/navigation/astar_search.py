@@ -23,9 +23,11 @@ Scratch memory. ``g`` is stored as the bits of the float64 value XOR those of ``
 zero word reads as ``+inf``, "not reached" (the start, g = 0, is stored as the bits of inf):
 zero pages are an empty search, and a blocked neighbour (step cost inf) can never improve on
 it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cell was last
-improved, one byte per cell. Each search records, per row, the columns of ``g`` it wrote, and
-a search asked to clean up sets them back to zero before it returns, so the next search can
-reuse the same memory without touching the rest of the grid.
+improved, one byte per cell (the bucket search also sets :data:`CLOSED` in it once it
+expands the cell). Each search records, per row, the first and last column of the cells it
+expanded; it wrote ``g`` only in those cells' 3 x 3 neighbourhoods, and a search asked to
+clean up sets that part back to zero before it returns, so the next search can reuse the same
+memory without touching the rest of the grid.
 
 The bucket search's loop (:func:`_bucket_rounds`, :func:`_relax`) is compiled without numba's
 runtime: it allocates nothing and counts no references, and its eight moves are written out
@@ -211,7 +213,7 @@ class Scratch:
     ``g`` (int64 words, see the module notes) and ``parent`` (uint8 moves) live in anonymous
     memory maps: the system hands out zero pages on first touch, so a search that explores a
     small part of a large grid keeps only that part resident. ``lo``/``hi`` are, per row, the
-    first and last column whose ``g`` the current search wrote (``lo > hi``: none).
+    first and last column of the cells the current search expanded (``lo > hi``: none).
     """
 
     cells: int
@@ -236,7 +238,8 @@ class Scratch:
 
 @numba.njit(cache=True, inline="always")
 def _mark(lo: np.ndarray, hi: np.ndarray, r: int, c: int) -> None:
-    """Remember that the search wrote g at (r, c)."""
+    """Remember that the search expanded (r, c): it may have written g in the 3 x 3 cells
+    around it."""
     if c < _get(lo, r):  # type: ignore[call-arg]  # numba body, as for _load_g
         _put(lo, r, c)  # type: ignore[call-arg]
     if c > _get(hi, r):  # type: ignore[call-arg]
@@ -245,14 +248,20 @@ def _mark(lo: np.ndarray, hi: np.ndarray, r: int, c: int) -> None:
 
 @numba.njit(cache=True)
 def _clean(g: np.ndarray, lo: np.ndarray, hi: np.ndarray, rows: int, cols: int, zero: bool) -> None:
-    """Forget the written columns; with ``zero``, also set their g words back to 0."""
+    """Forget the marks; with ``zero``, also set the g words the search may have written
+    back to 0: in row r, the columns of the marks of rows r - 1 to r + 1, widened by one."""
     top = np.iinfo(np.int32).max
+    above_lo, above_hi = top, -1  # the marks of row r - 1, before they were reset
     for r in range(rows):
-        if hi[r] >= lo[r]:
-            if zero:
-                g[r * cols + lo[r] : r * cols + hi[r] + 1] = 0
-            lo[r] = top
-            hi[r] = -1
+        here_lo, here_hi = lo[r], hi[r]
+        below_lo, below_hi = (lo[r + 1], hi[r + 1]) if r + 1 < rows else (top, -1)
+        first = max(min(above_lo, here_lo, below_lo) - 1, 0)
+        last = min(max(above_hi, here_hi, below_hi) + 1, cols - 1)
+        if zero and last >= first:
+            g[r * cols + first : r * cols + last + 1] = 0
+        above_lo, above_hi = here_lo, here_hi
+        lo[r] = top
+        hi[r] = -1
 
 
 @numba.njit(cache=True)
@@ -361,16 +370,16 @@ def _relax(
 ) -> tuple[int, int, int, float, float]:
     """Offer cell ``nb`` (row ``nr``, col ``nc``) the cost ``ng_`` by move ``k``.
 
-    If it beats the stored g, store it and push the cell into its f-bucket (the goal is not
-    pushed: it sets the bound instead). Returns the updated ``(free, used, n_open, g_goal,
-    bound)``. Compiled without reference counting, like its caller, so that passing the
-    arrays costs nothing.
+    ``nb`` must be a cell of the grid (a move that leaves the grid offers inf to the expanded
+    cell itself: its g is read, never beaten). If ``ng_`` beats the stored g, store it and
+    push the cell into its f-bucket (the goal is not pushed: it sets the bound instead).
+    Returns the updated ``(free, used, n_open, g_goal, bound)``. Compiled without reference
+    counting, like its caller, so that passing the arrays costs nothing.
     """
     # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
     if ng_ < _load_g(g, nb) * KEEP:
         _store_g(g, nb, ng_)
         _put(parent, nb, k)  # type: ignore[call-arg]  # numba body, as for _load_g
-        _mark(lo, hi, nr, nc)
         if nb == goal:
             return free, used, n_open, ng_, ng_ * KEEP
         f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
@@ -469,34 +478,53 @@ def _bucket_rounds(
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
         _put(parent, node, move | CLOSED)  # type: ignore[call-arg]
+        _mark(lo, hi, r, c)
         expanded += 1
-        # costs of the four side cells (inf outside the grid)
+        # the four side cells and their costs; outside the grid the cost is inf and the
+        # cell is the expanded one itself (inf never beats its g: nothing outside is read)
+        up = node - cols
+        down = node + cols
+        left = node - 1
+        right = node + 1
         if r == 0 or r == rows - 1 or c == 0 or c == cols - 1:
-            wu = _get(flat, node - cols) if r > 0 else inf  # type: ignore[call-arg]
-            wd = _get(flat, node + cols) if r < rows - 1 else inf  # type: ignore[call-arg]
-            wl = _get(flat, node - 1) if c > 0 else inf  # type: ignore[call-arg]
-            wr = _get(flat, node + 1) if c < cols - 1 else inf  # type: ignore[call-arg]
+            wu = wd = wl = wr = inf
+            if r > 0:
+                wu = _get(flat, up)  # type: ignore[call-arg]  # numba body, as for _load_g
+            else:
+                up = node
+            if r < rows - 1:
+                wd = _get(flat, down)  # type: ignore[call-arg]
+            else:
+                down = node
+            if c > 0:
+                wl = _get(flat, left)  # type: ignore[call-arg]
+            else:
+                left = node
+            if c < cols - 1:
+                wr = _get(flat, right)  # type: ignore[call-arg]
+            else:
+                right = node
         else:
-            wu = _get(flat, node - cols)  # type: ignore[call-arg]
-            wd = _get(flat, node + cols)  # type: ignore[call-arg]
-            wl = _get(flat, node - 1)  # type: ignore[call-arg]
-            wr = _get(flat, node + 1)  # type: ignore[call-arg]
+            wu = _get(flat, up)  # type: ignore[call-arg]
+            wd = _get(flat, down)  # type: ignore[call-arg]
+            wl = _get(flat, left)  # type: ignore[call-arg]
+            wr = _get(flat, right)  # type: ignore[call-arg]
         # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
         # allowed only when both side cells beside it are free
         free, used, n_open, g_goal, bound = _relax(
-            0, node - cols, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
+            0, up, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            1, node + cols, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
+            1, down, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            2, node - 1, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
+            2, left, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         free, used, n_open, g_goal, bound = _relax(
-            3, node + 1, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
+            3, right, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
         )  # fmt: skip
         if diagonal:
@@ -673,8 +701,11 @@ def search_heap(
         expanded += 1
         r = node // cols
         c = node - r * cols
+        _mark(lo, hi, r, c)
         nmoves = _move_costs(flat, node, r, c, rows, cols, diagonal, off, w8)
         for k in range(nmoves):
+            if w8[k] == np.inf:
+                continue  # blocked, or outside the grid (not to be read)
             ng_ = g_top + w8[k] if k < 4 else g_top + sqrt2 * w8[k]
             nb = node + off[k]
             if not ng_ < _load_g(g, nb) * KEEP:
@@ -683,7 +714,6 @@ def search_heap(
             nc = c + DC[k]
             _store_g(g, nb, ng_)
             parent[nb] = k
-            _mark(lo, hi, nr, nc)
             nf_ = math.floor((ng_ + _h(nr, nc, gr, gc, diagonal, hmin)) * inv_q)
             if size == hf.shape[0]:
                 hf, hg, hn = _doubled(hf), _doubled(hg), _doubled(hn)
