@@ -23,8 +23,9 @@ Scratch memory. ``g`` is stored as the bits of the float64 value XOR those of ``
 zero word reads as ``+inf``, "not reached" (the start, g = 0, is stored as the bits of inf):
 zero pages are an empty search, and a blocked neighbour (step cost inf) can never improve on
 it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cell was last
-improved, one byte per cell (the bucket search also sets :data:`CLOSED` in it once it
-expands the cell). Each search records, per row, the first and last column of the cells it
+improved, one byte per cell. The sign bit of a g word, never set by a g >= 0, is the bucket
+search's mark that it expanded the cell with that g (:data:`CLOSED`); storing an improved g
+clears it. Each search records, per row, the first and last column of the cells it
 expanded; it wrote ``g`` only in those cells' 3 x 3 neighbourhoods, and a search asked to
 clean up sets that part back to zero before it returns, so the next search can reuse the same
 memory without touching the rest of the grid.
@@ -59,11 +60,8 @@ SIDE_ROW = np.array([0, 0, 1, 1], dtype=np.int64)
 SIDE_COL = np.array([2, 3, 2, 3], dtype=np.int64)
 INF_BITS = np.int64(0x7FF0000000000000)
 """Bits of float64 ``+inf``: stored g words are the value's bits XOR these."""
-CLOSED = np.uint8(8)
-"""Bit of a ``parent`` byte set when the bucket search expands the cell with its current g
-(cleared when g improves, as the new move is written)."""
-MOVE = np.uint8(7)
-"""Bits of a ``parent`` byte holding the move."""
+CLOSED = np.int64(-0x8000000000000000)
+"""The sign bit of a g word: set when the bucket search expands the cell with its stored g."""
 
 
 @intrinsic
@@ -150,9 +148,9 @@ def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
 
 @numba.njit(cache=True, inline="always")
 def _load_g(g: np.ndarray, i: int) -> float:
-    """g of cell ``i`` (``inf`` when not reached)."""
+    """g of cell ``i`` (``inf`` when not reached), whether or not it is marked closed."""
     # numba body: mypy reads the intrinsic as taking the typing context too
-    return _bits_to_float(_get(g, i) ^ INF_BITS)  # type: ignore[call-arg, no-any-return]
+    return abs(_bits_to_float(_get(g, i) ^ INF_BITS))  # type: ignore[call-arg, no-any-return]
 
 
 @numba.njit(cache=True, inline="always")
@@ -270,7 +268,7 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
     n = 1
     node = goal
     while node != start:
-        k = parent[node] & MOVE
+        k = parent[node]
         node -= DR[k] * cols + DC[k]
         n += 1
     out = np.empty((n, 2), np.int64)
@@ -279,7 +277,7 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
         out[i, 0] = node // cols
         out[i, 1] = node % cols
         if i > 0:
-            k = parent[node] & MOVE
+            k = parent[node]
             node -= DR[k] * cols + DC[k]
     return out
 
@@ -461,10 +459,10 @@ def _bucket_rounds(
         node = entry & _LOW
         if nxt != -1:  # likely the next pop: start loading its rows
             _prefetch_rows(g, flat, _get(pool, nxt) & _LOW, cols)  # type: ignore[call-arg]
-        move = _get(parent, node)  # type: ignore[call-arg]
-        if move & CLOSED:
+        word = _get(g, node)  # type: ignore[call-arg]
+        if word & CLOSED:
             continue  # expanded already with this g: a stale entry
-        gn = _load_g(g, node)
+        gn = _bits_to_float(word ^ INF_BITS)  # type: ignore[call-arg]
         # row and column without an integer division: the float quotient is off by at
         # most one, and the remainder says which way
         r = np.int64(node * inv_cols)
@@ -477,7 +475,7 @@ def _bucket_rounds(
             c -= cols
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
-        _put(parent, node, move | CLOSED)  # type: ignore[call-arg]
+        _put(g, node, word | CLOSED)  # type: ignore[call-arg]
         _mark(lo, hi, r, c)
         expanded += 1
         # the four side cells and their costs; outside the grid the cost is inf and the
@@ -597,8 +595,8 @@ def search_buckets(
 
     ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
     ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
-    entry; with ``zero`` the written part of ``g`` is zero again on return. The ``parent``
-    bytes it leaves may carry the :data:`CLOSED` bit besides the move.
+    entry; with ``zero`` the written part of ``g`` is zero again on return (without, the
+    words it leaves may carry the :data:`CLOSED` bit).
     """
     cols = cost.shape[1]
     size = 1
@@ -607,7 +605,6 @@ def search_buckets(
     heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
     pool = np.empty(4096, np.int64)
     _store_g(g, start, 0.0)
-    parent[start] = 0  # not closed (the byte may hold a bit from an earlier search)
     _mark(lo, hi, start // cols, start % cols)
     h0 = _h(start // cols, start % cols, goal // cols, goal % cols, diagonal, hmin)
     cur = np.int64(math.floor(h0 * (1.0 / delta)))
