@@ -449,7 +449,7 @@ def _bucket_rounds(
             b = cur & mask
         if cur * delta >= g_goal:
             break  # every open entry has f >= g_goal
-        slot = _get(heads, b)  # type: ignore[call-arg]
+        slot: int = _get(heads, b)  # type: ignore[call-arg]
         entry = _get(pool, slot)  # type: ignore[call-arg]
         nxt = entry >> 32
         _put(heads, b, nxt)  # type: ignore[call-arg]
