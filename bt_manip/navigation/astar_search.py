@@ -365,13 +365,17 @@ def _relax(
     n_open: int,
     g_goal: float,
     bound: float,
-) -> tuple[int, int, int, float, float]:
+    pending: int,
+) -> tuple[int, int, int, float, float, int]:
     """Offer cell ``nb`` (row ``nr``, col ``nc``) the cost ``ng_`` by move ``k``.
 
     ``nb`` must be a cell of the grid (a move that leaves the grid offers inf to the expanded
     cell itself: its g is read, never beaten). If ``ng_`` beats the stored g, store it and
-    push the cell into its f-bucket (the goal is not pushed: it sets the bound instead).
-    Returns the updated ``(free, used, n_open, g_goal, bound)``. Compiled without reference
+    push the cell into its f-bucket (the goal is not pushed: it sets the bound instead). A
+    cell bound for the current bucket becomes the ``pending`` one instead, the one pushed
+    there before it going into the pool: the pending cell is the top of that bucket, the
+    next to be expanded, and skips the pool. Returns the updated ``(free, used, n_open,
+    g_goal, bound, pending)``. Compiled without reference
     counting, like its caller, so that passing the arrays costs nothing.
     """
     # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
@@ -379,20 +383,34 @@ def _relax(
         _store_g(g, nb, ng_)
         _put(parent, nb, k)  # type: ignore[call-arg]  # numba body, as for _load_g
         if nb == goal:
-            return free, used, n_open, ng_, ng_ * KEEP
+            return free, used, n_open, ng_, ng_ * KEEP, pending
         f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
         if f < bound:
-            kb = max(math.floor(f * inv_delta), cur) & mask
-            if free != -1:
-                s = free
-                free = _get(pool, s) >> 32  # type: ignore[call-arg]
-            else:
-                s = used
-                used += 1
-            _put(pool, s, nb | (np.int64(_get(heads, kb)) << 32))  # type: ignore[call-arg]
-            _put(heads, kb, s)  # type: ignore[call-arg]
             n_open += 1
-    return free, used, n_open, g_goal, bound
+            key = max(math.floor(f * inv_delta), cur)
+            if key == cur:
+                nb, pending = pending, nb
+                if nb == -1:
+                    return free, used, n_open, g_goal, bound, pending
+            free, used = _push(heads, pool, key & mask, nb, free, used)
+    return free, used, n_open, g_goal, bound, pending
+
+
+@numba.njit(cache=True, inline="always")
+def _push(
+    heads: np.ndarray, pool: np.ndarray, b: int, cell: int, free: int, used: int
+) -> tuple[int, int]:
+    """Push ``cell`` on top of bucket ``b`` in a free slot of the pool or a new one; returns
+    the updated ``(free, used)``."""
+    if free != -1:
+        s = free
+        free = _get(pool, s) >> 32  # type: ignore[call-arg]  # numba body, as for _load_g
+    else:
+        s = used
+        used += 1
+    _put(pool, s, cell | (np.int64(_get(heads, b)) << 32))  # type: ignore[call-arg]
+    _put(heads, b, s)  # type: ignore[call-arg]
+    return free, used
 
 
 @numba.njit(cache=True, **_NO_REFCOUNT)
@@ -430,7 +448,7 @@ def _bucket_rounds(
     inv_delta = 1.0 / delta
     inv_cols = 1.0 / cols
     inf = np.inf
-    room = pool.shape[0] - 8  # an expansion pushes at most 8 entries
+    room = pool.shape[0] - 9  # an expansion pushes at most 8 entries, and the pending one
     cur = ints[_CUR]
     used = ints[_USED]
     free = ints[_FREE]
@@ -438,25 +456,34 @@ def _bucket_rounds(
     expanded = ints[_EXPANDED]
     g_goal = floats[_G_GOAL]
     bound = floats[_BOUND]  # g_goal x KEEP: what a path through an entry must beat
+    pending = -1  # a cell on top of the current bucket, kept out of the pool
     done = True
     while n_open > 0:
         if used > room:
             done = False
             break
-        b = cur & mask
-        while _get(heads, b) == -1:  # type: ignore[call-arg]  # numba body, as for _load_g
-            cur += 1
+        if pending != -1:
+            if cur * delta >= g_goal:
+                break  # every open entry has f >= g_goal
+            node = pending
+            pending = -1
+            n_open -= 1
+            nxt = _get(heads, cur & mask)  # type: ignore[call-arg]  # numba body, as for _load_g
+        else:
             b = cur & mask
-        if cur * delta >= g_goal:
-            break  # every open entry has f >= g_goal
-        slot: int = _get(heads, b)  # type: ignore[call-arg]
-        entry = _get(pool, slot)  # type: ignore[call-arg]
-        nxt = entry >> 32
-        _put(heads, b, nxt)  # type: ignore[call-arg]
-        _put(pool, slot, np.int64(free) << 32)  # type: ignore[call-arg]
-        free = slot
-        n_open -= 1
-        node = entry & _LOW
+            while _get(heads, b) == -1:  # type: ignore[call-arg]
+                cur += 1
+                b = cur & mask
+            if cur * delta >= g_goal:
+                break  # every open entry has f >= g_goal
+            slot: int = _get(heads, b)  # type: ignore[call-arg]
+            entry = _get(pool, slot)  # type: ignore[call-arg]
+            nxt = entry >> 32
+            _put(heads, b, nxt)  # type: ignore[call-arg]
+            _put(pool, slot, np.int64(free) << 32)  # type: ignore[call-arg]
+            free = slot
+            n_open -= 1
+            node = entry & _LOW
         if nxt != -1:  # likely the next pop: start loading its rows
             _prefetch_rows(g, flat, _get(pool, nxt) & _LOW, cols)  # type: ignore[call-arg]
         word = _get(g, node)  # type: ignore[call-arg]
@@ -509,55 +536,61 @@ def _bucket_rounds(
             wr = _get(flat, right)  # type: ignore[call-arg]
         # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
         # allowed only when both side cells beside it are free
-        free, used, n_open, g_goal, bound = _relax(
+        free, used, n_open, g_goal, bound, pending = _relax(
             0, up, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
+        free, used, n_open, g_goal, bound, pending = _relax(
             1, down, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
+        free, used, n_open, g_goal, bound, pending = _relax(
             2, left, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
+        free, used, n_open, g_goal, bound, pending = _relax(
             3, right, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         if diagonal:
             if wu != inf and wl != inf:
-                free, used, n_open, g_goal, bound = _relax(
+                free, used, n_open, g_goal, bound, pending = _relax(
                     4, node - cols - 1, r - 1, c - 1,
                     gn + sqrt2 * _get(flat, node - cols - 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wu != inf and wr != inf:
-                free, used, n_open, g_goal, bound = _relax(
+                free, used, n_open, g_goal, bound, pending = _relax(
                     5, node - cols + 1, r - 1, c + 1,
                     gn + sqrt2 * _get(flat, node - cols + 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wd != inf and wl != inf:
-                free, used, n_open, g_goal, bound = _relax(
+                free, used, n_open, g_goal, bound, pending = _relax(
                     6, node + cols - 1, r + 1, c - 1,
                     gn + sqrt2 * _get(flat, node + cols - 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wd != inf and wr != inf:
-                free, used, n_open, g_goal, bound = _relax(
+                free, used, n_open, g_goal, bound, pending = _relax(
                     7, node + cols + 1, r + 1, c + 1,
                     gn + sqrt2 * _get(flat, node + cols + 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
+    if pending != -1:  # back into the pool, on top of its bucket, for the next round
+        free, used = _push(heads, pool, cur & mask, pending, free, used)
     ints[_CUR] = cur
     ints[_USED] = used
     ints[_FREE] = free
