@@ -468,7 +468,7 @@ def _bucket_rounds(
             node = pending
             pending = -1
             n_open -= 1
-            nxt = _get(heads, cur & mask)  # type: ignore[call-arg]  # numba body, as for _load_g
+            nxt: int = _get(heads, cur & mask)  # type: ignore[call-arg]  # numba body, as for _load_g
         else:
             b = cur & mask
             while _get(heads, b) == -1:  # type: ignore[call-arg]
