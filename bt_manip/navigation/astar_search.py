@@ -32,7 +32,11 @@ memory without touching the rest of the grid.
 
 The bucket search's loop (:func:`_bucket_rounds`, :func:`_relax`) is compiled without numba's
 runtime: it allocates nothing and counts no references, and its eight moves are written out
-one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool.
+one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool. Its
+array reads and writes skip numba's wrap of negative indices (every index is inside its array:
+a move that would leave the grid is offered to the expanded cell itself), a pool entry is one
+int64 (the cell and the next slot of its bucket), and the cell pushed last onto the current
+bucket, the next to be expanded, waits outside the pool.
 """
 
 from __future__ import annotations
