@@ -23,13 +23,20 @@ Scratch memory. ``g`` is stored as the bits of the float64 value XOR those of ``
 zero word reads as ``+inf``, "not reached" (the start, g = 0, is stored as the bits of inf):
 zero pages are an empty search, and a blocked neighbour (step cost inf) can never improve on
 it. ``parent`` holds the move (0-7, see ``DR``/``DC``) by which each reached cell was last
-improved, one byte per cell. Each search records, per row, the columns of ``g`` it wrote, and
-a search asked to clean up sets them back to zero before it returns, so the next search can
-reuse the same memory without touching the rest of the grid.
+improved, one byte per cell. The sign bit of a g word, never set by a g >= 0, is the bucket
+search's mark that it expanded the cell with that g (:data:`CLOSED`); storing an improved g
+clears it. Each search records, per row, the first and last column of the cells it
+expanded; it wrote ``g`` only in those cells' 3 x 3 neighbourhoods, and a search asked to
+clean up sets that part back to zero before it returns, so the next search can reuse the same
+memory without touching the rest of the grid.
 
 The bucket search's loop (:func:`_bucket_rounds`, :func:`_relax`) is compiled without numba's
 runtime: it allocates nothing and counts no references, and its eight moves are written out
-one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool.
+one by one, so an expansion costs no array traffic beyond the grid, ``g`` and the pool. Its
+array reads and writes skip numba's wrap of negative indices (every index is inside its array:
+a move that would leave the grid is offered to the expanded cell itself), a pool entry is one
+int64 (the cell and the next slot of its bucket), and the cell pushed last onto the current
+bucket, the next to be expanded, waits outside the pool.
 """
 
 from __future__ import annotations
@@ -44,6 +51,7 @@ import numpy as np
 from llvmlite import ir
 from numba.core import cgutils, types
 from numba.extending import intrinsic
+from numba.np.arrayobj import load_item, store_item
 
 KEEP = 1.0 - 1e-13
 """A new g must be below ``KEEP x`` the known g to count as an improvement."""
@@ -56,6 +64,8 @@ SIDE_ROW = np.array([0, 0, 1, 1], dtype=np.int64)
 SIDE_COL = np.array([2, 3, 2, 3], dtype=np.int64)
 INF_BITS = np.int64(0x7FF0000000000000)
 """Bits of float64 ``+inf``: stored g words are the value's bits XOR these."""
+CLOSED = np.int64(-0x8000000000000000)
+"""The sign bit of a g word: set when the bucket search expands the cell with its stored g."""
 
 
 @intrinsic
@@ -100,6 +110,37 @@ def _prefetch(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba int
     return sig, codegen
 
 
+@intrinsic
+def _get(typingctx, arr, idx):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx]`` for a 1-D array and an index known to be inside it (no negative wrap)."""
+    sig = arr.dtype(arr, idx)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        return load_item(context, builder, arrty, ptr)
+
+    return sig, codegen
+
+
+@intrinsic
+def _put(typingctx, arr, idx, value):  # type: ignore[no-untyped-def]  # numba intrinsic
+    """``arr[idx] = value`` for a 1-D array and an index known to be inside it."""
+    sig = types.void(arr, idx, value)
+
+    def codegen(context, builder, signature, args):  # type: ignore[no-untyped-def]
+        arrty, idxty, valty = signature.args
+        ary = context.make_array(arrty)(context, builder, args[0])
+        i = context.cast(builder, args[1], idxty, types.intp)
+        ptr = cgutils.get_item_pointer(context, builder, arrty, ary, [i], wraparound=False)
+        store_item(context, builder, arrty, context.cast(builder, args[2], valty, arrty.dtype), ptr)
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 @numba.njit(cache=True, inline="always")
 def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
     """Prefetch the rows above and below cell ``q`` of ``g`` and the cost grid."""
@@ -111,14 +152,14 @@ def _prefetch_rows(g: np.ndarray, flat: np.ndarray, q: int, cols: int) -> None:
 
 @numba.njit(cache=True, inline="always")
 def _load_g(g: np.ndarray, i: int) -> float:
-    """g of cell ``i`` (``inf`` when not reached)."""
+    """g of cell ``i`` (``inf`` when not reached), whether or not it is marked closed."""
     # numba body: mypy reads the intrinsic as taking the typing context too
-    return _bits_to_float(g[i] ^ INF_BITS)  # type: ignore[call-arg, no-any-return]
+    return abs(_bits_to_float(_get(g, i) ^ INF_BITS))  # type: ignore[call-arg, no-any-return]
 
 
 @numba.njit(cache=True, inline="always")
 def _store_g(g: np.ndarray, i: int, value: float) -> None:
-    g[i] = _float_to_bits(value) ^ INF_BITS  # type: ignore[call-arg]  # numba body, as above
+    _put(g, i, _float_to_bits(value) ^ INF_BITS)  # type: ignore[call-arg]  # numba body, as above
 
 
 @numba.njit(cache=True, inline="always")
@@ -174,7 +215,7 @@ class Scratch:
     ``g`` (int64 words, see the module notes) and ``parent`` (uint8 moves) live in anonymous
     memory maps: the system hands out zero pages on first touch, so a search that explores a
     small part of a large grid keeps only that part resident. ``lo``/``hi`` are, per row, the
-    first and last column whose ``g`` the current search wrote (``lo > hi``: none).
+    first and last column of the cells the current search expanded (``lo > hi``: none).
     """
 
     cells: int
@@ -199,23 +240,30 @@ class Scratch:
 
 @numba.njit(cache=True, inline="always")
 def _mark(lo: np.ndarray, hi: np.ndarray, r: int, c: int) -> None:
-    """Remember that the search wrote g at (r, c)."""
-    if c < lo[r]:
-        lo[r] = c
-    if c > hi[r]:
-        hi[r] = c
+    """Remember that the search expanded (r, c): it may have written g in the 3 x 3 cells
+    around it."""
+    if c < _get(lo, r):  # type: ignore[call-arg]  # numba body, as for _load_g
+        _put(lo, r, c)  # type: ignore[call-arg]
+    if c > _get(hi, r):  # type: ignore[call-arg]
+        _put(hi, r, c)  # type: ignore[call-arg]
 
 
 @numba.njit(cache=True)
 def _clean(g: np.ndarray, lo: np.ndarray, hi: np.ndarray, rows: int, cols: int, zero: bool) -> None:
-    """Forget the written columns; with ``zero``, also set their g words back to 0."""
+    """Forget the marks; with ``zero``, also set the g words the search may have written
+    back to 0: in row r, the columns of the marks of rows r - 1 to r + 1, widened by one."""
     top = np.iinfo(np.int32).max
+    above_lo, above_hi = top, -1  # the marks of row r - 1, before they were reset
     for r in range(rows):
-        if hi[r] >= lo[r]:
-            if zero:
-                g[r * cols + lo[r] : r * cols + hi[r] + 1] = 0
-            lo[r] = top
-            hi[r] = -1
+        here_lo, here_hi = lo[r], hi[r]
+        below_lo, below_hi = (lo[r + 1], hi[r + 1]) if r + 1 < rows else (top, -1)
+        first = max(min(above_lo, here_lo, below_lo) - 1, 0)
+        last = min(max(above_hi, here_hi, below_hi) + 1, cols - 1)
+        if zero and last >= first:
+            g[r * cols + first : r * cols + last + 1] = 0
+        above_lo, above_hi = here_lo, here_hi
+        lo[r] = top
+        hi[r] = -1
 
 
 @numba.njit(cache=True)
@@ -288,6 +336,8 @@ def _move_costs(
 _NO_REFCOUNT: dict[str, Any] = {"_nrt": False}
 """numba option: compile without the runtime (no reference counting; no allocation inside)."""
 
+_LOW = np.int64(0xFFFFFFFF)
+
 # Indices into the bucket search's state vectors (it runs in rounds between pool growths).
 _CUR, _USED, _FREE, _OPEN, _EXPANDED = 0, 1, 2, 3, 4
 _G_GOAL, _BOUND = 0, 1
@@ -305,9 +355,7 @@ def _relax(
     lo: np.ndarray,
     hi: np.ndarray,
     heads: np.ndarray,
-    pn: np.ndarray,
-    pg: np.ndarray,
-    pnext: np.ndarray,
+    pool: np.ndarray,
     goal: int,
     gr: int,
     gc: int,
@@ -321,36 +369,52 @@ def _relax(
     n_open: int,
     g_goal: float,
     bound: float,
-) -> tuple[int, int, int, float, float]:
+    pending: int,
+) -> tuple[int, int, int, float, float, int]:
     """Offer cell ``nb`` (row ``nr``, col ``nc``) the cost ``ng_`` by move ``k``.
 
-    If it beats the stored g, store it and push the cell into its f-bucket (the goal is not
-    pushed: it sets the bound instead). Returns the updated ``(free, used, n_open, g_goal,
-    bound)``. Compiled without reference counting, like its caller, so that passing the
-    arrays costs nothing.
+    ``nb`` must be a cell of the grid (a move that leaves the grid offers inf to the expanded
+    cell itself: its g is read, never beaten). If ``ng_`` beats the stored g, store it and
+    push the cell into its f-bucket (the goal is not pushed: it sets the bound instead). A
+    cell bound for the current bucket becomes the ``pending`` one instead, the one pushed
+    there before it going into the pool: the pending cell is the top of that bucket, the
+    next to be expanded, and skips the pool. Returns the updated ``(free, used, n_open,
+    g_goal, bound, pending)``. Compiled without reference
+    counting, like its caller, so that passing the arrays costs nothing.
     """
     # inf (a blocked move) never beats a stored g; an unreached cell reads as inf
     if ng_ < _load_g(g, nb) * KEEP:
         _store_g(g, nb, ng_)
-        parent[nb] = k
-        _mark(lo, hi, nr, nc)
+        _put(parent, nb, k)  # type: ignore[call-arg]  # numba body, as for _load_g
         if nb == goal:
-            return free, used, n_open, ng_, ng_ * KEEP
+            return free, used, n_open, ng_, ng_ * KEEP, pending
         f = ng_ + _h(nr, nc, gr, gc, diagonal, hmin)
         if f < bound:
-            kb = max(math.floor(f * inv_delta), cur) & mask
-            if free != -1:
-                s = free
-                free = pnext[s]
-            else:
-                s = used
-                used += 1
-            pn[s] = nb
-            pg[s] = ng_
-            pnext[s] = heads[kb]
-            heads[kb] = s
             n_open += 1
-    return free, used, n_open, g_goal, bound
+            key = max(math.floor(f * inv_delta), cur)
+            if key == cur:
+                nb, pending = pending, nb
+                if nb == -1:
+                    return free, used, n_open, g_goal, bound, pending
+            free, used = _push(heads, pool, key & mask, nb, free, used)
+    return free, used, n_open, g_goal, bound, pending
+
+
+@numba.njit(cache=True, inline="always")
+def _push(
+    heads: np.ndarray, pool: np.ndarray, b: int, cell: int, free: int, used: int
+) -> tuple[int, int]:
+    """Push ``cell`` on top of bucket ``b`` in a free slot of the pool or a new one; returns
+    the updated ``(free, used)``."""
+    if free != -1:
+        s = free
+        free = _get(pool, s) >> 32  # type: ignore[call-arg]  # numba body, as for _load_g
+    else:
+        s = used
+        used += 1
+    _put(pool, s, cell | (np.int64(_get(heads, b)) << 32))  # type: ignore[call-arg]
+    _put(heads, b, s)  # type: ignore[call-arg]
+    return free, used
 
 
 @numba.njit(cache=True, **_NO_REFCOUNT)
@@ -369,26 +433,26 @@ def _bucket_rounds(
     lo: np.ndarray,
     hi: np.ndarray,
     heads: np.ndarray,
-    pn: np.ndarray,
-    pg: np.ndarray,
-    pnext: np.ndarray,
+    pool: np.ndarray,
     ints: np.ndarray,
     floats: np.ndarray,
 ) -> bool:
     """Run the bucket search until it ends (True) or its pool may run out of slots (False).
 
-    ``flat`` is the cost grid as one row-major vector of ``rows x cols``. The pool (``pn``,
-    ``pg``, ``pnext``: cell, g at push time, next slot in the bucket) and the state vectors
-    are the caller's. The function allocates nothing and is compiled without reference
-    counting (``_nrt=False``): the moves are written out one by one (no per-move arrays),
-    and :func:`_relax` takes the arrays at no cost.
+    ``flat`` is the cost grid as one row-major vector of ``rows x cols``. A pool entry is one
+    int64: the cell in the low 32 bits, the next slot of its bucket (or of the free list) in
+    the high 32 bits (-1: none). The pool and the state vectors are the caller's. The
+    function allocates nothing and is compiled without reference counting (``_nrt=False``):
+    the moves are written out one by one (no per-move arrays), :func:`_relax` takes the
+    arrays at no cost, and the array reads and writes skip numba's negative-index wrap.
     """
     gr = goal // cols
     gc = goal % cols
     sqrt2 = math.sqrt(2.0)
     inv_delta = 1.0 / delta
+    inv_cols = 1.0 / cols
     inf = np.inf
-    room = pn.shape[0] - 8  # an expansion pushes at most 8 entries
+    room = pool.shape[0] - 9  # an expansion pushes at most 8 entries, and the pending one
     cur = ints[_CUR]
     used = ints[_USED]
     free = ints[_FREE]
@@ -396,92 +460,141 @@ def _bucket_rounds(
     expanded = ints[_EXPANDED]
     g_goal = floats[_G_GOAL]
     bound = floats[_BOUND]  # g_goal x KEEP: what a path through an entry must beat
+    pending = -1  # a cell on top of the current bucket, kept out of the pool
     done = True
     while n_open > 0:
         if used > room:
             done = False
             break
-        b = cur & mask
-        while heads[b] == -1:
-            cur += 1
+        if pending != -1:
+            if cur * delta >= g_goal:
+                break  # every open entry has f >= g_goal
+            node = pending
+            pending = -1
+            n_open -= 1
+            nxt: int = _get(heads, cur & mask)  # type: ignore[call-arg]  # numba body, as for _load_g
+        else:
             b = cur & mask
-        if cur * delta >= g_goal:
-            break  # every open entry has f >= g_goal
-        slot = heads[b]
-        heads[b] = pnext[slot]
-        n_open -= 1
-        node = pn[slot]
-        gn = pg[slot]
-        pnext[slot] = free
-        free = slot
-        nxt = heads[b]  # likely the next pop: start loading its rows
-        if nxt != -1:
-            _prefetch_rows(g, flat, pn[nxt], cols)
-        if gn > _load_g(g, node):
-            continue  # stale entry
-        r = node // cols
+            while _get(heads, b) == -1:  # type: ignore[call-arg]
+                cur += 1
+                b = cur & mask
+            if cur * delta >= g_goal:
+                break  # every open entry has f >= g_goal
+            slot: int = _get(heads, b)  # type: ignore[call-arg]
+            entry = _get(pool, slot)  # type: ignore[call-arg]
+            nxt = entry >> 32
+            _put(heads, b, nxt)  # type: ignore[call-arg]
+            _put(pool, slot, np.int64(free) << 32)  # type: ignore[call-arg]
+            free = slot
+            n_open -= 1
+            node = entry & _LOW
+        if nxt != -1:  # likely the next pop: start loading its rows
+            _prefetch_rows(g, flat, _get(pool, nxt) & _LOW, cols)  # type: ignore[call-arg]
+        word = _get(g, node)  # type: ignore[call-arg]
+        if word & CLOSED:
+            continue  # expanded already with this g: a stale entry
+        gn = _bits_to_float(word ^ INF_BITS)  # type: ignore[call-arg]
+        # row and column without an integer division: the float quotient is off by at
+        # most one, and the remainder says which way
+        r = np.int64(node * inv_cols)
         c = node - r * cols
+        if c < 0:
+            r -= 1
+            c += cols
+        elif c >= cols:
+            r += 1
+            c -= cols
         if bound < inf and gn + _h(r, c, gr, gc, diagonal, hmin) >= bound:
             continue  # cannot lead to a cheaper path to the goal
+        _put(g, node, word | CLOSED)  # type: ignore[call-arg]
+        _mark(lo, hi, r, c)
         expanded += 1
-        # costs of the four side cells (inf outside the grid)
+        # the four side cells and their costs; outside the grid the cost is inf and the
+        # cell is the expanded one itself (inf never beats its g: nothing outside is read)
+        up = node - cols
+        down = node + cols
+        left = node - 1
+        right = node + 1
         if r == 0 or r == rows - 1 or c == 0 or c == cols - 1:
-            wu = flat[node - cols] if r > 0 else inf
-            wd = flat[node + cols] if r < rows - 1 else inf
-            wl = flat[node - 1] if c > 0 else inf
-            wr = flat[node + 1] if c < cols - 1 else inf
+            wu = wd = wl = wr = inf
+            if r > 0:
+                wu = _get(flat, up)  # type: ignore[call-arg]  # numba body, as for _load_g
+            else:
+                up = node
+            if r < rows - 1:
+                wd = _get(flat, down)  # type: ignore[call-arg]
+            else:
+                down = node
+            if c > 0:
+                wl = _get(flat, left)  # type: ignore[call-arg]
+            else:
+                left = node
+            if c < cols - 1:
+                wr = _get(flat, right)  # type: ignore[call-arg]
+            else:
+                right = node
         else:
-            wu = flat[node - cols]
-            wd = flat[node + cols]
-            wl = flat[node - 1]
-            wr = flat[node + 1]
+            wu = _get(flat, up)  # type: ignore[call-arg]
+            wd = _get(flat, down)  # type: ignore[call-arg]
+            wl = _get(flat, left)  # type: ignore[call-arg]
+            wr = _get(flat, right)  # type: ignore[call-arg]
         # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
         # allowed only when both side cells beside it are free
-        free, used, n_open, g_goal, bound = _relax(
-            0, node - cols, r - 1, c, gn + wu, g, parent, lo, hi, heads, pn, pg, pnext,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        free, used, n_open, g_goal, bound, pending = _relax(
+            0, up, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
-            1, node + cols, r + 1, c, gn + wd, g, parent, lo, hi, heads, pn, pg, pnext,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        free, used, n_open, g_goal, bound, pending = _relax(
+            1, down, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
-            2, node - 1, r, c - 1, gn + wl, g, parent, lo, hi, heads, pn, pg, pnext,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        free, used, n_open, g_goal, bound, pending = _relax(
+            2, left, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
-        free, used, n_open, g_goal, bound = _relax(
-            3, node + 1, r, c + 1, gn + wr, g, parent, lo, hi, heads, pn, pg, pnext,
-            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur, free, used, n_open, g_goal, bound,
+        free, used, n_open, g_goal, bound, pending = _relax(
+            3, right, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
+            goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
+            free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         if diagonal:
             if wu != inf and wl != inf:
-                free, used, n_open, g_goal, bound = _relax(
-                    4, node - cols - 1, r - 1, c - 1, gn + sqrt2 * flat[node - cols - 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                free, used, n_open, g_goal, bound, pending = _relax(
+                    4, node - cols - 1, r - 1, c - 1,
+                    gn + sqrt2 * _get(flat, node - cols - 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wu != inf and wr != inf:
-                free, used, n_open, g_goal, bound = _relax(
-                    5, node - cols + 1, r - 1, c + 1, gn + sqrt2 * flat[node - cols + 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                free, used, n_open, g_goal, bound, pending = _relax(
+                    5, node - cols + 1, r - 1, c + 1,
+                    gn + sqrt2 * _get(flat, node - cols + 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wd != inf and wl != inf:
-                free, used, n_open, g_goal, bound = _relax(
-                    6, node + cols - 1, r + 1, c - 1, gn + sqrt2 * flat[node + cols - 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                free, used, n_open, g_goal, bound, pending = _relax(
+                    6, node + cols - 1, r + 1, c - 1,
+                    gn + sqrt2 * _get(flat, node + cols - 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
             if wd != inf and wr != inf:
-                free, used, n_open, g_goal, bound = _relax(
-                    7, node + cols + 1, r + 1, c + 1, gn + sqrt2 * flat[node + cols + 1],
-                    g, parent, lo, hi, heads, pn, pg, pnext,
+                free, used, n_open, g_goal, bound, pending = _relax(
+                    7, node + cols + 1, r + 1, c + 1,
+                    gn + sqrt2 * _get(flat, node + cols + 1),  # type: ignore[call-arg]
+                    g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
-                    free, used, n_open, g_goal, bound,
+                    free, used, n_open, g_goal, bound, pending,
                 )  # fmt: skip
+    if pending != -1:  # back into the pool, on top of its bucket, for the next round
+        free, used = _push(heads, pool, cur & mask, pending, free, used)
     ints[_CUR] = cur
     ints[_USED] = used
     ints[_FREE] = free
@@ -519,31 +632,27 @@ def search_buckets(
 
     ``span`` must exceed the largest f increase along one move divided by ``delta``, plus 2.
     ``g``, ``parent``, ``lo`` and ``hi`` are a :class:`Scratch`'s arrays, ``g`` all zero on
-    entry; with ``zero`` the written part of ``g`` is zero again on return.
+    entry; with ``zero`` the written part of ``g`` is zero again on return (without, the
+    words it leaves may carry the :data:`CLOSED` bit).
     """
     cols = cost.shape[1]
     size = 1
     while size < span:  # a power of two: the bucket of a key is key & mask
         size *= 2
     heads = np.full(size, -1, np.int32)  # first pool slot of each bucket
-    pn = np.empty(4096, np.int32)
-    pg = np.empty(4096, np.float64)
-    pnext = np.empty(4096, np.int32)
+    pool = np.empty(4096, np.int64)
     _store_g(g, start, 0.0)
     _mark(lo, hi, start // cols, start % cols)
     h0 = _h(start // cols, start % cols, goal // cols, goal % cols, diagonal, hmin)
     cur = np.int64(math.floor(h0 * (1.0 / delta)))
-    pn[0] = start
-    pg[0] = 0.0
-    pnext[0] = -1
+    pool[0] = start | (np.int64(-1) << 32)
     heads[cur & (size - 1)] = 0
     ints = np.array([cur, 1, -1, 1, 0], np.int64)
     floats = np.array([np.inf, np.inf])
     flat = cost.ravel()
     while not _bucket_rounds(flat, cost.shape[0], cols, start, goal, diagonal, hmin, delta,
-                             size - 1, g, parent, lo, hi, heads, pn, pg, pnext, ints, floats):
-        used = ints[_USED]
-        pn, pg, pnext = _grown(pn, used), _grown(pg, used), _grown(pnext, used)
+                             size - 1, g, parent, lo, hi, heads, pool, ints, floats):
+        pool = _grown(pool, ints[_USED])
     _clean(g, lo, hi, cost.shape[0], cols, zero)
     return floats[_G_GOAL], ints[_EXPANDED]
 
@@ -626,8 +735,11 @@ def search_heap(
         expanded += 1
         r = node // cols
         c = node - r * cols
+        _mark(lo, hi, r, c)
         nmoves = _move_costs(flat, node, r, c, rows, cols, diagonal, off, w8)
         for k in range(nmoves):
+            if w8[k] == np.inf:
+                continue  # blocked, or outside the grid (not to be read)
             ng_ = g_top + w8[k] if k < 4 else g_top + sqrt2 * w8[k]
             nb = node + off[k]
             if not ng_ < _load_g(g, nb) * KEEP:
@@ -636,7 +748,6 @@ def search_heap(
             nc = c + DC[k]
             _store_g(g, nb, ng_)
             parent[nb] = k
-            _mark(lo, hi, nr, nc)
             nf_ = math.floor((ng_ + _h(nr, nc, gr, gc, diagonal, hmin)) * inv_q)
             if size == hf.shape[0]:
                 hf, hg, hn = _doubled(hf), _doubled(hg), _doubled(hn)
