@@ -84,6 +84,7 @@ class ShapeReader:
         self._mapped: dict[int, np.ndarray | None] = {}
         self._placements: dict[int, np.ndarray] = {}
         self._axes: dict[int, np.ndarray] = {}
+        self._angle: float | None = None
 
     def placement(self, placement: Any) -> np.ndarray:
         """The 4x4 matrix (file units) of an object placement, each placement of a chain
@@ -240,12 +241,22 @@ class ShapeReader:
             return found
         return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
 
+    @property
+    def angle_unit(self) -> float | None:
+        """Radians per plane-angle unit of the file (None without a model)."""
+        if self._angle is None and self.model is not None:
+            import ifcopenshell.util.unit
+
+            self._angle = float(ifcopenshell.util.unit.calculate_unit_scale(self.model,
+                                                                             "PLANEANGLEUNIT"))
+        return self._angle
+
     def _item_points(self, item: Any) -> np.ndarray | None:
         """Points of one representation item in its representation's frame (file units)."""
 
         item = _uncut(item)
         if item.is_a("IfcExtrudedAreaSolid"):
-            profile = _profile_points(item.SweptArea, self.axis)
+            profile = _profile_points(item.SweptArea, self.axis, self.angle_unit)
             if profile is None:
                 return None
             local = self.axis(item.Position) if item.Position is not None else np.eye(4)
@@ -410,9 +421,14 @@ def body_representation(element: Any) -> Any:
     return None
 
 
-def _profile_points(profile: Any, axis: Any = None) -> np.ndarray | None:
+def _profile_points(profile: Any, axis: Any = None,
+                    angle_unit: float | None = None) -> np.ndarray | None:
     """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise.
-    ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without)."""
+    ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without).
+    With ``angle_unit`` (radians per the file's plane-angle unit), an outline that is a
+    composite curve of polylines and circular arcs is read too, each arc as points of a
+    polygon that encloses it (:func:`_composite_points`): the points of an obstacle's
+    footprint, not an outline whose area counts."""
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
@@ -431,6 +447,11 @@ def _profile_points(profile: Any, axis: Any = None) -> np.ndarray | None:
             pts = np.array([p.Coordinates[:2] for p in curve.Points], dtype=float)
         elif curve.is_a("IfcIndexedPolyCurve") and curve.Segments is None:
             pts = np.array([c[:2] for c in curve.Points.CoordList], dtype=float)
+        elif curve.is_a("IfcCompositeCurve") and angle_unit is not None:
+            found = _composite_points(curve, angle_unit, axis)
+            if found is None:
+                return None
+            pts = found
         else:
             return None
         if len(pts) > 1 and np.allclose(pts[0], pts[-1]):
@@ -445,6 +466,48 @@ def _profile_points(profile: Any, axis: Any = None) -> np.ndarray | None:
              else np.asarray(placement.get_axis2placement(position), dtype=float))
         pts = pts @ m[:2, :2].T + m[:2, 3]
     return pts
+
+
+ARC_STEP = math.radians(5.0)
+"""Largest angle between two points read off a circular arc."""
+
+
+def _composite_points(curve: Any, angle_unit: float, axis: Any) -> np.ndarray | None:
+    """The points of a 2D composite curve of polylines and trimmed circles (the outlines of
+    Revit's stairs and rolled steel sections): each polyline's points, and for each arc points
+    at most :data:`ARC_STEP` apart on the circle enlarged by ``1 / cos(step / 2)``, so the
+    polygon through them encloses the arc. None for any other segment (a B-spline, an arc
+    trimmed by points, a basis curve that is not a circle)."""
+    chunks: list[np.ndarray] = []
+    for segment in curve.Segments:
+        parent = segment.ParentCurve
+        if parent.is_a("IfcPolyline"):
+            chunks.append(np.array([p.Coordinates[:2] for p in parent.Points], dtype=float))
+            continue
+        if not parent.is_a("IfcTrimmedCurve"):
+            return None
+        circle = parent.BasisCurve
+        if not circle.is_a("IfcCircle") or circle.Position is None:
+            return None
+        trims = []
+        for trim in (parent.Trim1, parent.Trim2):
+            values = [t.wrappedValue for t in trim if t.is_a("IfcParameterValue")]
+            if not values:
+                return None
+            trims.append(float(values[0]) * angle_unit)
+        t1, t2 = trims
+        # the arc runs from Trim1 to Trim2, counter-clockwise when the sense agrees
+        sweep = (t2 - t1) % (2 * math.pi) if parent.SenseAgreement else \
+            -((t1 - t2) % (2 * math.pi))
+        n = max(1, math.ceil(abs(sweep) / ARC_STEP))
+        angles = t1 + sweep * np.arange(n + 1) / n
+        radius = float(circle.Radius) / math.cos(abs(sweep) / n / 2)
+        local = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
+        m = axis(circle.Position)
+        chunks.append(local @ m[:2, :2].T + m[:2, 3])
+    if not chunks:
+        return None
+    return np.vstack(chunks)
 
 
 def _polygon_area(pts: np.ndarray) -> float:
