@@ -9,11 +9,11 @@ table 5.6), with the variances
 - ``trans``: ``alpha3 * trans^2 + alpha4 * (rot1^2 + rot2^2)``
 - ``rot2``: ``alpha1 * rot2^2 + alpha2 * trans^2``
 
-A fifth parameter, ``alpha5`` (0 gives AMCL's model exactly), adds a sideways slip from
-turning: each particle is also moved across its final heading by a normal draw of variance
-``alpha5 * (rot1^2 + rot2^2)``. A skid-steer base turning on the spot slides sideways about a
-pivot its wheels do not measure well, and more so with a load held out in front; the diff
-model alone spreads a turn's translation error only along the direction of travel.
+:func:`sample_motion_planar` is the "planar" model, the default of bt-manip's filter: the move
+taken apart into its forward, sideways and turning parts in the base's frame, each noisy. A
+skid-steer base turning on the spot slides sideways a few centimetres about a pivot its wheels
+do not measure well; the diff model reads that slide as a quarter turn towards it and back, and
+its noise, proportional to those turns, scatters the particles over a metre.
 
 As in AMCL, the turns that enter the variances are measured modulo a half turn, so that
 driving backwards does not count as two half turns, and ``rot1`` is taken as 0 for a move
@@ -62,13 +62,13 @@ def sample_motion(
     alphas: tuple[float, ...],
     rng: np.random.Generator,
 ) -> np.ndarray:
-    """``poses`` (n, 3) moved by a noisy copy each of the odometry move ``old`` -> ``new``;
-    ``alphas``: ``(alpha1, alpha2, alpha3, alpha4)`` or with ``alpha5`` after them.
+    """``poses`` (n, 3) moved by a noisy copy each of the odometry move ``old`` -> ``new``
+    (AMCL's diff model); ``alphas``: ``(alpha1, alpha2, alpha3, alpha4)``, any further value
+    unused.
 
     Returns a new array; yaw wrapped into [-pi, pi).
     """
     a1, a2, a3, a4 = alphas[:4]
-    a5 = alphas[4] if len(alphas) > 4 else 0.0
     rot1, trans, rot2 = odometry_delta(old, new)
     r1 = _turn_for_noise(rot1)
     r2 = _turn_for_noise(rot2)
@@ -85,12 +85,6 @@ def sample_motion(
     out[:, 0] = poses[:, 0] + trans_hat * np.cos(heading)
     out[:, 1] = poses[:, 1] + trans_hat * np.sin(heading)
     out[:, 2] = wrap(heading + rot2_hat)
-    if a5 > 0.0:
-        sd_side = math.sqrt(a5 * (r1 * r1 + r2 * r2))
-        if sd_side > 0.0:
-            side = sd_side * rng.standard_normal(n)
-            out[:, 0] -= side * np.sin(out[:, 2])
-            out[:, 1] += side * np.cos(out[:, 2])
     return out
 
 

@@ -73,9 +73,8 @@ class LocalizationOptions:
     alpha4: float = 0.2
     """Translation noise from rotation."""
     alpha5: float = 0.05
-    """Sideways slip from rotation (not in Nav2's diff model; 0 turns it off): the variance of
-    a move across the heading per squared radian turned (see
-    :mod:`bt_manip.localization.motion_model`)."""
+    """Sideways slip from rotation, of the planar model only: the variance of a move across
+    the heading per squared radian turned (see :mod:`bt_manip.localization.motion_model`)."""
 
     # -- likelihood-field sensor model ---------------------------------------------------------
     z_hit: float = 0.95

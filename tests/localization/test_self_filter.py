@@ -11,21 +11,7 @@ import pytest
 
 from bt_manip.localization.runtime import SELF_FILTER_PADDING, Localizer
 from bt_manip.sim.world import World
-from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D
-from tests.sensing.worlds import ROOM, write
-
-
-def _held_bar(world: World) -> None:
-    """A 0.6 m bar held across the fingers, level, low enough to cross the scan plane."""
-    robot = world.robots["husky"]
-    grasp, _ = robot.link_pose(robot.description.grasp_frame)
-    bar = BodySpec(name="bar", movable=True, parts=[Part("box", (0.03, 0.6, 0.5))],
-                   urdf=None, pose=Pose3D((grasp[0], grasp[1], grasp[2] - 0.3)),
-                   planar=False, mass=0.2, friction=0.8, colour=(1, 0, 0, 1),
-                   randomize=Range2D(), line=0)
-    world.spawn(bar)
-    assert world.attachments.attach("husky", "bar", max_distance=0.5).ok
-    world.step(24)
+from tests.sensing.worlds import ROOM, spawn_held, write
 
 
 @pytest.fixture()
@@ -39,7 +25,7 @@ def test_a_held_load_across_the_laser_is_left_out_and_the_walls_kept(holding: Wo
     loc = Localizer(holding, holding.robots["husky"], "husky", seed=0)
     before = loc.lidar.scan()
     own_before = loc._own_returns(before)
-    _held_bar(holding)
+    spawn_held(holding, "bar", (0.03, 0.6, 0.5))  # held level, across the scan plane
     scan = loc.lidar.scan()
     own = loc._own_returns(scan)
     bar = holding.body_id("bar")

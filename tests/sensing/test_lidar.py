@@ -15,7 +15,7 @@ from bt_manip.sensing.lidar import Lidar, Scan
 from bt_manip.sensing.sensors import LidarSpec
 from bt_manip.sim.world import World
 from bt_manip.sim.world_spec import BodySpec, Part, Pose3D, Range2D
-from tests.sensing.worlds import ROOM, write
+from tests.sensing.worlds import ROOM, spawn_held, write
 
 FRONT = LidarSpec("front", "top_plate_link", xyz=(0.45, 0.0, 0.104), fov_deg=180.0, beams=181,
                   range_m=10.0, noise_m=0.0)
@@ -201,16 +201,9 @@ def test_held_object_is_seen(tmp_path: Path) -> None:
     world = World(write(tmp_path, ROOM.replace("arm_state: tuck", "arm_state: home")))
     try:
         robot = world.robots["husky"]
-        grasp, _ = robot.link_pose(robot.description.grasp_frame)
         # a 0.5 m bar held upright between the fingers reaches down through the scan plane
-        bar = BodySpec(name="bar", movable=True, parts=[Part("box", (0.03, 0.03, 0.5))],
-                       urdf=None, pose=Pose3D((grasp[0], grasp[1], grasp[2] - 0.3)),
-                       planar=False, mass=0.2, friction=0.8, colour=(1, 0, 0, 1),
-                       randomize=Range2D(), line=0)
         lidar = Lidar(world, robot, FRONT)
-        world.spawn(bar)
-        assert world.attachments.attach("husky", "bar", max_distance=0.5).ok
-        world.step(24)
+        spawn_held(world, "bar", (0.03, 0.03, 0.5))
         bar_xy = np.asarray(world.body_pose("bar").xyz[:2])
         scan = lidar.scan()
         origin, heading = lidar.sensor_pose()
