@@ -71,14 +71,17 @@ class RobotServices:
 
     @property
     def navigator(self) -> Navigator:
-        """The robot's navigator, built on first use from the world's static obstacles.
+        """The robot's navigator, built on first use from the world's static obstacles (and,
+        when the robot localises, on its laser-fed costmap layers: movable objects are then
+        known where the laser has marked them, not from the world's geometry).
 
         Raises :class:`~bt_manip.navigation.grid.GridTooLarge` when the world is too large to
         be mapped.
         """
         if self._navigator is None:
+            layers = self.localizer.costmaps if self.localizer is not None else None
             self._navigator = Navigator(
-                self.robot, self.world.obstacle_body_ids(), self.world.movable
+                self.robot, self.world.obstacle_body_ids(), self.world.movable, layers=layers
             )
         return self._navigator
 
