@@ -57,9 +57,11 @@ class ObstacleLayerOptions:
 
 
 @numba.njit(cache=True)
-def _clear_rays(marked: np.ndarray, r0: int, c0: int, r1: np.ndarray, c1: np.ndarray) -> int:
+def _clear_rays(marked: np.ndarray, r0: int, c0: int, r1: np.ndarray, c1: np.ndarray,
+                out: np.ndarray) -> int:
     """Clear the cells on Bresenham's line from (r0, c0) to each (r1[k], c1[k]), both ends
-    included (cells outside the grid are skipped); the number of cells cleared."""
+    included (cells outside the grid are skipped); their flat indices are written to ``out``
+    (as many as it holds), and their number returned."""
     rows, cols = marked.shape
     cleared = 0
     for k in range(r1.shape[0]):
@@ -71,27 +73,25 @@ def _clear_rays(marked: np.ndarray, r0: int, c0: int, r1: np.ndarray, c1: np.nda
         sc = 1 if dc > 0 else -1
         r = r0
         c = c0
-        if ac >= ar:
-            err = ac // 2
-            for _ in range(ac + 1):
-                if 0 <= r < rows and 0 <= c < cols and marked[r, c]:
-                    marked[r, c] = False
-                    cleared += 1
-                err -= ar
+        major = max(ar, ac)
+        minor = min(ar, ac)
+        err = major // 2
+        for _ in range(major + 1):
+            if 0 <= r < rows and 0 <= c < cols and marked[r, c]:
+                marked[r, c] = False
+                if cleared < out.shape[0]:
+                    out[cleared] = r * cols + c
+                cleared += 1
+            err -= minor
+            if ac >= ar:
                 if err < 0:
                     r += sr
-                    err += ac
+                    err += major
                 c += sc
-        else:
-            err = ar // 2
-            for _ in range(ar + 1):
-                if 0 <= r < rows and 0 <= c < cols and marked[r, c]:
-                    marked[r, c] = False
-                    cleared += 1
-                err -= ac
+            else:
                 if err < 0:
                     c += sc
-                    err += ar
+                    err += major
                 r += sr
     return cleared
 
@@ -162,15 +162,20 @@ class ObstacleLayer:
         reach = np.minimum(r, o.raytrace_max_range)
         r0, c0 = self._cells(np.array([sx]), np.array([sy]))
         er, ec = self._cells(sx + reach * cos, sy + reach * sin)
-        changed = _clear_rays(self.marked, int(r0[0]), int(c0[0]), er, ec) > 0
+        # a cell a beam clears may be marked again by a return: what changed is what was
+        # cleared and not marked again, and what was marked anew
+        cells = max(1, int(np.abs(er - r0[0]).max(initial=0) + np.abs(ec - c0[0]).max(initial=0)))
+        out = np.empty(len(er) * (cells + 1), np.int64)
+        n = _clear_rays(self.marked, int(r0[0]), int(c0[0]), er, ec, out)
         near = (r < o.obstacle_max_range) & (r >= o.obstacle_min_range)
         mr, mc = self._cells(sx + r[near] * cos[near], sy + r[near] * sin[near])
         rows, cols = self.shape
         inside = (mr >= 0) & (mr < rows) & (mc >= 0) & (mc < cols)
         mr, mc = mr[inside], mc[inside]
-        if mr.size and not self.marked[mr, mc].all():
-            self.marked[mr, mc] = True
-            changed = True
+        cleared = out[:n]
+        was = self.marked[mr, mc] | np.isin(mr * cols + mc, cleared)
+        self.marked[mr, mc] = True
+        changed = bool((~was).any()) or (n > 0 and not self.marked.reshape(-1)[cleared].all())
         if changed:
             self.version += 1
         return changed
