@@ -17,7 +17,11 @@ tick, before the tree is ticked):
 - when the robot's costmaps are due (:class:`~bt_manip.navigation.layered.RobotCostmaps`: the
   global one at 1 Hz, the local one at 5 Hz), they are given the latest scan (the filter's, or
   one cast for them, whose noise is drawn from a generator of their own so that the filter's
-  draws stay as they were), laid in the map frame from the believed pose. Returns nearer than
+  draws stay as they were), laid in the map frame from the believed pose. While the base stands
+  still (its odometry moved less than :data:`STILL_M` and :data:`STILL_RAD`), a scan is cast
+  for them at most every :data:`STILL_RESCAN_S` (a deliberate saving: casting a scan is the
+  dearest part of an update, and a still robot sees the same world unless something moves in
+  it, which it then notices within that time). Returns nearer than
   :data:`MIN_RETURN_M` and returns off what the robot holds (its outline at the scan plane,
   padded by :data:`HELD_PAD_M`) are left out: the robot never marks itself or its load.
 
@@ -46,7 +50,7 @@ from bt_manip.localization.map_from_world import map_from_world, static_outlines
 from bt_manip.localization.options import LocalizationOptions
 from bt_manip.localization.surface import surface_field
 from bt_manip.navigation.grid import DEFAULT_RESOLUTION, GridTooLarge, OccupancyGrid, bodies_extent
-from bt_manip.navigation.layered import GLOBAL, RobotCostmaps
+from bt_manip.navigation.layered import RobotCostmaps
 from bt_manip.navigation.layers import inside_outlines
 from bt_manip.navigation.shapes import body_outlines
 from bt_manip.overlay import Overlay
@@ -102,6 +106,11 @@ MARKS_DRAWN = 1500
 MARK_COLOUR = (1.0, 0.55, 0.0, 1.0)
 HELD_PAD_M = 0.05
 """Returns within this distance (m) of the outline of what the robot holds mark nothing."""
+STILL_M = 0.01
+STILL_RAD = 0.01
+"""Odometry travel (m) and turn (rad) below which the base counts as standing still."""
+STILL_RESCAN_S = 1.0
+"""Sim seconds between the costmaps' own scans while the base stands still."""
 STATIC_MAP_PAD_M = 0.5
 """The costmaps cover the static obstacles' extent padded by this (m): the navigator's
 static grid (:func:`~bt_manip.navigation.grid.rasterise`'s default pad)."""
@@ -239,6 +248,10 @@ class Localizer:
         """The robot's global and local costmaps' obstacle layers, fed from the laser (None:
         the navigator keeps drawing movable objects from the world's geometry)."""
         self._costmap_rng = entity_rng(seed, f"costmap_lidar:{name}")
+        self._costmap_scan: tuple[float, Pose] | None = None
+        """Sim time and odometry pose of the costmaps' last scan."""
+        self._drawn_marks = 0
+        """The global obstacle layer's version last drawn on the overlay."""
         self._scan_height = height
 
     def _odom(self) -> Pose:
@@ -267,7 +280,13 @@ class Localizer:
             if self._moved_enough(odom):
                 self._scan_and_update(odom, now)
         if self.costmaps is not None and self.costmaps.due(now):
-            self._feed_costmaps(now)
+            last = self._costmap_scan
+            scanned = self.last_scan is not None and abs(self.last_scan.time - now) <= 1e-9
+            if scanned or last is None or now - last[0] >= STILL_RESCAN_S - 1e-9 or (
+                    math.hypot(odom.x - last[1][0], odom.y - last[1][1]) >= STILL_M
+                    or abs(wrap(odom.yaw - last[1][2])) >= STILL_RAD):
+                self._costmap_scan = (now, (odom.x, odom.y, odom.yaw))
+                self._feed_costmaps(now)
         self.errors.sample(now, self.pose(), self.robot.base_pose2d())
 
     def _feed_costmaps(self, now: float) -> None:
@@ -292,9 +311,10 @@ class Localizer:
                 returned &= ~inside_outlines(pts, outlines, HELD_PAD_M)
         pose = self.pose()
         sensor = compose(pose, scan.sensor_pose)
-        changed = self.costmaps.take(now, (pose[0], pose[1]), sensor, scan.angles, scan.ranges,
-                                     returned)
-        if GLOBAL in changed and self.overlay is not None:
+        self.costmaps.take(now, (pose[0], pose[1]), sensor, scan.angles, scan.ranges, returned)
+        version = self.costmaps.global_layer.version
+        if version != self._drawn_marks and self.overlay is not None:
+            self._drawn_marks = version  # marked, cleared by a scan or by a clear node
             self.draw_marks(self.overlay)
 
     def draw_marks(self, overlay: Overlay) -> None:

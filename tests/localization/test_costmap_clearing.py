@@ -16,6 +16,7 @@ cleared by ray tracing: they are stale, and they close the only way out.
 
 from __future__ import annotations
 
+import itertools
 import math
 from pathlib import Path
 from typing import Any
@@ -23,9 +24,11 @@ from typing import Any
 import pytest
 
 from bt_manip.episode import Episode, EpisodeSpec
+from bt_manip.localization.runtime import MARKS_DRAWN
 from bt_manip.navigation.layered import GLOBAL
 from bt_manip.run.runner import RunOptions
 from bt_manip.run.status import RunStatus
+from bt_manip.viz.recorder import Recorder
 
 WORLD = """name: doorway_room
 walls:
@@ -119,8 +122,14 @@ def run(tmp_path: Path, recovery: str) -> tuple[Any, dict[str, Any], tuple[float
             return fail(code, reason)
 
         follow.fail = first_failure_takes_the_crate_away  # type: ignore[method-assign]
-        report = episode.run()
+        recorder = Recorder(tmp_path / "replay.html", world_, episode.tree)
+        report = episode.run(hooks=[recorder])
         seen["stale"] = marks_near(loc.costmaps.layer(GLOBAL), *CRATE)
+        # the replay holds the global costmap's marks over time, as the overlay drew them
+        seen["drawn"] = [
+            len(obj["geometries"][0]["data"]["attributes"]["position"]["array"]) // 3
+            for _, name, obj, _ in recorder.rec.overlay_events
+            if name == "husky_costmap_marks" and obj is not None]
         pose = world_.robots["husky"].base_pose2d()
     return report, seen, pose
 
@@ -139,6 +148,10 @@ def test_a_stale_mark_blocks_the_doorway_until_the_costmaps_are_cleared(
         assert report.costmap is not None
         assert report.costmap["global_clears"] >= 1 and report.costmap["local_clears"] >= 1
         assert seen["stale"] == 0
+        # drawn as they grew, and again once cleared (the walls seen since, the crate gone)
+        drawn = seen["drawn"]
+        assert len(drawn) >= 3 and max(drawn) <= MARKS_DRAWN
+        assert any(b < a for a, b in itertools.pairwise(drawn))
     else:
         assert report.status is RunStatus.FAILURE and not at_goal
         assert "no path" in report.reason or "footprint" in report.reason
