@@ -67,24 +67,54 @@ class RollingWindow:
         r1 = min(rows, math.ceil((y + self.options.height / 2 - layer.origin[1]) / res))
         return slice(r0, max(r0, r1)), slice(c0, max(c0, c1))
 
-    def move_to(self, x: float, y: float) -> None:
-        """Centre the window on (x, y) and forget the marks outside it."""
+    def move_to(self, x: float, y: float, reach: float = 0.0) -> None:
+        """Centre the window on (x, y) and forget the marks outside it.
+
+        Marks lie only in the window after each move, and a scan marks only within ``reach``
+        (m) of (x, y): the cells looked at are those of the old window, the new one and that
+        reach (the whole grid the first time), not the whole grid."""
+        old = self.bounds()
         self.centre = (float(x), float(y))
         window = self.bounds()
         assert window is not None
-        marked = self.layer.marked
-        outside = np.ones(marked.shape, bool)
-        outside[window] = False
-        self.layer.clear(outside)
+        layer = self.layer
+        rows, cols = layer.shape
+        if old is None:
+            around = (slice(0, rows), slice(0, cols))
+        else:
+            res = layer.resolution
+            r0 = math.floor((y - reach - layer.origin[1]) / res)
+            r1 = math.ceil((y + reach - layer.origin[1]) / res) + 1
+            c0 = math.floor((x - reach - layer.origin[0]) / res)
+            c1 = math.ceil((x + reach - layer.origin[0]) / res) + 1
+            r0 = max(0, min(r0, old[0].start, window[0].start))
+            r1 = min(rows, max(r1, old[0].stop, window[0].stop))
+            c0 = max(0, min(c0, old[1].start, window[1].start))
+            c1 = min(cols, max(c1, old[1].stop, window[1].stop))
+            around = (slice(r0, max(r0, r1)), slice(c0, max(c0, c1)))
+        sub = layer.marked[around]
+        if not sub.any():
+            return
+        keep = np.zeros(sub.shape, bool)
+        keep[window[0].start - around[0].start:window[0].stop - around[0].start,
+             window[1].start - around[1].start:window[1].stop - around[1].start] = True
+        drop = sub & ~keep
+        if drop.any():
+            sub[drop] = False  # a view of the layer's grid
+            layer.version += 1
 
     def update(self, robot_xy: tuple[float, float], sensor: tuple[float, float, float],
                angles: np.ndarray, ranges: np.ndarray, returned: np.ndarray) -> bool:
         """Roll the window to the robot, then take the scan (see
-        :meth:`ObstacleLayer.update`); True when the marks changed."""
+        :meth:`ObstacleLayer.update`); True when marks were made or forgotten (the layer's
+        ``version`` moved)."""
         before = self.layer.version
         self.move_to(*robot_xy)
         self.layer.update(sensor, angles, ranges, returned)
-        self.move_to(*robot_xy)  # returns beyond the window's edge are not kept
+        # returns beyond the window's edge are not kept
+        reach = math.hypot(sensor[0] - robot_xy[0], sensor[1] - robot_xy[1]) + (
+            self.layer.options.obstacle_max_range + 2 * self.layer.resolution)
+        self.move_to(*robot_xy, reach=reach)
         return self.layer.version != before
 
     def first_blocked(self, points: np.ndarray, reach: float) -> int | None:

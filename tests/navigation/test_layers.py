@@ -115,6 +115,10 @@ def test_the_rolling_window_forgets_what_it_left_behind() -> None:
     assert window.first_blocked(path[:1], 0.6) is None
     window.move_to(6.0, 5.0)  # the face at x = 3.0 is 3 m behind: outside a 5 m window
     assert window.layer.count == 0
+    # a 2 m window keeps none of a face 2 m ahead: its returns fall beyond the window's edge
+    small = RollingWindow.like(ObstacleLayer.like(GRID), RollingWindowOptions(width=2.0))
+    small.update((1.0, 5.025), (1.0, 5.025, 0.0), ANGLES, ranges, ranges < RANGE_MAX)
+    assert small.layer.count == 0
 
 
 def test_the_clear_services_act_on_the_costmap_they_name() -> None:
