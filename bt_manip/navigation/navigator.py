@@ -27,9 +27,15 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
 
 With costmap layers (``layers``: the robot's
 :class:`~bt_manip.navigation.layered.RobotCostmaps`, given when the run localises), the movable
-objects are not drawn from the world's geometry at all: the map the planners read is the static
-grid with the global costmap's laser marks drawn in (:func:`bt_manip.navigation.layers.compose`),
-inflated; the carrying robot's chassis slab gets the marks too (a mark says something stands at
+objects are not drawn from the world's geometry as they move: the map the planners read is the
+static grid with the global costmap's laser marks drawn in
+(:func:`bt_manip.navigation.layers.compose`), inflated. The objects the robot was told of
+(``known``: the world file's objects, as a site plan gives them) are drawn once, where they
+stand when the navigator is built, and stay there in its map (a prior map: moving them later
+does not move them there) until the robot picks one up; that is how an object the laser cannot
+see (lower than its scan plane, as Scenario A's panel on its stand) is still planned round.
+Objects that appear during the run (a dropped crate, a spawned model) are known only from the
+laser; the carrying robot's chassis slab gets the marks too (a mark says something stands at
 the laser's height, which the chassis reaches; whether it reaches the load, a planar laser cannot
 tell). The bare robot's blocked-path check reads the local costmap (the rolling window): the
 path ahead is blocked when it passes within the footprint's half width of a local mark, and the
@@ -136,6 +142,8 @@ class Navigator:
         movable: body ids (or name -> id) of objects that may move; redrawn on refresh.
         layers: the robot's laser-fed costmaps; with them the movable objects are not drawn,
             the global costmap's marks are (see the module docstring).
+        known: with ``layers``, the movable objects the robot was told of, drawn where they
+            stand now until it picks one up.
     """
 
     def __init__(
@@ -145,11 +153,13 @@ class Navigator:
         movable: Mapping[str, int] | Sequence[int] = (),
         options: NavigatorOptions = NavigatorOptions(),
         layers: RobotCostmaps | None = None,
+        known: Sequence[int] = (),
     ) -> None:
         self.robot = robot
         self.layers = layers
-        self._layers_version = -1
-        """The global obstacle layer's version drawn on :attr:`costmap`."""
+        self._layers_drawn: tuple[int, frozenset[int]] | None = None
+        """The global obstacle layer's version and the known objects drawn on
+        :attr:`costmap`."""
         self.client = robot.client
         self.options = options
         self._follower_options: FollowerOptions = options.follower
@@ -167,6 +177,15 @@ class Navigator:
             band=self.band,
             remember=False,
         )
+        self.known: dict[int, np.ndarray] = {}
+        """With layers: per object the robot was told of and has not picked up, the flat
+        indices of its cells when the navigator was built."""
+        if layers is not None:
+            for body in known:
+                parts = [self.static.cells_of(o) for o in body_outlines(self.client, body,
+                                                                        self.band)]
+                if parts:
+                    self.known[body] = np.unique(np.concatenate(parts))
         self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.footprint = self.base_footprint
         self.attached: dict[int, str] = {}
@@ -208,8 +227,17 @@ class Navigator:
         copy, when there are none: it is never drawn on). With costmap layers, the static grid
         with the global costmap's marks."""
         if self.layers is not None:
-            self._layers_version = self.layers.global_layer.version
-            return compose(self.static, self.layers.global_layer)
+            self._layers_drawn = self._layers_key()
+            grid = compose(self.static, self.layers.global_layer)
+            if not self.known:
+                return grid
+            if grid is self.static:
+                grid = OccupancyGrid(grid.origin, grid.resolution, grid.occupied.copy(),
+                                     grid.band)
+            flat = grid.occupied.reshape(-1)
+            for idx in self.known.values():
+                flat[idx] = True
+            return grid
         if cells is None:
             cells = self._movable_cells()
         if not cells:
@@ -226,7 +254,7 @@ class Navigator:
         """Redraw the movable objects (with costmap layers: the global costmap's marks); True if
         the occupied cells changed."""
         if self.layers is not None:
-            if self.layers.global_layer.version == self._layers_version:
+            if self._layers_key() == self._layers_drawn:
                 return False
             old_occupied = self.costmap.grid.occupied
             grid = self._compose()
@@ -245,6 +273,10 @@ class Navigator:
             return False
         self.costmap = self.costmap.with_grid(grid)
         return True
+
+    def _layers_key(self) -> tuple[int, frozenset[int]]:
+        assert self.layers is not None
+        return (self.layers.global_layer.version, frozenset(self.known))
 
     @property
     def planning_footprint(self) -> PlanarFootprint:
@@ -268,6 +300,7 @@ class Navigator:
         """
         label = name or self.movable.get(body, f"body {body}")
         self.attached[body] = label
+        self.known.pop(body, None)  # it has been taken from where the map had it
         self.footprint = self.footprint.with_body(self.robot, body, label, band=self.band)
         self.refresh()
         self._build_carry_layers()
@@ -326,6 +359,10 @@ class Navigator:
             marks = self.layers.global_layer.marked
             r, k = min(low.shape[0], marks.shape[0]), min(low.shape[1], marks.shape[1])
             low.occupied[:r, :k] |= marks[:r, :k]
+            if low.shape == self.static.shape:
+                flat = low.occupied.reshape(-1)
+                for idx in self.known.values():
+                    flat[idx] = True
         high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
         self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
         self._carry_high = high

@@ -1,8 +1,9 @@
 """A stale mark and Nav2's clearing recovery, in a small room whose only way out is a doorway
 onto open ground.
 
-A crate stands in the doorway, absent from the map (only two posts stand outside, well off the
-line of sight through the doorway). The Husky, localising, plans straight
+A crate stands in the doorway, absent from the map: it is not one of the world file's objects
+(which the robot is told of) but put there as the run starts. Only two posts stand outside,
+well off the line of sight through the doorway. The Husky, localising, plans straight
 through it (it has not seen it), marks it once its laser comes within ``obstacle_max_range``,
 and FollowPath stops for it (106). At that first failure the crate is taken away. Nothing
 stands behind the doorway, so no beam ends beyond the crate's place and its marks are never
@@ -21,13 +22,17 @@ import math
 from pathlib import Path
 from typing import Any
 
+import pybullet as pb
 import pytest
 
 from bt_manip.episode import Episode, EpisodeSpec
-from bt_manip.localization.runtime import MARKS_DRAWN
-from bt_manip.navigation.layered import GLOBAL
+from bt_manip.localization.runtime import MARKS_DRAWN, static_frame
+from bt_manip.navigation.layered import GLOBAL, RobotCostmaps
+from bt_manip.navigation.navigator import Navigator
 from bt_manip.run.runner import RunOptions
 from bt_manip.run.status import RunStatus
+from bt_manip.sim.world import World
+from bt_manip.sim.world_spec import COLOURS, BodySpec, Part, Pose3D, Range2D
 from bt_manip.viz.recorder import Recorder
 
 WORLD = """name: doorway_room
@@ -51,9 +56,6 @@ furniture:
      colour: grey}
   - {name: post_south, shape: cylinder, radius: 0.15, height: 1.0, pose: [3.5, -1.5, 0.0],
      colour: grey}
-objects:
-  - {name: crate, shape: box, size: [0.3, 0.3, 0.3], mass: 8.0, friction: 0.9,
-     colour: brown, pose: [2.0, 0.0, 0.15]}
 robots:
   - name: husky
     description: husky_ur3
@@ -107,6 +109,10 @@ def run(tmp_path: Path, recovery: str) -> tuple[Any, dict[str, Any], tuple[float
         world_ = episode.world
         loc = episode.localization.localizers["husky"]
         assert loc.costmaps is not None
+        world_.spawn(BodySpec(
+            name="crate", movable=True, parts=[Part("box", (0.3, 0.3, 0.3))], urdf=None,
+            pose=Pose3D((CRATE[0], CRATE[1], 0.15)), planar=False, mass=8.0, friction=0.9,
+            colour=COLOURS["brown"], randomize=Range2D(), line=0))
         episode.localization()  # the first scan, as before the first tick
         seen["at_start"] = marks_near(loc.costmaps.layer(GLOBAL), *CRATE)
         follow = next(n for n in episode.tree.root.iterate() if type(n).__name__ == "FollowPath")
@@ -157,3 +163,46 @@ def test_a_stale_mark_blocks_the_doorway_until_the_costmaps_are_cleared(
         assert "no path" in report.reason or "footprint" in report.reason
         assert seen["stale"] > 0  # no beam saw through the doorway: the mark stayed
         assert pose[0] < CRATE[0] - 0.5
+
+
+def test_the_navigator_knows_the_world_files_objects_and_only_sees_the_rest(
+        tmp_path: Path) -> None:
+    world_file = tmp_path / "room.yaml"
+    world_file.write_text(WORLD.replace("robots:", (
+        "objects:\n"
+        "  - {name: panel, shape: box, size: [0.6, 0.1, 0.15], mass: 1.0, friction: 0.9,\n"
+        "     colour: white, pose: [0.0, 1.0, 0.075]}\nrobots:")))
+    with World(world_file, seed=0) as world:
+        crate = world.spawn(BodySpec(
+            name="crate", movable=True, parts=[Part("box", (0.3, 0.3, 0.3))], urdf=None,
+            pose=Pose3D((1.0, -1.0, 0.15)), planar=False, mass=8.0, friction=0.9,
+            colour=COLOURS["brown"], randomize=Range2D(), line=0))
+        panel = world.body_id("panel")
+        frame = static_frame(world)
+        assert frame is not None
+        robot = world.robots["husky"]
+        nav = Navigator(robot, world.obstacle_body_ids(), world.movable,
+                        layers=RobotCostmaps(frame), known=[panel])
+        grid = nav.costmap.grid
+
+        def occupied(x: float, y: float) -> bool:
+            return bool(grid.occupied[grid.world_to_cell(x, y)])
+
+        assert occupied(0.0, 1.0)  # told of: on the map from the start
+        assert not occupied(1.0, -1.0)  # the crate: not seen yet, not drawn
+        # the panel moves: the map keeps it where it was (no truth drawn)
+        pb.resetBasePositionAndOrientation(panel, (0.0, -0.5, 0.075), (0, 0, 0, 1),
+                                           physicsClientId=world.client)
+        pb.resetBasePositionAndOrientation(crate, (-1.0, 1.0, 0.15), (0, 0, 0, 1),
+                                           physicsClientId=world.client)
+        assert not nav.refresh()
+        grid = nav.costmap.grid
+        assert occupied(0.0, 1.0) and not occupied(0.0, -0.5)
+        # picked up: gone from where the map had it
+        nav.attach(panel, "panel")
+        grid = nav.costmap.grid
+        assert not occupied(0.0, 1.0)
+        # without layers (no localisation), today's map: every movable object where it is
+        plain = Navigator(robot, world.obstacle_body_ids(), world.movable)
+        grid = plain.costmap.grid
+        assert occupied(0.0, -0.5) and occupied(-1.0, 1.0) and not occupied(0.0, 1.0)
