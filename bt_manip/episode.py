@@ -137,6 +137,7 @@ class Episode:
             report.extra["injected"] = self.faults.report()
         if self.localization is not None:
             report.localization = self.localization.report()
+            report.costmap = self.localization.costmap_report()
         planning = self.context.arm_planning()
         if planning:  # wall time: in the report, never on the blackboard
             report.extra["arm_planning"] = planning

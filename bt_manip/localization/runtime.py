@@ -13,7 +13,17 @@ tick, before the tree is ticked):
 - when the filter took a scan, ``map -> odom`` is set from its estimate, so that the pose the
   robot believes it has between two filter updates is ``map -> odom`` composed with the
   current odometry (what AMCL publishes through tf);
-- the error of that belief against the true base pose is sampled (:class:`ErrorLog`).
+- the error of that belief against the true base pose is sampled (:class:`ErrorLog`);
+- when the robot's costmaps are due (:class:`~bt_manip.navigation.layered.RobotCostmaps`: the
+  global one at 1 Hz, the local one at 5 Hz), they are given the latest scan (the filter's, or
+  one cast for them, whose noise is drawn from a generator of their own so that the filter's
+  draws stay as they were), laid in the map frame from the believed pose. While the base stands
+  still (its odometry moved less than :data:`STILL_M` and :data:`STILL_RAD`), a scan is cast
+  for them at most every :data:`STILL_RESCAN_S` (a deliberate saving: casting a scan is the
+  dearest part of an update, and a still robot sees the same world unless something moves in
+  it, which it then notices within that time). The self filter's returns (the robot itself and
+  what it holds, :meth:`Localizer._own_returns`) are left out: the robot never marks itself or
+  its load.
 
 Every random draw comes from generators seeded by the episode seed and the robot's name
 (:func:`bt_manip.sim.randomize.entity_rng`): the same seed gives the same run. Nothing here is
@@ -39,6 +49,8 @@ from bt_manip.localization.kidnap import kidnap
 from bt_manip.localization.map_from_world import map_from_world, static_outlines
 from bt_manip.localization.options import LocalizationOptions
 from bt_manip.localization.surface import surface_field
+from bt_manip.navigation.grid import DEFAULT_RESOLUTION, GridTooLarge, OccupancyGrid, bodies_extent
+from bt_manip.navigation.layered import RobotCostmaps
 from bt_manip.overlay import Overlay
 from bt_manip.run.faults import (
     KIDNAP,
@@ -90,6 +102,30 @@ SCAN_COLOUR = (0.9, 0.1, 0.1, 1.0)
 PARTICLE_COLOUR = (0.2, 0.35, 0.95, 1.0)
 ERROR_THRESHOLD_M = 0.2
 """The report counts the sim seconds the position error spends above this (m)."""
+MARKS_DRAWN = 1500
+"""Most marks of the global costmap's obstacle layer drawn on the overlay (every k-th)."""
+MARK_COLOUR = (1.0, 0.55, 0.0, 1.0)
+STILL_M = 0.01
+STILL_RAD = 0.01
+"""Odometry travel (m) and turn (rad) below which the base counts as standing still."""
+STILL_RESCAN_S = 1.0
+"""Sim seconds between the costmaps' own scans while the base stands still."""
+STATIC_MAP_PAD_M = 0.5
+"""The costmaps cover the static obstacles' extent padded by this (m): the navigator's
+static grid (:func:`~bt_manip.navigation.grid.rasterise`'s default pad)."""
+
+
+def static_frame(world: World) -> OccupancyGrid | None:
+    """An empty grid in the frame of the navigators' static grid (None when the world is too
+    large to map: navigation then fails with the reason)."""
+    obstacles = world.obstacle_body_ids()
+    if not obstacles:
+        return None
+    try:
+        return OccupancyGrid.empty(bodies_extent(world.client, obstacles, STATIC_MAP_PAD_M),
+                                   DEFAULT_RESOLUTION)
+    except GridTooLarge:
+        return None
 
 
 def options_of(settings: LocalizationSpec) -> LocalizationOptions:
@@ -205,6 +241,16 @@ class Localizer:
         self.overlay: Overlay | None = None
         """Where the scan, the particles and the estimate are drawn after each filter update
         (the run's overlay, which the viewer and the replay read); None draws nothing."""
+        frame = static_frame(world)
+        self.costmaps: RobotCostmaps | None = (
+            RobotCostmaps(frame, start=world.time) if frame is not None else None)
+        """The robot's global and local costmaps' obstacle layers, fed from the laser (None:
+        the navigator keeps drawing movable objects from the world's geometry)."""
+        self._costmap_rng = entity_rng(seed, f"costmap_lidar:{name}")
+        self._costmap_scan: tuple[float, Pose] | None = None
+        """Sim time and odometry pose of the costmaps' last scan."""
+        self._drawn_marks = 0
+        """The global obstacle layer's version last drawn on the overlay."""
 
     def _odom(self) -> Pose:
         o = self.odometry.reading()
@@ -231,7 +277,39 @@ class Localizer:
                 self.next_scan += period
             if self._moved_enough(odom):
                 self._scan_and_update(odom, now)
+        if self.costmaps is not None and self.costmaps.due(now):
+            last = self._costmap_scan
+            scanned = self.last_scan is not None and abs(self.last_scan.time - now) <= 1e-9
+            if scanned or last is None or now - last[0] >= STILL_RESCAN_S - 1e-9 or (
+                    math.hypot(odom.x - last[1][0], odom.y - last[1][1]) >= STILL_M
+                    or abs(wrap(odom.yaw - last[1][2])) >= STILL_RAD):
+                self._costmap_scan = (now, (odom.x, odom.y, odom.yaw))
+                self._feed_costmaps(now)
         self.errors.sample(now, self.pose(), self.robot.base_pose2d())
+
+    def _feed_costmaps(self, now: float) -> None:
+        """Give the costmaps due now the latest scan (see the module docstring)."""
+        assert self.costmaps is not None
+        scan = self.last_scan
+        if scan is None or abs(scan.time - now) > 1e-9:
+            scan = self.lidar.scan(self.faults.lidar_dropout, rng=self._costmap_rng)
+        returned = ~scan.no_return & ~self._own_returns(scan)
+        pose = self.pose()
+        sensor = compose(pose, scan.sensor_pose)
+        self.costmaps.take(now, (pose[0], pose[1]), sensor, scan.angles, scan.ranges, returned)
+        version = self.costmaps.global_layer.version
+        if version != self._drawn_marks and self.overlay is not None:
+            self._drawn_marks = version  # marked, cleared by a scan or by a clear node
+            self.draw_marks(self.overlay)
+
+    def draw_marks(self, overlay: Overlay) -> None:
+        """Draw the global costmap's marks on ``overlay`` (orange, just above the floor; at most
+        :data:`MARKS_DRAWN` of them, every k-th)."""
+        assert self.costmaps is not None
+        pts = self.costmaps.global_layer.points()
+        step = max(1, -(-len(pts) // MARKS_DRAWN))
+        overlay.show_points(f"{self.name}_costmap_marks", pts[::step], z=0.02, rgba=MARK_COLOUR,
+                            size=0.05)
 
     def _moved_enough(self, odom: Odometry) -> bool:
         """Whether the filter would take a scan now: none taken since its start, or the
@@ -338,6 +416,12 @@ class RunLocalization:
         in every shipped world)."""
         first = next(iter(self.localizers.values()))
         return first.errors.summary()
+
+    def costmap_report(self) -> dict[str, int] | None:
+        """The report's ``costmap`` object: the first robot's costmaps
+        (:meth:`~bt_manip.navigation.layered.RobotCostmaps.report`); None without them."""
+        first = next(iter(self.localizers.values()))
+        return first.costmaps.report() if first.costmaps is not None else None
 
 
 class KidnapAt:

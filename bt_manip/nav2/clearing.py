@@ -5,8 +5,16 @@ The robot's map is its static grid (walls, furniture) with the movable objects d
 they were last seen. Clearing forgets the drawn objects (all of them, those within a square
 round the robot, or those outside it); the next plan draws them again where they are now.
 bt-manip keeps one map per robot, so the local and global costmaps a tree names
-(``service_name``) are the same map. Each node answers SUCCESS at once (FAILURE only without a
-world or a mobile base).
+(``service_name``) are the same map.
+
+When the run localises, the robot has Nav2's two costmaps, fed by its laser
+(:mod:`bt_manip.navigation.layered`), and the nodes act as Nav2's do: on the costmap their
+``service_name`` names (``local_costmap/clear_entirely_local_costmap``: the local one only;
+``.../clear_entirely_global_costmap``: the global one only; a name with neither word: both),
+forgetting the laser's marks of its obstacle layer (all of them, those within the square round
+the robot's believed position, or those outside it). The static layer (walls, furniture) is
+never cleared. Each node answers SUCCESS at once (FAILURE only without a world or a mobile
+base).
 """
 
 from __future__ import annotations
@@ -75,12 +83,18 @@ class _Clear(Nav2Action):
 
 @registry.register
 class ClearEntireCostmap(_Clear):
-    """Forgets every object drawn on the robot's map. SUCCESS."""
+    """Forgets every object drawn on the robot's map (when localising: every laser mark of the
+    costmap ``service_name`` names). SUCCESS."""
 
     INPUT_PORTS: dict[str, PortInformation] = SERVICE_PORTS
 
     def begin(self) -> None:
-        clear_map(synced_navigator(self, self.base()))
+        nav = synced_navigator(self, self.base())
+        if nav.layers is not None:
+            nav.layers.clear(str(self.get_input("service_name") or ""))
+            nav.refresh()
+            return
+        clear_map(nav)
 
 
 def _square_ports(what: str) -> dict[str, PortInformation]:
@@ -102,22 +116,31 @@ class _ClearSquare(_Clear):
         robot = self.base()
         nav = synced_navigator(self, robot)
         x, y, _ = self.believed_pose(robot)
-        square = square_round(nav, x, y, float(self.get_input("reset_distance")))
+        half = float(self.get_input("reset_distance"))
+        if nav.layers is not None:
+            square = nav.layers.global_layer.square(x, y, half)
+            nav.layers.clear(str(self.get_input("service_name") or ""),
+                             square if self.INSIDE else ~square)
+            nav.refresh()
+            return
+        square = square_round(nav, x, y, half)
         clear_map(nav, keep=~square if self.INSIDE else square)
 
 
 @registry.register
 class ClearCostmapAroundRobot(_ClearSquare):
-    """Forgets the objects drawn within ``reset_distance`` (half the side of a square) of the
-    robot. SUCCESS."""
+    """Forgets the objects drawn (when localising: the laser marks of the costmap
+    ``service_name`` names) within ``reset_distance`` (half the side of a square) of the robot.
+    SUCCESS."""
 
     INPUT_PORTS: dict[str, PortInformation] = _square_ports("clear")
 
 
 @registry.register
 class ClearCostmapExceptRegion(_ClearSquare):
-    """Forgets the objects drawn farther than ``reset_distance`` (half the side of a square)
-    from the robot, keeping those near it. SUCCESS."""
+    """Forgets the objects drawn (when localising: the laser marks of the costmap
+    ``service_name`` names) farther than ``reset_distance`` (half the side of a square) from
+    the robot, keeping those near it. SUCCESS."""
 
     INSIDE = False
     INPUT_PORTS: dict[str, PortInformation] = _square_ports("keep")

@@ -8,6 +8,10 @@ redraws the movable objects where they are now and looks at the next :data:`LOOK
 path; a movable object closer to that stretch than the robot's half width blocks it. Only
 movable objects count: the path was planned clear of the walls and furniture, and an object
 that was there when it was planned was planned round.
+
+When the run localises, the robot knows of no movable object: the check reads its local
+costmap instead (:mod:`bt_manip.navigation.rolling_window`), and a laser mark within the
+robot's half width of the stretch blocks it (named "an obstacle in the local costmap").
 """
 
 from __future__ import annotations
@@ -21,6 +25,8 @@ from bt_manip.navigation.navigator import Navigator
 LOOKAHEAD = 0.8
 """Metres of path in front of the robot that FollowPath checks: a second of driving at the path
 follower's top speed (Nav2's Regulated Pure Pursuit looks a second ahead by default)."""
+LOCAL_MARK = "an obstacle in the local costmap"
+"""What a laser mark on the path ahead is called (costmap layers know no object's name)."""
 CHECK_PERIOD = 0.2
 """Sim seconds between two checks (Nav2's local costmap is updated at 5 Hz by default)."""
 
@@ -51,9 +57,15 @@ def blocked_ahead(nav: Navigator, points: np.ndarray, position: tuple[float, flo
                   lookahead: float = LOOKAHEAD) -> Blocked | None:
     """The nearest movable object (not carried, not in ``ignore``) that lies within the robot's
     half width of the next ``lookahead`` m of the path ``points`` (the robot's turning point
-    along it, from ``position``); None when the stretch is clear. Redraws the robot's map."""
+    along it, from ``position``); None when the stretch is clear. Redraws the robot's map.
+    With costmap layers, the nearest laser mark of the local costmap instead."""
     nav.refresh()
     grid = nav.costmap.grid
+    if nav.layers is not None:
+        ahead, s = stretch_ahead(points, position, lookahead)
+        reach = nav.footprint.half_width + grid.resolution / np.sqrt(2.0)
+        k = nav.layers.local.first_blocked(ahead, reach)
+        return None if k is None else Blocked(LOCAL_MARK, float(s[k]))
     if not grid.sources:
         return None
     ahead, s = stretch_ahead(points, position, lookahead)

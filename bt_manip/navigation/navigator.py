@@ -25,6 +25,22 @@ and stops when ``status.state`` is SUCCEEDED or FAILED (``status.reason`` says w
   ends off its pose, the same search plans the rest of the way again from where the robot
   stands (moved objects are not watched for in this mode).
 
+With costmap layers (``layers``: the robot's
+:class:`~bt_manip.navigation.layered.RobotCostmaps`, given when the run localises), the movable
+objects are not drawn from the world's geometry as they move: the map the planners read is the
+static grid with the global costmap's laser marks drawn in
+(:func:`bt_manip.navigation.layers.compose`), inflated. The objects the robot was told of
+(``known``: the world file's objects, as a site plan gives them) are drawn once, where they
+stand when the navigator is built, and stay there in its map (a prior map: moving them later
+does not move them there) until the robot picks one up; that is how an object the laser cannot
+see (lower than its scan plane, as Scenario A's panel on its stand) is still planned round.
+Objects that appear during the run (a dropped crate, a spawned model) are known only from the
+laser; the carrying robot's chassis slab gets the marks too (a mark says something stands at
+the laser's height, which the chassis reaches; whether it reaches the load, a planar laser cannot
+tell). The bare robot's blocked-path check reads the local costmap (the rolling window): the
+path ahead is blocked when it passes within the footprint's half width of a local mark, and the
+plan is made again on the global costmap.
+
 Where a skid-steer base turns on the spot (``pivot``) matters for ending on the goal; see
 :mod:`bt_manip.navigation.controller`.
 
@@ -57,6 +73,8 @@ from bt_manip.navigation.footprint import PlanarFootprint
 from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
 from bt_manip.navigation.holonomic import HolonomicFollower, base_limited, turning_footprint
 from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
+from bt_manip.navigation.layered import RobotCostmaps
+from bt_manip.navigation.layers import compose
 from bt_manip.navigation.planner import NavPlan, PlannerOptions, PlanOutcome, plan_path
 from bt_manip.navigation.segments import SegmentFollower
 from bt_manip.navigation.shapes import ZBand, body_outlines, planar_frame
@@ -122,6 +140,10 @@ class Navigator:
         robot: a :class:`bt_manip.sim.robot.Robot` (its client, body and descriptor are used).
         obstacles: body ids of the static structure and furniture.
         movable: body ids (or name -> id) of objects that may move; redrawn on refresh.
+        layers: the robot's laser-fed costmaps; with them the movable objects are not drawn,
+            the global costmap's marks are (see the module docstring).
+        known: with ``layers``, the movable objects the robot was told of, drawn where they
+            stand now until it picks one up.
     """
 
     def __init__(
@@ -130,8 +152,14 @@ class Navigator:
         obstacles: Sequence[int],
         movable: Mapping[str, int] | Sequence[int] = (),
         options: NavigatorOptions = NavigatorOptions(),
+        layers: RobotCostmaps | None = None,
+        known: Sequence[int] = (),
     ) -> None:
         self.robot = robot
+        self.layers = layers
+        self._layers_drawn: tuple[int, frozenset[int]] | None = None
+        """The global obstacle layer's version and the known objects drawn on
+        :attr:`costmap`."""
         self.client = robot.client
         self.options = options
         self._follower_options: FollowerOptions = options.follower
@@ -149,6 +177,15 @@ class Navigator:
             band=self.band,
             remember=False,
         )
+        self.known: dict[int, np.ndarray] = {}
+        """With layers: per object the robot was told of and has not picked up, the flat
+        indices of its cells when the navigator was built."""
+        if layers is not None:
+            for body in known:
+                parts = [self.static.cells_of(o) for o in body_outlines(self.client, body,
+                                                                        self.band)]
+                if parts:
+                    self.known[body] = np.unique(np.concatenate(parts))
         self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.footprint = self.base_footprint
         self.attached: dict[int, str] = {}
@@ -173,8 +210,11 @@ class Navigator:
 
     # -- map --------------------------------------------------------------------------------
     def _movable_cells(self) -> dict[int, np.ndarray]:
-        """Per movable object not carried, the flat indices of the cells it occupies now."""
+        """Per movable object not carried, the flat indices of the cells it occupies now (none
+        with costmap layers: the laser marks them)."""
         cells: dict[int, np.ndarray] = {}
+        if self.layers is not None:
+            return cells
         for body in self.movable:
             if body not in self.attached:
                 outlines = body_outlines(self.client, body, self.band)
@@ -184,7 +224,20 @@ class Navigator:
 
     def _compose(self, cells: dict[int, np.ndarray] | None = None) -> OccupancyGrid:
         """The static grid with the movable objects drawn in (the static grid itself, not a
-        copy, when there are none: it is never drawn on)."""
+        copy, when there are none: it is never drawn on). With costmap layers, the static grid
+        with the global costmap's marks."""
+        if self.layers is not None:
+            self._layers_drawn = self._layers_key()
+            grid = compose(self.static, self.layers.global_layer)
+            if not self.known:
+                return grid
+            if grid is self.static:
+                grid = OccupancyGrid(grid.origin, grid.resolution, grid.occupied.copy(),
+                                     grid.band)
+            flat = grid.occupied.reshape(-1)
+            for idx in self.known.values():
+                flat[idx] = True
+            return grid
         if cells is None:
             cells = self._movable_cells()
         if not cells:
@@ -198,7 +251,17 @@ class Navigator:
         return grid
 
     def refresh(self) -> bool:
-        """Redraw the movable objects; True if the occupied cells changed."""
+        """Redraw the movable objects (with costmap layers: the global costmap's marks); True if
+        the occupied cells changed."""
+        if self.layers is not None:
+            if self._layers_key() == self._layers_drawn:
+                return False
+            old_occupied = self.costmap.grid.occupied
+            grid = self._compose()
+            if np.array_equal(grid.occupied, old_occupied):
+                return False
+            self.costmap = self.costmap.with_grid(grid)
+            return True
         cells = self._movable_cells()
         old = self.costmap.grid
         if cells.keys() == old.sources.keys() and all(
@@ -210,6 +273,10 @@ class Navigator:
             return False
         self.costmap = self.costmap.with_grid(grid)
         return True
+
+    def _layers_key(self) -> tuple[int, frozenset[int]]:
+        assert self.layers is not None
+        return (self.layers.global_layer.version, frozenset(self.known))
 
     @property
     def planning_footprint(self) -> PlanarFootprint:
@@ -233,6 +300,7 @@ class Navigator:
         """
         label = name or self.movable.get(body, f"body {body}")
         self.attached[body] = label
+        self.known.pop(body, None)  # it has been taken from where the map had it
         self.footprint = self.footprint.with_body(self.robot, body, label, band=self.band)
         self.refresh()
         self._build_carry_layers()
@@ -279,13 +347,22 @@ class Navigator:
         for b in self.attached:
             high_parts += body_outlines(c, b, high_band, reference=frame)
         high_fp = PlanarFootprint(tuple(high_parts), " + ".join(self.attached.values()))
-        movers = [b for b in self.movable if b not in self.attached]
+        movers = [] if self.layers is not None else [
+            b for b in self.movable if b not in self.attached]
         bodies = list(self._obstacles) + movers
         ext = self.static.extent
         res = self.options.resolution
         low = rasterise(
             c, bodies, resolution=res, band=(self.band[0], low_top), extent=ext, remember=False
         )
+        if self.layers is not None:  # the same origin and cell side as the static grid
+            marks = self.layers.global_layer.marked
+            r, k = min(low.shape[0], marks.shape[0]), min(low.shape[1], marks.shape[1])
+            low.occupied[:r, :k] |= marks[:r, :k]
+            if low.shape == self.static.shape:
+                flat = low.occupied.reshape(-1)
+                for idx in self.known.values():
+                    flat[idx] = True
         high = rasterise(c, bodies, resolution=res, band=high_band, extent=ext, remember=False)
         self._carry = (low_fp, high_fp, low, lattice_clearance(low), lattice_clearance(high))
         self._carry_high = high
@@ -459,6 +536,10 @@ class Navigator:
         return np.clip(rows, 0, r - 1), np.clip(cols, 0, c - 1)
 
     def _path_blocked(self, ahead: np.ndarray) -> bool:
+        if self.layers is not None:
+            self.refresh()
+            reach = self.planning_footprint.half_width + self.options.resolution / math.sqrt(2.0)
+            return self.layers.local.first_blocked(ahead, reach) is not None
         if not self.movable or not self.refresh():
             return False
         rows, cols = self._cells(ahead)

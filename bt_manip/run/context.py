@@ -71,14 +71,21 @@ class RobotServices:
 
     @property
     def navigator(self) -> Navigator:
-        """The robot's navigator, built on first use from the world's static obstacles.
+        """The robot's navigator, built on first use from the world's static obstacles (and,
+        when the robot localises, on its laser-fed costmap layers: the world file's objects are
+        then known where they stood when it was built, until picked up, and everything else
+        where the laser has marked it).
 
         Raises :class:`~bt_manip.navigation.grid.GridTooLarge` when the world is too large to
         be mapped.
         """
         if self._navigator is None:
+            layers = self.localizer.costmaps if self.localizer is not None else None
+            movable = self.world.movable
+            declared = [movable[o.name] for o in self.world.spec.objects if o.name in movable]
             self._navigator = Navigator(
-                self.robot, self.world.obstacle_body_ids(), self.world.movable
+                self.robot, self.world.obstacle_body_ids(), movable, layers=layers,
+                known=declared,
             )
         return self._navigator
 

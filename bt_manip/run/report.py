@@ -69,6 +69,11 @@ class RunReport:
     """With localisation on: the believed pose's error against the truth over the run
     (``mean_error_m``, ``p95_error_m``, ``max_error_m``, ``mean_yaw_error_rad``,
     ``time_over_0_2m_s``); None (not in the JSON) otherwise."""
+    costmap: dict[str, int] | None = None
+    """With localisation on: the robot's laser-fed costmaps (per costmap, ``global_`` or
+    ``local_``: ``marked_cells`` at the end, ``peak_marked_cells``, ``updates``, ``clears``,
+    ``cleared_cells``; :meth:`~bt_manip.navigation.layered.RobotCostmaps.report`); None (not
+    in the JSON) otherwise."""
     notes: list[str] = field(default_factory=list)
     """Text the summary ends with (the episode adds the as-built table); not in the JSON."""
 
@@ -94,6 +99,8 @@ class RunReport:
             del data["as_built"]
         if self.localization is None:
             del data["localization"]
+        if self.costmap is None:
+            del data["costmap"]
         for node in data["nodes"]:
             if node["counts"] is None:
                 del node["counts"]
@@ -118,6 +125,13 @@ class RunReport:
                 f"{loc['p95_error_m'] * 100:.1f} cm, max {loc['max_error_m'] * 100:.1f} cm, "
                 f"mean yaw {loc['mean_yaw_error_rad']:.4f} rad, "
                 f"{loc['time_over_0_2m_s']:.1f} s over 0.2 m")
+        if self.costmap is not None:
+            cm = self.costmap
+            lines.append(
+                f"  costmaps: {cm['global_marked_cells']} cells marked in the global one at the "
+                f"end (peak {cm['global_peak_marked_cells']}), {cm['local_marked_cells']} in "
+                f"the local one; clears: global {cm['global_clears']}, local "
+                f"{cm['local_clears']}")
         cause = self.cause.get("path")
         failed = [n for n in self.nodes if "FAILURE" in (n.status, n.last_status) and n.reason]
         failed.sort(key=lambda n: n.path != cause)  # the failure that ended the run first

@@ -118,12 +118,15 @@ class Lidar:
         r = rotation_matrix(quat)
         return np.asarray(pos, dtype=float), math.atan2(r[1, 0], r[0, 0])
 
-    def scan(self, dropout: float = 0.0) -> Scan:
+    def scan(self, dropout: float = 0.0, rng: np.random.Generator | None = None) -> Scan:
         """A scan at the robot's true state now; ``dropout``: the probability of each beam to
-        be lost (needs a generator)."""
+        be lost (needs a generator); ``rng``: draw the noise and dropouts from this generator
+        instead of the laser's own (a second reader of the same laser, whose draws leave the
+        laser's own sequence as it was)."""
         if not 0.0 <= dropout <= 1.0:
             raise ValueError(f"dropout must be within 0..1, got {dropout}")
-        if dropout > 0.0 and self.rng is None:
+        rng = rng if rng is not None else self.rng
+        if dropout > 0.0 and rng is None:
             raise ValueError("a dropout needs a random generator (Lidar(..., rng=...))")
         spec = self.spec
         origin, heading = self.sensor_pose()
@@ -131,11 +134,11 @@ class Lidar:
         ranges = cast(origin[0], origin[1], heading, spec.angle_min, spec.angle_increment,
                       spec.beams, cut.segments, cut.circles)
         hit = ranges < spec.range_m
-        if self.rng is not None:
-            noise = self.rng.normal(0.0, 1.0, spec.beams) * spec.noise_m
+        if rng is not None:
+            noise = rng.normal(0.0, 1.0, spec.beams) * spec.noise_m
             ranges = np.where(hit, np.clip(ranges + noise, 0.0, spec.range_m), ranges)
             if dropout > 0.0:
-                ranges[self.rng.random(spec.beams) < dropout] = spec.range_m
+                ranges[rng.random(spec.beams) < dropout] = spec.range_m
         ranges = np.minimum(ranges, spec.range_m)
         return Scan(
             ranges=ranges,
