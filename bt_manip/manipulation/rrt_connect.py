@@ -47,9 +47,9 @@ class PlanOptions:
     """Largest joint-space distance (rad, Euclidean) a tree grows by in one extension."""
     max_checks: int = 200_000
     """Collision checks the search may spend before giving up."""
-    shortcut_rounds: int = 60
+    shortcut_rounds: int = 20
     """Random shortcut attempts after a path is found (at most)."""
-    shortcut_patience: int = 12
+    shortcut_patience: int = 6
     """The random attempts end early once this many in a row have failed: the path is then
     near as short as the remaining attempts would make it, at a fraction of their checks."""
     goal_bias: float = 0.05
