@@ -60,7 +60,7 @@ class BenchOptions:
     seed: int = 0
     step: float = 0.05
     max_checks: int = 200_000
-    shortcut_rounds: int = 60
+    shortcut_rounds: int = 20
 
 
 @dataclass(frozen=True)

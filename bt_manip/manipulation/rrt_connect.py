@@ -21,6 +21,7 @@ import itertools
 import math
 from collections.abc import Callable, Generator
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
@@ -46,13 +47,22 @@ class PlanOptions:
     """Largest joint-space distance (rad, Euclidean) a tree grows by in one extension."""
     max_checks: int = 200_000
     """Collision checks the search may spend before giving up."""
-    shortcut_rounds: int = 60
-    """Random shortcut attempts after a path is found."""
+    shortcut_rounds: int = 20
+    """Random shortcut attempts after a path is found (at most)."""
+    shortcut_patience: int = 6
+    """The random attempts end early once this many in a row have failed: the path is then
+    near as short as the remaining attempts would make it, at a fraction of their checks."""
     goal_bias: float = 0.05
     """Share of samples that are the other tree's root."""
     validate_step: float = 0.01
     """The found path is checked again at this resolution (rad per joint); a segment that
     clips an obstacle between the coarser checks is planned again at this resolution."""
+    hulls_decide: bool = True
+    """When neither end's convex hulls touch anything, a configuration whose hulls touch counts
+    as blocked without asking the exact meshes (:meth:`CollisionScene.segment_free` with
+    ``hulls_only``): every path found is then free for the meshes too, and the checks near
+    obstacles cost a fraction. Ends whose hulls touch (a grasp in a tight spot) are planned
+    with the meshes' answers."""
 
 
 @dataclass(frozen=True)
@@ -95,10 +105,38 @@ class _Tree:
         return out
 
 
-def _steer(a: np.ndarray, b: np.ndarray, extend: float) -> np.ndarray:
+class _SegmentCheck(Protocol):
+    def __call__(self, a: np.ndarray, b: np.ndarray, step: float) -> bool: ...
+
+
+def _segment_check(scene: CollisionScene, hulls_only: bool) -> _SegmentCheck:
+    """The segment test a plan uses: the scene's, on the hulls alone when ``hulls_only``."""
+    if not hulls_only:
+        return scene.segment_free
+
+    def free(a: np.ndarray, b: np.ndarray, step: float) -> bool:
+        return scene.segment_free(a, b, step, hulls_only=True)
+
+    return free
+
+
+def _hulls_decide(scene: CollisionScene, ends: tuple[np.ndarray, ...],
+                  options: PlanOptions) -> bool:
+    """Whether a plan between ``ends`` (free, checked) may count hull contacts as contacts:
+    the option is on, the scene has a hull pass and no end's hulls touch."""
+    if not options.hulls_decide or not isinstance(scene, CollisionScene) or scene.exact:
+        return False
+    return not any(scene.hulls_touch(q) for q in ends)
+
+
+def _steer(a: np.ndarray, b: np.ndarray, extend: float) -> tuple[np.ndarray, bool]:
+    """The point ``extend`` from ``a`` toward ``b`` (``b`` itself when nearer), and whether it
+    is ``b``."""
     d = b - a
-    dist = float(np.linalg.norm(d))
-    return b.copy() if dist <= extend else a + d * (extend / dist)
+    dist = math.sqrt(float(d @ d))
+    if dist <= extend:
+        return b.copy(), True
+    return a + d * (extend / dist), False
 
 
 def check_end(scene: CollisionScene, q: np.ndarray, which: str) -> None:
@@ -148,9 +186,11 @@ def plan_steps(
     first = scene.checks
     check_end(scene, start, "start")
     check_end(scene, goal, "goal")
-    if scene.segment_free(start, goal, options.step):
+    hulls_only = _hulls_decide(scene, (start, goal), options)
+    free = _segment_check(scene, hulls_only)
+    if free(start, goal, options.step):
         # checked again at the validation step, as every path is
-        direct = _validated(scene, [start, goal], rng, options, first, stop)
+        direct = _validated(scene, [start, goal], rng, options, first, stop, hulls_only)
         return PlanResult(direct, 0, scene.checks - first, (1, 1))
     lo = np.where(np.isfinite(scene.lower), scene.lower, -math.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, math.pi)
@@ -166,15 +206,15 @@ def plan_steps(
             target = trees[b].q[0].copy()
         else:
             target = rng.uniform(lo, hi)
-        grown = _extend(scene, trees[a], target, options)
+        grown = _extend(free, trees[a], target, options)
         if grown is not None:
-            met = _connect(scene, trees[b], trees[a].q[grown], options)
+            met = _connect(free, trees[b], trees[a].q[grown], options)
             if met is not None:
                 one, other = trees[a].branch(grown), trees[b].branch(met)
                 path = one[::-1] + other if a == 0 else other[::-1] + one
                 path = _dedupe(path)
-                path = shortcut(scene, path, rng, options)
-                path = _validated(scene, path, rng, options, first, stop)
+                path = shortcut(scene, path, rng, options, hulls_only)
+                path = _validated(scene, path, rng, options, first, stop, hulls_only)
                 return PlanResult(path, samples, scene.checks - first,
                                   (trees[0].n, trees[1].n))
         a, b = b, a
@@ -188,16 +228,19 @@ def plan_steps(
 def _validated(
     scene: CollisionScene, path: list[np.ndarray], rng: np.random.Generator,
     options: PlanOptions, first: int, stop: Callable[[], bool] | None = None,
+    hulls_only: bool = False,
 ) -> list[np.ndarray]:
-    """``path`` with every segment free at ``validate_step``: a segment that is not is planned
-    again at that resolution (within what is left of the budget)."""
+    """``path`` with every segment free at ``validate_step`` (on the hulls alone when
+    ``hulls_only``): a segment that is not is planned again at that resolution (within what is
+    left of the budget)."""
     if options.validate_step >= options.step:
         return path
+    free = _segment_check(scene, hulls_only)
     out = [path[0]]
     i = 0
     while i < len(path) - 1:
         a, b = path[i], path[i + 1]
-        if scene.segment_free(a, b, options.validate_step):
+        if free(a, b, options.validate_step):
             out.append(b)
             i += 1
             continue
@@ -213,26 +256,26 @@ def _validated(
 
 
 def _extend(
-    scene: CollisionScene, tree: _Tree, target: np.ndarray, options: PlanOptions
+    free: _SegmentCheck, tree: _Tree, target: np.ndarray, options: PlanOptions
 ) -> int | None:
     near = tree.nearest(target)
-    q = _steer(tree.q[near], target, options.extend)
-    if scene.segment_free(tree.q[near], q, options.step):
+    q, _ = _steer(tree.q[near], target, options.extend)
+    if free(tree.q[near], q, options.step):
         return tree.add(q, near)
     return None
 
 
 def _connect(
-    scene: CollisionScene, tree: _Tree, target: np.ndarray, options: PlanOptions
+    free: _SegmentCheck, tree: _Tree, target: np.ndarray, options: PlanOptions
 ) -> int | None:
     """Grow ``tree`` toward ``target`` until it reaches it (its index) or is blocked (None)."""
     near = tree.nearest(target)
     while True:
-        q = _steer(tree.q[near], target, options.extend)
-        if not scene.segment_free(tree.q[near], q, options.step):
+        q, reached = _steer(tree.q[near], target, options.extend)
+        if not free(tree.q[near], q, options.step):
             return None
         near = tree.add(q, near)
-        if np.array_equal(q, target):
+        if reached:
             return near
 
 
@@ -251,50 +294,58 @@ def path_length(path: list[np.ndarray]) -> float:
 
 def shortcut(
     scene: CollisionScene, path: list[np.ndarray], rng: np.random.Generator,
-    options: PlanOptions = PlanOptions(),
+    options: PlanOptions = PlanOptions(), hulls_only: bool = False,
 ) -> list[np.ndarray]:
-    """``path`` with waypoints skipped where the straight segment between them is free: first
-    greedily from the start, then ``options.shortcut_rounds`` random pairs of points on it."""
-    path = _greedy(scene, path, options.step)
+    """``path`` with waypoints skipped where the straight segment between them is free (on the
+    hulls alone when ``hulls_only``): first greedily from the start, then
+    ``options.shortcut_rounds`` random pairs of points on it."""
+    free = _segment_check(scene, hulls_only)
+    path = _greedy(free, path, options.step)
+    failed = 0
+    along = _along(path)
     for _ in range(options.shortcut_rounds):
-        if len(path) < 3:
+        if len(path) < 3 or failed >= options.shortcut_patience or along[-1] <= 0.0:
             break
-        total = path_length(path)
-        if total <= 0.0:
-            break
-        s, t = sorted(rng.uniform(0.0, total, 2))
-        (i, qa), (j, qb) = _point_at(path, s), _point_at(path, t)
+        s, t = sorted(rng.uniform(0.0, along[-1], 2))
+        (i, qa), (j, qb) = _point_at(path, along, s), _point_at(path, along, t)
+        failed += 1
         if j <= i:
             continue
         # qa and qb lie between the configurations their segments were checked at, and the
         # pieces of those segments left in the path are checked at other configurations than
         # the whole was: check the pieces too, so that every segment of the result is free at
         # ``step`` as checked on its own (as a validator checks it)
-        if (scene.segment_free(qa, qb, options.step)
-                and scene.segment_free(path[i], qa, options.step)
-                and scene.segment_free(qb, path[j + 1], options.step)):
+        if (free(qa, qb, options.step) and free(path[i], qa, options.step)
+                and free(qb, path[j + 1], options.step)):
             path = [*path[:i + 1], qa, qb, *path[j + 1:]]
             path = _dedupe(path)
+            along = _along(path)
+            failed = 0
     return path
 
 
-def _greedy(scene: CollisionScene, path: list[np.ndarray], step: float) -> list[np.ndarray]:
+def _greedy(free: _SegmentCheck, path: list[np.ndarray], step: float) -> list[np.ndarray]:
     out = [path[0]]
     i = 0
     while i < len(path) - 1:
         j = len(path) - 1
-        while j > i + 1 and not scene.segment_free(path[i], path[j], step):
+        while j > i + 1 and not free(path[i], path[j], step):
             j -= 1
         out.append(path[j])
         i = j
     return out
 
 
-def _point_at(path: list[np.ndarray], s: float) -> tuple[int, np.ndarray]:
-    """The point ``s`` rad along ``path`` and the index of the segment's first waypoint."""
-    for i, (a, b) in enumerate(itertools.pairwise(path)):
-        length = float(np.linalg.norm(b - a))
-        if s <= length or i == len(path) - 2:
-            return i, a + (b - a) * (min(s, length) / max(length, 1e-12))
-        s -= length
-    return len(path) - 2, path[-1]
+def _along(path: list[np.ndarray]) -> np.ndarray:
+    """How far along ``path`` (rad, Euclidean) each waypoint lies: 0 for the first."""
+    steps = np.diff(np.asarray(path, dtype=float), axis=0)
+    return np.concatenate([[0.0], np.cumsum(np.sqrt(np.einsum("ij,ij->i", steps, steps)))])
+
+
+def _point_at(path: list[np.ndarray], along: np.ndarray, s: float) -> tuple[int, np.ndarray]:
+    """The point ``s`` rad along ``path`` (``along``: :func:`_along` of it) and the index of
+    the segment's first waypoint."""
+    i = min(int(np.searchsorted(along[1:], s)), len(path) - 2)
+    a, b = path[i], path[i + 1]
+    length = float(along[i + 1] - along[i])
+    return i, a + (b - a) * (min(max(s - float(along[i]), 0.0), length) / max(length, 1e-12))

@@ -203,3 +203,76 @@ def test_the_hull_pass_counts_a_hair_gap_as_a_contact() -> None:
     assert all(r.security_margin == HULL_MARGIN for r in scene.gdata.collisionRequests)
     assert all(r.security_margin == 0.0 for r in scene.mesh_gdata.collisionRequests)
     assert all(r.security_margin == 0.0 for r in _scene(exact=True).gdata.collisionRequests)
+
+
+def _hull_only_point(scene: CollisionScene, q: np.ndarray) -> np.ndarray:
+    """A point (root frame) inside a link's convex hull at ``q`` but clear of its mesh by a
+    few millimetres: found among seeded samples around the hand."""
+    import coal
+    import pinocchio as pin
+
+    meshes = scene.mesh_geometry
+    assert meshes is not None
+    gdata = scene.gdata
+    pin.updateGeometryPlacements(scene.model, scene.data, scene.geometry, gdata, q)
+    ball, rng = coal.Sphere(0.002), np.random.default_rng(0)
+    for index, g in enumerate(scene.geometry.geometryObjects):
+        if g.name.startswith("panda_hand") or g.name.startswith("panda_link7"):
+            placed = gdata.oMg[index]
+            where = coal.Transform3s(placed.rotation, placed.translation)
+            hull, mesh = g.geometry, meshes.geometryObjects[index].geometry
+            for _ in range(4000):
+                p = placed.translation + rng.uniform(-0.12, 0.12, 3)
+                at = coal.Transform3s(np.eye(3), p)
+                if (coal.distance(hull, where, ball, at, coal.DistanceRequest(),
+                                  coal.DistanceResult()) < -0.001
+                        and coal.distance(mesh, where, ball, at, coal.DistanceRequest(),
+                                          coal.DistanceResult()) > 0.004):
+                    return p
+    raise AssertionError("no point inside a hull and outside its mesh")
+
+
+def test_hull_contacts_decide_only_when_asked_and_plans_keep_mesh_answers_at_tight_ends() -> None:
+    # A pebble inside the hand's hull but clear of its mesh: the meshes call HOME free, the
+    # hull pass alone calls it blocked; a plan from HOME then asks the meshes (its start's
+    # hulls touch) and its path is free on the exact meshes.
+    scene = _scene(wall=False)
+    pebble = _hull_only_point(scene, HOME)
+    m = np.eye(4)
+    m[:3, 3] = pebble
+    scene.add_obstacle(Obstacle("pebble", "sphere", (0.001,), tuple(map(tuple, m))))
+    assert not scene.collides(HOME) and scene.hulls_touch(HOME)
+    near = HOME + np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.02])
+    assert scene.segment_free(HOME, near, 0.05)
+    assert not scene.segment_free(HOME, near, 0.05, hulls_only=True)
+    result = plan(scene, HOME, LEFT, np.random.default_rng(1))
+    exact = _scene(exact=True, wall=False)
+    exact.add_obstacle(Obstacle("pebble", "sphere", (0.001,), tuple(map(tuple, m))))
+    assert all(exact.segment_free(a, b, 0.01) for a, b in itertools.pairwise(result.path))
+
+
+def test_shortcut_attempts_end_after_the_failures_in_a_row() -> None:
+    # Free only along an L of two segments: no shortcut can succeed, so the random attempts
+    # (each draws its two points once) stop after ``shortcut_patience`` of them.
+    from bt_manip.manipulation.rrt_connect import shortcut
+
+    class _Corridor(_Band):
+        def collides(self, q: np.ndarray) -> bool:
+            return not (abs(q[1]) < 1e-9 or abs(q[0] - 1.0) < 1e-9)
+
+    class _Counted:
+        def __init__(self) -> None:
+            self.rng, self.draws = np.random.default_rng(0), 0
+
+        def uniform(self, lo: float, hi: float, size: int) -> np.ndarray:
+            self.draws += 1
+            return self.rng.uniform(lo, hi, size)
+
+    path = [np.array([0.0, 0.0]), np.array([1.0, 0.0]), np.array([1.0, 1.0])]
+    for patience, attempts in ((5, 5), (60, 60)):
+        rng = _Counted()
+        out = shortcut(cast(CollisionScene, _Corridor()), path, cast(np.random.Generator, rng),
+                       PlanOptions(shortcut_rounds=60, shortcut_patience=patience))
+        assert len(out) == 3 and all(np.array_equal(a, b) for a, b in zip(out, path,
+                                                                            strict=True))
+        assert rng.draws == attempts
