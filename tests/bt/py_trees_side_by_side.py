@@ -16,8 +16,10 @@ same seeded blackboard and ``random`` seed.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import random
+import re
 import types
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -188,9 +190,13 @@ def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
         tree = from_py_trees(root, builtins=way != "py_trees_nodes",
                              context=TreeContext(clock=clock), blackboard=entries)
         if way == "xml":
+            # XML holds the tree, not its blackboard: the loaded tree starts with the
+            # entries the converted one started with (the seed, and what py_trees'
+            # setup_ports() had written: its ports' constants and outputs' defaults)
+            start = {k: tree.blackboard.get(k) for k in tree.blackboard.keys()}  # noqa: SIM118
             text = to_xml(tree)
             fresh_blackboard(seed_bb)
-            tree = load_tree_string(text, context=TreeContext(clock=clock), blackboard=entries)
+            tree = load_tree_string(text, context=TreeContext(clock=clock), blackboard=start)
         spy_leaves(tree.root, log)
         if setup:
             tree.root.setup_with_descendants()
@@ -198,6 +204,29 @@ def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
         return _ticks(tree.tick, tree.root, log,
                       lambda: {k: plain(blackboard.get(k)) for k in blackboard.keys()},  # noqa: SIM118
                       ticks, clock, seed)
+
+
+UUID = re.compile(r"_[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}")
+
+
+def same_each_build(value: Any) -> Any:
+    """``value`` without what differs from one build of a tree to the next: the uuids that
+    py_trees' XML parser appends to names and that name the blackboard keys of ports left
+    unremapped or given a constant, iterators (the blackboard compares them as objects)."""
+    if isinstance(value, str):
+        return UUID.sub("_<uuid>", value)
+    if isinstance(value, dict):
+        return {same_each_build(k): same_each_build(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(same_each_build(v) for v in value)
+    if isinstance(value, Iterator):
+        return f"<{type(value).__name__}>"
+    return value
+
+
+def normalised(run: Run) -> Run:
+    """``run`` as :func:`same_each_build` sees it."""
+    return Run(*(same_each_build(getattr(run, f.name)) for f in dataclasses.fields(Run)))
 
 
 def comparable(calls: list[Call]) -> list[Call]:

@@ -32,7 +32,10 @@ py_trees stops a child that had finished when its parent starts again (its
 
 Leaves are wrapped (:mod:`bt_manip.bt.pytrees.leaf`), the very objects of the py_trees tree,
 so references kept to them stay live; ``py_trees.timers.Timer`` becomes ``PyTreesTimer``, which
-reads the tree's clock. Nodes that already are bt-manip nodes are kept.
+reads the tree's clock. Ports wired by ``setup_ports()`` before conversion (by the user's code or
+py_trees' XML parser) keep their wiring, and the tree's blackboard starts with the entries that
+``setup_ports()`` wrote (:mod:`bt_manip.bt.pytrees.wiring`). Nodes that already are bt-manip
+nodes are kept.
 """
 
 from __future__ import annotations
@@ -89,6 +92,7 @@ def from_py_trees(
     node = convert_node(root, builtins=builtins)
     tree = view.PyTreesViewTree(node, context=context, blackboard=blackboard, tree_id=tree_id)
     _register_leaves(node)
+    _seed_setup_entries(tree)
     return tree
 
 
@@ -221,6 +225,15 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
     made.status = py_trees.common.Status.INVALID
     made._init_node({})
     return cast(BtNode, made)  # an instance of made_class, a BtNode subclass
+
+
+def _seed_setup_entries(tree: Tree) -> None:
+    """Write the entries py_trees' ``setup_ports()`` had written for the tree's behaviours
+    (constants, outputs' defaults) where the tree's blackboard has none yet."""
+    for walked in walk_nodes(tree.root):
+        for key, value in getattr(walked.node, "setup_entries", {}).items():
+            if not tree.blackboard.has_value(key):
+                tree.blackboard.set(key, value)
 
 
 def _register_leaves(root: BtNode) -> None:
