@@ -30,6 +30,7 @@ from py_trees.common import Status
 
 from bt_manip.bt import from_py_trees, load_tree_string, to_xml
 from bt_manip.bt.context import TreeContext
+from bt_manip.bt.node import TreeRuntimeError
 from bt_manip.bt.pytrees.leaf import PyTreesLeaf
 from bt_manip.bt.subtree import SubTree
 from bt_manip.clock import ManualClock
@@ -159,8 +160,8 @@ def _ticks(tick: Callable[[], Any], root: Any, log: list[Call], bb: Callable[[],
         log.clear()
         try:
             tick()
-        except Exception as e:  # both engines must raise at the same tick
-            run.error = f"{type(e).__name__}"
+        except Exception as e:  # both engines must raise the same error at the same tick
+            run.error = raised(e)
             break
         finally:
             run.calls.append(list(log))
@@ -169,6 +170,14 @@ def _ticks(tick: Callable[[], Any], root: Any, log: list[Call], bb: Callable[[],
         run.blackboards.append(bb())
         clock.advance(STEP)
     return run
+
+
+def raised(error: Exception) -> str:
+    """What was raised: py_trees' own exception, also where bt-manip reports it as a
+    :class:`~bt_manip.bt.node.TreeRuntimeError` naming the node (raised from it)."""
+    if isinstance(error, TreeRuntimeError) and isinstance(error.__cause__, Exception):
+        error = error.__cause__
+    return f"{type(error).__name__}: {error}"
 
 
 def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],

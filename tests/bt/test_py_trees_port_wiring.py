@@ -9,7 +9,7 @@ same entries, and ``to_xml`` writes that wiring.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import py_trees
 import pytest
@@ -22,14 +22,16 @@ from bt_manip.bt.ports import Literal, Ref
 from bt_manip.bt.pytrees.leaf import PyTreesLeaf
 from bt_manip.bt.status import NodeStatus
 
+Ports = dict[str, PortInformation]
+
 
 class WiringScale(BehaviourWithPorts, register=False):
     """Write ``value * factor`` to ``scaled`` and "done" to ``note``."""
 
-    INPUT_PORTS = {"value": PortInformation(float),
-                   "factor": PortInformation(float, default_value=2.0)}
-    OUTPUT_PORTS = {"scaled": PortInformation(float),
-                    "note": PortInformation(str, default_value="idle")}
+    INPUT_PORTS: ClassVar[Ports] = {
+        "value": PortInformation(float), "factor": PortInformation(float, default_value=2.0)}
+    OUTPUT_PORTS: ClassVar[Ports] = {
+        "scaled": PortInformation(float), "note": PortInformation(str, default_value="idle")}
 
     def update(self) -> Status:
         self._set_output("scaled", self.get_input("value") * self.get_input("factor"))

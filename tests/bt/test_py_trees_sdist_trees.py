@@ -44,10 +44,6 @@ FINISHED_CHILDREN = ("documented terminate(INVALID) difference: the Parallel's c
                      "calls terminate(INVALID) on them (not RUNNING)")
 KNOWN: dict[str, str] = {
     **{f"test_parallels::test_parallel_failure#{i}": FINISHED_CHILDREN for i in (4, 5, 6)},
-    "test_parallels::test_parallel_success_on_selected_invalid_configuration#0": (
-        "not yet: from_py_trees refuses, with a TypeError naming them, a SuccessOnSelected "
-        "policy naming behaviours that are not the parallel's children; py_trees ticks such a "
-        "Parallel to FAILURE with an error message"),
 }
 """Trees whose side-by-side run differs, and why (besides :data:`PORT_MODULES`)."""
 

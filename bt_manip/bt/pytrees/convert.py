@@ -46,6 +46,7 @@ from typing import Any, cast
 import py_trees
 from py_trees.behaviour import Behaviour
 
+from bt_manip.bt.attributes import UnwritableText
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
@@ -122,16 +123,19 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
         children = _children(node, builtins)
         attributes: dict[str, Any] = {"policy": type(policy).__name__,
                                       "synchronise": policy.synchronise}
-        if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnSelected):
-            strangers = [c.name for c in policy.children if c not in originals]
-            if strangers:
-                raise TypeError(
-                    f"cannot convert parallel '{name}': its SuccessOnSelected policy names "
-                    f"{strangers}, which are not its children (py_trees ticks such a parallel "
-                    "to FAILURE)"
-                )
-            attributes["selected"] = [originals.index(c) for c in policy.children]
-        return ptc.PyTreesParallel(name, children, **attributes)
+        if not isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnSelected):
+            return ptc.PyTreesParallel(name, children, **attributes)
+        selected = policy.children
+        attributes["selected"] = [originals.index(c) for c in selected if c in originals]
+        parallel = ptc.PyTreesParallel(name, children, **attributes)
+        strangers = [c.name for c in selected if c not in originals]
+        if strangers:  # py_trees' check raises at every tick, naming them; so does this one
+            parallel.policy.children = [children[originals.index(c)] if c in originals else c
+                                        for c in selected]
+            parallel.attribute_texts["selected"] = UnwritableText(
+                None, f"the SuccessOnSelected policy names {strangers}, which are not children "
+                "of the parallel")
+        return parallel
     if kind not in (py_trees.composites.Sequence, py_trees.composites.Selector):
         return _own_class(node, builtins)
     memory = bool(cast("py_trees.composites.Sequence | py_trees.composites.Selector", node).memory)
