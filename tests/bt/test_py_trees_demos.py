@@ -141,11 +141,12 @@ def demos() -> dict[str, Demo]:
 
 DEMOS = demos()
 REFUSED_AS_XML = {
-    "blackboard": "argument 'variable_value'",  # an object of the demo's Nested class
-    "blackboard_remappings": "argument 'remap_to'",  # Remap does not keep it
-    "stewardship": "ID 'SuccessEveryN' is registered for py_trees.behaviours.SuccessEveryN",
+    "blackboard": "argument 'variable_value': a Nested cannot be written in XML",
 }
-"""Demos that ``to_xml`` refuses to write, and what its error names."""
+"""Demos that ``to_xml`` refuses to write, and what its error names. The blackboard demo sets
+an object of its own ``Nested`` class as a value (``variable_value``, typed ``Any``): XML text
+for it loads as JSON or text, never as a ``Nested``, and the loader does not build objects of
+classes that untrusted XML would name."""
 
 
 @pytest.fixture(autouse=True)
@@ -198,6 +199,22 @@ def test_the_demo_trees_are_registered_after_conversion() -> None:
     tree = from_py_trees(demo("context_switching").create_root())
     assert registry.get("ContextSwitch") is not None
     assert '<ContextSwitch name="Context"/>' in to_xml(tree)
+
+
+def test_a_user_class_named_like_a_py_trees_class_is_written_by_its_module() -> None:
+    """stewardship's own ``SuccessEveryN`` is not py_trees' ``SuccessEveryN``."""
+    fresh_blackboard({})
+    xml = to_xml(from_py_trees(demo("stewardship").create_tree()))
+    assert '<py_trees.demos.stewardship.SuccessEveryN name="EveryN"/>' in xml
+    assert registry.get("SuccessEveryN").BEHAVIOUR is py_trees.behaviours.SuccessEveryN
+
+
+def test_remap_to_is_read_back_from_the_behaviours_client() -> None:
+    """The remappings demo's ``Remap`` keeps ``remap_to`` only in its blackboard client."""
+    fresh_blackboard({})
+    factory, _seed, _setup = DEMOS["blackboard_remappings"]
+    xml = to_xml(from_py_trees(factory()))
+    assert """<Remap remap_to='{"/foo/bar/wow": "/parameters/wow"}'/>""" in xml
 
 
 @pytest.mark.parametrize("name", sorted(REFUSED_AS_XML))

@@ -318,12 +318,32 @@ _COUNTERPARTS: dict[type, Any] = {}
 
 
 def wrap(behaviour: Behaviour) -> LeafNode:
-    """A bt-manip leaf running ``behaviour`` (the object itself, not a copy)."""
-    counterpart = _clock_counterparts().get(type(behaviour))
+    """A bt-manip leaf running ``behaviour`` (the object itself, not a copy).
+
+    Its class gets the class name as ID, or its module-qualified name
+    (``py_trees.demos.stewardship.SuccessEveryN``) where the class name is registered for
+    another class, so that the XML ``to_xml`` writes loads this class back."""
+    cls = type(behaviour)
+    counterpart = _clock_counterparts().get(cls)
     if counterpart is not None:
         timer = cast(py_trees.timers.Timer, behaviour)  # the only class with a counterpart
         return counterpart(timer.name, duration=timer.duration)
-    return leaf_class_for(type(behaviour))(behaviour=behaviour)
+    return _conversion_class(cls)(behaviour=behaviour)
+
+
+_QUALIFIED: dict[type, type[PyTreesLeaf]] = {}
+
+
+def _conversion_class(cls: type[Behaviour]) -> type[PyTreesLeaf]:
+    if cls in _QUALIFIED:
+        return _QUALIFIED[cls]
+    leaf_class = leaf_class_for(cls)
+    registered = registry.get(leaf_class.NODE_ID)
+    if registered is None or getattr(registered, "BEHAVIOUR", None) is cls:
+        return leaf_class
+    qualified = leaf_class_for(cls, f"{cls.__module__}.{cls.__qualname__}")
+    _QUALIFIED[cls] = qualified
+    return qualified
 
 
 PY_TREES_LEAVES: tuple[type[Behaviour], ...] = (
