@@ -10,8 +10,8 @@ is then registered in the behaviour's blackboard client, remapped to a py_trees 
 - a port left unremapped reads and writes the key py_trees made for it under the node
   (``/<namespace>/<name>_<uuid>/<port>``): a reference to that entry, so the converted tree
   keeps py_trees' blackboard as it is;
-- an input given a constant (py_trees' parser turns ``port="2.5"`` into a key holding the
-  value) becomes that constant.
+- an input given a constant (py_trees' parser turns ``port="2.5"`` into a key of the node
+  holding the value) becomes that constant.
 
 :func:`setup_entries` gives the entries py_trees' ``setup_ports()`` wrote for the behaviour
 (the constants, the declared defaults of its outputs): a converted tree starts with them, as
@@ -63,11 +63,11 @@ def carried_wiring(behaviour: Any) -> dict[str, Binding]:
     storage = _storage()
     bindings: dict[str, Binding] = {}
     for port, target in _targets(behaviour).items():
-        if port in behaviour.input_ports() and target == _constant_key(behaviour, port):
-            if target in storage:
-                bindings[port] = Literal(storage[target])
-            continue
-        bindings[port] = Ref(target.lstrip("/"))
+        constant = port in behaviour.input_ports() and target == _constant_key(behaviour, port)
+        if constant and target in storage:
+            bindings[port] = Literal(storage[target])
+        else:  # (a constant no longer on py_trees' blackboard: its key, empty, as in py_trees)
+            bindings[port] = Ref(target.lstrip("/"))
     return bindings
 
 
