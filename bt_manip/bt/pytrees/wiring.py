@@ -26,6 +26,7 @@ import py_trees
 from py_trees.ports import PortsMixin
 
 from bt_manip.bt.ports import Binding, Literal, Ref
+from bt_manip.bt.pytrees.storage import PORT_PREFIX
 
 
 def _client(behaviour: Any) -> py_trees.blackboard.Client | None:
@@ -42,7 +43,7 @@ def _targets(behaviour: PortsMixin) -> dict[str, str]:
     targets = {}
     for port in (*behaviour.input_ports(), *behaviour.output_ports()):
         target = remappings.get(client.absolute_name(port))
-        if target is not None:
+        if target is not None and not target.startswith(PORT_PREFIX):  # not a leaf's own
             targets[port] = target
     return targets
 
