@@ -131,10 +131,6 @@ class PyTreesParallel(_PyTreesComposite):
       SuccessOnSelected: when the children at the indices ``selected`` (``0;2``) did;
     - otherwise RUNNING. With ``synchronise`` (SuccessOnAll, SuccessOnSelected) a child that
       succeeded is not ticked again until the parallel finishes.
-
-    A converted py_trees ``Parallel`` whose SuccessOnSelected policy selects no child or a
-    behaviour that is not its child raises at every tick, as py_trees' own check does (a
-    :class:`~bt_manip.bt.node.TreeRuntimeError` naming the node and those behaviours).
     """
 
     PY = py_trees.composites.Parallel

@@ -30,6 +30,11 @@ composite and decorator gets its py_trees counterpart. One difference remains wi
 py_trees stops a child that had finished when its parent starts again (its
 ``terminate(INVALID)`` runs once more); a BT.CPP parent resets it without calling it.
 
+A ``Parallel`` whose SuccessOnSelected policy selects no child, or a behaviour that is not its
+child, is converted all the same: as in py_trees, its check raises at every tick (here a
+:class:`~bt_manip.bt.node.TreeRuntimeError` naming the node and those behaviours), and
+``to_xml`` refuses the selection.
+
 Leaves are wrapped (:mod:`bt_manip.bt.pytrees.leaf`), the very objects of the py_trees tree,
 so references kept to them stay live; ``py_trees.timers.Timer`` becomes ``PyTreesTimer``, which
 reads the tree's clock. Ports wired by ``setup_ports()`` before conversion (by the user's code or
