@@ -16,8 +16,10 @@ same seeded blackboard and ``random`` seed.
 
 from __future__ import annotations
 
+import dataclasses
 import enum
 import random
+import re
 import types
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -28,6 +30,7 @@ from py_trees.common import Status
 
 from bt_manip.bt import from_py_trees, load_tree_string, to_xml
 from bt_manip.bt.context import TreeContext
+from bt_manip.bt.node import TreeRuntimeError
 from bt_manip.bt.pytrees.leaf import PyTreesLeaf
 from bt_manip.bt.subtree import SubTree
 from bt_manip.clock import ManualClock
@@ -157,8 +160,8 @@ def _ticks(tick: Callable[[], Any], root: Any, log: list[Call], bb: Callable[[],
         log.clear()
         try:
             tick()
-        except Exception as e:  # both engines must raise at the same tick
-            run.error = f"{type(e).__name__}"
+        except Exception as e:  # both engines must raise the same error at the same tick
+            run.error = raised(e)
             break
         finally:
             run.calls.append(list(log))
@@ -167,6 +170,14 @@ def _ticks(tick: Callable[[], Any], root: Any, log: list[Call], bb: Callable[[],
         run.blackboards.append(bb())
         clock.advance(STEP)
     return run
+
+
+def raised(error: Exception) -> str:
+    """What was raised: py_trees' own exception, also where bt-manip reports it as a
+    :class:`~bt_manip.bt.node.TreeRuntimeError` naming the node (raised from it)."""
+    if isinstance(error, TreeRuntimeError) and isinstance(error.__cause__, Exception):
+        error = error.__cause__
+    return f"{type(error).__name__}: {error}"
 
 
 def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
@@ -188,9 +199,13 @@ def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
         tree = from_py_trees(root, builtins=way != "py_trees_nodes",
                              context=TreeContext(clock=clock), blackboard=entries)
         if way == "xml":
+            # XML holds the tree, not its blackboard: the loaded tree starts with the
+            # entries the converted one started with (the seed, and what py_trees'
+            # setup_ports() had written: its ports' constants and outputs' defaults)
+            start = {k: tree.blackboard.get(k) for k in tree.blackboard.keys()}  # noqa: SIM118
             text = to_xml(tree)
             fresh_blackboard(seed_bb)
-            tree = load_tree_string(text, context=TreeContext(clock=clock), blackboard=entries)
+            tree = load_tree_string(text, context=TreeContext(clock=clock), blackboard=start)
         spy_leaves(tree.root, log)
         if setup:
             tree.root.setup_with_descendants()
@@ -198,6 +213,29 @@ def run_way(way: str, factory: Factory, ticks: int, seed_bb: dict[str, Any],
         return _ticks(tree.tick, tree.root, log,
                       lambda: {k: plain(blackboard.get(k)) for k in blackboard.keys()},  # noqa: SIM118
                       ticks, clock, seed)
+
+
+UUID = re.compile(r"_[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}")
+
+
+def same_each_build(value: Any) -> Any:
+    """``value`` without what differs from one build of a tree to the next: the uuids that
+    py_trees' XML parser appends to names and that name the blackboard keys of ports left
+    unremapped or given a constant, iterators (the blackboard compares them as objects)."""
+    if isinstance(value, str):
+        return UUID.sub("_<uuid>", value)
+    if isinstance(value, dict):
+        return {same_each_build(k): same_each_build(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return type(value)(same_each_build(v) for v in value)
+    if isinstance(value, Iterator):
+        return f"<{type(value).__name__}>"
+    return value
+
+
+def normalised(run: Run) -> Run:
+    """``run`` as :func:`same_each_build` sees it."""
+    return Run(*(same_each_build(getattr(run, f.name)) for f in dataclasses.fields(Run)))
 
 
 def comparable(calls: list[Call]) -> list[Call]:

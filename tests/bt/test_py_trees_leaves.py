@@ -24,7 +24,8 @@ from bt_manip.bt.context import TreeContext
 from bt_manip.bt.controls import ReactiveSequence, Sequence
 from bt_manip.bt.decorators import Inverter
 from bt_manip.bt.leaves import AlwaysSuccess
-from bt_manip.bt.pytrees.leaf import PyTreesLeaf, register_py_trees_behaviours
+from bt_manip.bt.pytrees.leaf import PyTreesLeaf, leaf_class_for, register_py_trees_behaviours
+from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.xml_loader import load_tree
 from bt_manip.clock import ManualClock
 from bt_manip.errors import InputError
@@ -381,3 +382,30 @@ def test_an_exception_in_a_behaviour_is_a_tree_error_naming_the_node() -> None:
     assert str(caught.value).startswith(
         "BlackboardToStatus 'read' (line 1): KeyError: \"client 'read' tried to access "
         "'/missing' but it does not yet exist on the blackboard\"")
+
+
+class Success(py_trees.behaviour.Behaviour):
+    """A user's class named like py_trees' ``Success``: fails."""
+
+    def update(self) -> Status:
+        return Status.FAILURE
+
+
+def test_a_class_named_like_a_registered_one_converts_under_its_module_name() -> None:
+    root = py_trees.composites.Sequence("seq", memory=True,
+                                        children=[Success(name="one"), Success(name="two")])
+    tree = from_py_trees(root)
+    qualified = f"{__name__}.Success"
+    assert [n.NODE_ID for n in tree.root.children] == [qualified, qualified]
+    assert type(tree.root.children[0]) is type(tree.root.children[1])
+    again = load_tree_string(to_xml(tree))
+    assert again.tick() is NodeStatus.FAILURE
+    assert registry.get("Success").BEHAVIOUR is py_trees.behaviours.Success
+
+
+def test_to_xml_refuses_a_node_whose_id_is_registered_for_another_class() -> None:
+    shadow = leaf_class_for(Success)  # ID "Success", not registered: py_trees' is
+    tree = Tree(Sequence("seq", children=[shadow(name="one")]))
+    with pytest.raises(ValueError, match=r"ID 'Success' is registered for "
+                                         r"py_trees\.behaviours\.Success,"):
+        to_xml(tree)

@@ -17,12 +17,9 @@ tree as it was built.
 from __future__ import annotations
 
 import copy
-import dataclasses
-import re
 import sys
 import time
 import types
-from collections.abc import Iterator
 from typing import Any
 
 import py_trees
@@ -32,9 +29,9 @@ from tests.bt import py_trees_sdist as sdist
 from tests.bt.py_trees_side_by_side import (
     WAYS,
     Clocked,
-    Run,
     differences,
     fresh_blackboard,
+    normalised,
     run_way,
 )
 
@@ -42,32 +39,17 @@ MAX_TICKS = 60
 """Ticks at most (two tests tick a 2 s wait until it ends, 48 and 190 times in real time)."""
 TREE_WAYS = WAYS[:3]  # py_trees, builtins, py_trees_nodes
 
-PORTS = ("ports wired by setup_ports() (by the test or by py_trees' XML parser) are lost: "
-         "from_py_trees rewires a wrapped behaviour's ports from its node's attributes, so a "
-         "required input is missing or an output lands elsewhere (not covered yet, as for the "
-         "ports demos)")
-PORT_MODULES = ("test_ports::", "test_ports_xml_parser::")
-"""Every tree of these modules has ports wired so (:data:`PORTS`)..."""
-PORTS_UNSEEN = {"test_ports_xml_parser::TestXMLParser.test_port_default_values_from_XML#0"}
-"""... but in these the wiring lost changes nothing one sees (unwired inputs fall back to
-their declared defaults either way, no output is written)."""
 FINISHED_CHILDREN = ("documented terminate(INVALID) difference: the Parallel's children had "
                      "finished in an earlier tree of the test, and py_trees' Parallel, starting, "
                      "calls terminate(INVALID) on them (not RUNNING)")
 KNOWN: dict[str, str] = {
     **{f"test_parallels::test_parallel_failure#{i}": FINISHED_CHILDREN for i in (4, 5, 6)},
-    "test_parallels::test_parallel_success_on_selected_invalid_configuration#0": (
-        "not yet: from_py_trees refuses, with a TypeError naming them, a SuccessOnSelected "
-        "policy naming behaviours that are not the parallel's children; py_trees ticks such a "
-        "Parallel to FAILURE with an error message"),
 }
 """Trees whose side-by-side run differs, and why (besides :data:`PORT_MODULES`)."""
 
 
 def known(tree_id: str) -> str | None:
     """Why the tree ``tree_id`` is known not to tick alike, or None."""
-    if tree_id.startswith(PORT_MODULES) and tree_id not in PORTS_UNSEEN:
-        return PORTS
     return KNOWN.get(tree_id)
 
 
@@ -120,27 +102,6 @@ def real_time_restored() -> Any:
         if "time" in vars(module):
             module.time = time  # type: ignore[attr-defined]
     fresh_blackboard({})
-
-
-UUID = re.compile(r"_[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}")
-
-
-def same_each_build(value: Any) -> Any:
-    """``value`` without what differs from one build of a tree to the next: the uuids py_trees'
-    XML parser appends to names, iterators (the blackboard compares them as objects)."""
-    if isinstance(value, str):
-        return UUID.sub("_<uuid>", value)
-    if isinstance(value, dict):
-        return {same_each_build(k): same_each_build(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return type(value)(same_each_build(v) for v in value)
-    if isinstance(value, Iterator):
-        return f"<{type(value).__name__}>"
-    return value
-
-
-def normalised(run: Run) -> Run:
-    return Run(*(same_each_build(getattr(run, f.name)) for f in dataclasses.fields(Run)))
 
 
 def mismatches(recorded: sdist.Recorded) -> dict[str, list[str]]:

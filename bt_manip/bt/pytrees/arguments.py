@@ -240,7 +240,9 @@ def _jsonable(value: Any) -> Any:
 
 
 # Where py_trees' own behaviours keep their constructor arguments (for saving a wrapped
-# instance as XML); other classes are read from an attribute named like the parameter.
+# instance as XML); other classes are read from an attribute named like the parameter, and a
+# ``remap_to`` argument that no attribute keeps from the remappings of the behaviour's
+# blackboard clients (py_trees' ``register_key(key, remap_to=...)``).
 _STORED_AS = {"n": ("every_n", "period")}
 
 
@@ -254,6 +256,10 @@ def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[st
     results = vars(behaviour).get("blackboard_results")  # CheckBlackboardVariableValues
     if "namespace" in params and isinstance(results, py_trees.blackboard.Client):
         found["namespace"] = results.namespace
+    if "remap_to" in params and not any(a in vars(behaviour) for a in ("remap_to", "_remap_to")):
+        remapped = _client_remappings(behaviour)  # register_key(..., remap_to=...) of its own
+        if remapped:
+            found["remap_to"] = remapped
     for name in params:
         if name in found:
             continue
@@ -262,6 +268,16 @@ def recover_arguments(behaviour: Behaviour, params: dict[str, Param]) -> dict[st
                 found[name] = vars(behaviour)[attribute]
                 break
     return found
+
+
+def _client_remappings(behaviour: Behaviour) -> dict[str, str]:
+    """The keys that ``behaviour``'s blackboard clients registered remapped elsewhere
+    (``register_key(key, remap_to=...)``), as ``{key: remapped key}``."""
+    remapped: dict[str, str] = {}
+    for client in behaviour.blackboards:
+        mapping: dict[str, str] = object.__getattribute__(client, "remappings")
+        remapped.update({k: v for k, v in mapping.items() if k != v})
+    return remapped
 
 
 def port_info(p: Param) -> PortInformation:

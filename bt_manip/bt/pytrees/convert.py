@@ -30,9 +30,17 @@ composite and decorator gets its py_trees counterpart. One difference remains wi
 py_trees stops a child that had finished when its parent starts again (its
 ``terminate(INVALID)`` runs once more); a BT.CPP parent resets it without calling it.
 
+A ``Parallel`` whose SuccessOnSelected policy selects no child, or a behaviour that is not its
+child, is converted all the same: as in py_trees, its check raises at every tick (here a
+:class:`~bt_manip.bt.node.TreeRuntimeError` naming the node and those behaviours), and
+``to_xml`` refuses the selection.
+
 Leaves are wrapped (:mod:`bt_manip.bt.pytrees.leaf`), the very objects of the py_trees tree,
 so references kept to them stay live; ``py_trees.timers.Timer`` becomes ``PyTreesTimer``, which
-reads the tree's clock. Nodes that already are bt-manip nodes are kept.
+reads the tree's clock. Ports wired by ``setup_ports()`` before conversion (by the user's code or
+py_trees' XML parser) keep their wiring, and the tree's blackboard starts with the entries that
+``setup_ports()`` wrote (:mod:`bt_manip.bt.pytrees.wiring`). Nodes that already are bt-manip
+nodes are kept.
 """
 
 from __future__ import annotations
@@ -43,6 +51,7 @@ from typing import Any, cast
 import py_trees
 from py_trees.behaviour import Behaviour
 
+from bt_manip.bt.attributes import UnwritableText
 from bt_manip.bt.blackboard import Blackboard
 from bt_manip.bt.context import TreeContext
 from bt_manip.bt.node import BtNode
@@ -89,6 +98,7 @@ def from_py_trees(
     node = convert_node(root, builtins=builtins)
     tree = view.PyTreesViewTree(node, context=context, blackboard=blackboard, tree_id=tree_id)
     _register_leaves(node)
+    _seed_setup_entries(tree)
     return tree
 
 
@@ -118,16 +128,19 @@ def _composite(node: py_trees.composites.Composite, builtins: bool) -> BtNode:
         children = _children(node, builtins)
         attributes: dict[str, Any] = {"policy": type(policy).__name__,
                                       "synchronise": policy.synchronise}
-        if isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnSelected):
-            strangers = [c.name for c in policy.children if c not in originals]
-            if strangers:
-                raise TypeError(
-                    f"cannot convert parallel '{name}': its SuccessOnSelected policy names "
-                    f"{strangers}, which are not its children (py_trees ticks such a parallel "
-                    "to FAILURE)"
-                )
-            attributes["selected"] = [originals.index(c) for c in policy.children]
-        return ptc.PyTreesParallel(name, children, **attributes)
+        if not isinstance(policy, py_trees.common.ParallelPolicy.SuccessOnSelected):
+            return ptc.PyTreesParallel(name, children, **attributes)
+        selected = policy.children
+        attributes["selected"] = [originals.index(c) for c in selected if c in originals]
+        parallel = ptc.PyTreesParallel(name, children, **attributes)
+        strangers = [c.name for c in selected if c not in originals]
+        if strangers:  # py_trees' check raises at every tick, naming them; so does this one
+            parallel.policy.children = [children[originals.index(c)] if c in originals else c
+                                        for c in selected]
+            parallel.attribute_texts["selected"] = UnwritableText(
+                None, f"the SuccessOnSelected policy names {strangers}, which are not children "
+                "of the parallel")
+        return parallel
     if kind not in (py_trees.composites.Sequence, py_trees.composites.Selector):
         return _own_class(node, builtins)
     memory = bool(cast("py_trees.composites.Sequence | py_trees.composites.Selector", node).memory)
@@ -221,6 +234,15 @@ def _own_class(node: Behaviour, builtins: bool) -> BtNode:
     made.status = py_trees.common.Status.INVALID
     made._init_node({})
     return cast(BtNode, made)  # an instance of made_class, a BtNode subclass
+
+
+def _seed_setup_entries(tree: Tree) -> None:
+    """Write the entries py_trees' ``setup_ports()`` had written for the tree's behaviours
+    (constants, outputs' defaults) where the tree's blackboard has none yet."""
+    for walked in walk_nodes(tree.root):
+        for key, value in getattr(walked.node, "setup_entries", {}).items():
+            if not tree.blackboard.has_value(key):
+                tree.blackboard.set(key, value)
 
 
 def _register_leaves(root: BtNode) -> None:

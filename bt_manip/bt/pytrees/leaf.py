@@ -20,7 +20,9 @@ a constructor argument is fixed when the tree is built, so it cannot be a blackb
 A behaviour with py_trees ports (``BehaviourWithPorts`` / ``PortsMixin`` with ``INPUT_PORTS``
 and ``OUTPUT_PORTS``) gets them as bt-manip ports: ``port="{key}"`` wires the port to a
 blackboard entry, other text is a literal converted to the port's type; the behaviour's own
-``get_input()``/``_set_output()`` then read and write those.
+``get_input()``/``_set_output()`` then read and write those. A behaviour wrapped after its
+``setup_ports()`` ran (a converted py_trees tree) keeps that wiring
+(:mod:`bt_manip.bt.pytrees.wiring`).
 
 The blackboard bridge is :mod:`bt_manip.bt.pytrees.storage`, the conversion of constructor
 arguments :mod:`bt_manip.bt.pytrees.arguments`.
@@ -55,6 +57,12 @@ from bt_manip.bt.pytrees.storage import (
     EntryView,
     py_trees_storage,
     raised_as_tree_error,
+)
+from bt_manip.bt.pytrees.wiring import (
+    carried_wiring,
+    forget_client,
+    setup_entries,
+    subtree_namespace,
 )
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import RESULT_OF_PY_TREES, NodeStatus
@@ -101,7 +109,8 @@ class PyTreesLeaf(LeafNode):
             name = behaviour.name
             given = recover_arguments(behaviour, self.PARAMS)
             unknown = {p: Literal(_UNKNOWN) for p in self.PARAMS if p not in given}
-            attributes = {**unknown, **{k: Literal(v) for k, v in given.items()}, **attributes}
+            attributes = {**unknown, **{k: Literal(v) for k, v in given.items()},
+                          **carried_wiring(behaviour), **attributes}
         super().__init__(name or self.NODE_ID, **attributes)
         for port, binding in list(self.bindings.items()):
             if isinstance(binding, Literal) and binding.value is _UNKNOWN:
@@ -125,6 +134,9 @@ class PyTreesLeaf(LeafNode):
         self.behaviour = behaviour
         self.blackboards = behaviour.blackboards
         self._local: dict[str, Any] = {}
+        self.setup_entries: dict[str, Any] = setup_entries(behaviour)
+        """Entries py_trees' ``setup_ports()`` had written for the behaviour before it was
+        wrapped (a converted tree starts with them)."""
         if isinstance(behaviour, PortsMixin):
             self._wire_ports(behaviour)
 
@@ -171,8 +183,10 @@ class PyTreesLeaf(LeafNode):
                 remap[port] = PORT_PREFIX + port
                 if isinstance(binding, Literal):
                     self._local[PORT_PREFIX + port] = binding.value
+        namespace = subtree_namespace(behaviour)  # where an earlier setup_ports() put it
+        forget_client(behaviour)
         with py_trees_storage(EntryView(self.blackboard, self._local)):
-            behaviour.setup_ports(port_remappings=remap, subtree_namespace="/")
+            behaviour.setup_ports(port_remappings=remap, subtree_namespace=namespace)
 
     def _view(self) -> EntryView:
         return EntryView(self.blackboard, self._local)
@@ -304,12 +318,32 @@ _COUNTERPARTS: dict[type, Any] = {}
 
 
 def wrap(behaviour: Behaviour) -> LeafNode:
-    """A bt-manip leaf running ``behaviour`` (the object itself, not a copy)."""
-    counterpart = _clock_counterparts().get(type(behaviour))
+    """A bt-manip leaf running ``behaviour`` (the object itself, not a copy).
+
+    Its class gets the class name as ID, or its module-qualified name
+    (``py_trees.demos.stewardship.SuccessEveryN``) where the class name is registered for
+    another class, so that the XML ``to_xml`` writes loads this class back."""
+    cls = type(behaviour)
+    counterpart = _clock_counterparts().get(cls)
     if counterpart is not None:
         timer = cast(py_trees.timers.Timer, behaviour)  # the only class with a counterpart
         return counterpart(timer.name, duration=timer.duration)
-    return leaf_class_for(type(behaviour))(behaviour=behaviour)
+    return _conversion_class(cls)(behaviour=behaviour)
+
+
+_QUALIFIED: dict[type, type[PyTreesLeaf]] = {}
+
+
+def _conversion_class(cls: type[Behaviour]) -> type[PyTreesLeaf]:
+    if cls in _QUALIFIED:
+        return _QUALIFIED[cls]
+    leaf_class = leaf_class_for(cls)
+    registered = registry.get(leaf_class.NODE_ID)
+    if registered is None or getattr(registered, "BEHAVIOUR", None) is cls:
+        return leaf_class
+    qualified = leaf_class_for(cls, f"{cls.__module__}.{cls.__qualname__}")
+    _QUALIFIED[cls] = qualified
+    return qualified
 
 
 PY_TREES_LEAVES: tuple[type[Behaviour], ...] = (
