@@ -67,9 +67,7 @@ class ParticleFilter:
         self.options = options
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.sensor = SensorModel(field, options.z_hit, options.z_rand, options.sigma_hit)
-        self.wide_sensor = SensorModel(field, options.z_hit, options.z_rand,
-                                       max(options.sigma_hit, options.sigma_hit_wide))
-        """The broader field used while the particles are spread (see :meth:`_spread`)."""
+        self._wide_sensor: SensorModel | None = None
         self._z = standard_normal_quantile(options.pf_z)
         self._set: pset.ParticleSet | None = None
         self._last_odom: tuple[float, float, float] | None = None
@@ -155,6 +153,16 @@ class ParticleFilter:
             current = self._resample(current)
         self._set = current
         return True
+
+    @property
+    def wide_sensor(self) -> SensorModel:
+        """The broader field used while the particles are spread (see :meth:`_spread`), made
+        the first time it is needed (a filter that never loses the robot never makes it)."""
+        if self._wide_sensor is None:
+            o = self.options
+            self._wide_sensor = SensorModel(self.field, o.z_hit, o.z_rand,
+                                            max(o.sigma_hit, o.sigma_hit_wide))
+        return self._wide_sensor
 
     def _spread(self) -> bool:
         """Whether the particles are spread over more than one place (the last estimate's

@@ -234,6 +234,8 @@ class Localizer:
         self.map_to_odom: Pose = compose(start, inverse(self._odom()))
         self.next_scan = world.time
         self.last_scan: Scan | None = None
+        self._last_own: np.ndarray | None = None
+        """The self filter's beams of :attr:`last_scan` (the costmaps reuse them)."""
         self.errors = ErrorLog()
         self.kidnapped_at: float | None = None
         self._last_update: Pose | None = None
@@ -290,10 +292,11 @@ class Localizer:
     def _feed_costmaps(self, now: float) -> None:
         """Give the costmaps due now the latest scan (see the module docstring)."""
         assert self.costmaps is not None
-        scan = self.last_scan
-        if scan is None or abs(scan.time - now) > 1e-9:
+        scan, own = self.last_scan, self._last_own
+        if scan is None or own is None or abs(scan.time - now) > 1e-9:
             scan = self.lidar.scan(self.faults.lidar_dropout, rng=self._costmap_rng)
-        returned = ~scan.no_return & ~self._own_returns(scan)
+            own = self._own_returns(scan)
+        returned = ~scan.no_return & ~own
         pose = self.pose()
         sensor = compose(pose, scan.sensor_pose)
         self.costmaps.take(now, (pose[0], pose[1]), sensor, scan.angles, scan.ranges, returned)
@@ -326,7 +329,8 @@ class Localizer:
         """Scan, give the scan to the filter, and set ``map -> odom`` from its estimate."""
         scan = self.lidar.scan(self.faults.lidar_dropout)
         self.last_scan = scan
-        ranges = np.where(self._own_returns(scan), scan.range_max, scan.ranges)
+        self._last_own = own = self._own_returns(scan)
+        ranges = np.where(own, scan.range_max, scan.ranges)
         reading = FilterScan(ranges, scan.angle_min, scan.angle_increment, scan.range_max,
                              sensor_pose=scan.sensor_pose, time=now)
         if self.filter.update(OdomPose(odom.x, odom.y, odom.yaw, now), reading):

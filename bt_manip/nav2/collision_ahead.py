@@ -63,8 +63,7 @@ def blocked_ahead(nav: Navigator, points: np.ndarray, position: tuple[float, flo
     grid = nav.costmap.grid
     if nav.layers is not None:
         ahead, s = stretch_ahead(points, position, lookahead)
-        reach = nav.footprint.half_width + grid.resolution / np.sqrt(2.0)
-        k = nav.layers.local.first_blocked(ahead, reach)
+        k = nav.layers.local.first_in_way(ahead, nav.footprint.half_width)
         return None if k is None else Blocked(LOCAL_MARK, float(s[k]))
     if not grid.sources:
         return None

@@ -538,8 +538,8 @@ class Navigator:
     def _path_blocked(self, ahead: np.ndarray) -> bool:
         if self.layers is not None:
             self.refresh()
-            reach = self.planning_footprint.half_width + self.options.resolution / math.sqrt(2.0)
-            return self.layers.local.first_blocked(ahead, reach) is not None
+            return self.layers.local.first_in_way(ahead,
+                                                  self.planning_footprint.half_width) is not None
         if not self.movable or not self.refresh():
             return False
         rows, cols = self._cells(ahead)

@@ -117,6 +117,12 @@ class RollingWindow:
         self.move_to(*robot_xy, reach=reach)
         return self.layer.version != before
 
+    def first_in_way(self, points: np.ndarray, half_width: float) -> int | None:
+        """Index of the first of ``points`` where a footprint of ``half_width`` (m) would
+        touch a marked cell: within the half width plus half a cell's diagonal of the cell's
+        centre (:meth:`first_blocked`); None when none is."""
+        return self.first_blocked(points, half_width + self.layer.resolution / math.sqrt(2.0))
+
     def first_blocked(self, points: np.ndarray, reach: float) -> int | None:
         """Index of the first of ``points`` (n, 2; map frame) within ``reach`` (m) of a marked
         cell's centre, or None when none is."""
