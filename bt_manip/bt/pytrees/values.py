@@ -127,7 +127,7 @@ def _build(obj: dict[str, Any]) -> Any:
     name, state = obj[TYPE_KEY], obj[STATE_KEY]
     if not isinstance(name, str):
         raise ValueTypeError(f'"{TYPE_KEY}" names a value type, got {_short(name)}')
-    cls = registry.value_type(name)
+    cls: Any = registry.value_type(name)
     if cls is None:
         known = ", ".join(sorted(registry.value_types())) or "none"
         raise ValueTypeError(
