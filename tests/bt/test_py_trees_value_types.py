@@ -18,6 +18,7 @@ import py_trees
 import pytest
 
 from bt_manip.bt import NodeStatus, from_py_trees, load_tree_string, registry, to_xml
+from bt_manip.bt.pytrees.values import MAX_DEPTH
 from bt_manip.bt.tree import Tree
 from bt_manip.cli import main
 from bt_manip.errors import InputError
@@ -210,10 +211,39 @@ def test_malformed_values_are_load_errors(trusted: None, written: str, problem: 
     assert problem in message
 
 
-def test_json_nested_too_deeply_is_a_load_error() -> None:
-    depth = 100_000
-    with pytest.raises(InputError, match="the JSON is nested too deeply"):
+@pytest.mark.parametrize("depth", [MAX_DEPTH + 1, 100_000])
+def test_json_nested_too_deeply_is_a_load_error(depth: int) -> None:
+    with pytest.raises(InputError) as raised:
         load_tree_string(set_v("[" * depth + "]" * depth))
+    assert str(raised.value) == (
+        "<string>:3: bad value for parameter 'variable_value' of SetBlackboardVariable: the JSON "
+        f"is nested more than {MAX_DEPTH} levels deep")
+    tree = load_tree_string(set_v("[" * MAX_DEPTH + "]" * MAX_DEPTH))  # as deep as allowed
+    tree.tick()
+    value, levels = tree.blackboard.get("v"), 1
+    while value:
+        (value,), levels = value, levels + 1
+    assert levels == MAX_DEPTH
+
+
+def test_the_deepest_value_that_is_written_loads_back(trusted: None) -> None:
+    written = None
+    for depth in range(MAX_DEPTH):
+        nested: Any = 1
+        for _ in range(depth):
+            nested = [nested]
+        try:
+            written = (depth, to_xml(setter(Point(nested, 0))))
+        except ValueError as e:
+            assert "the Point's attribute 'x'" in str(e) and "levels deep" in str(e)
+            break
+    assert written is not None and written[0] > MAX_DEPTH // 2
+    tree = load_tree_string(written[1])
+    tree.tick()
+    value = tree.blackboard.get("v")
+    for _ in range(written[0]):
+        value.x = value.x[0]
+    assert value.x == 1
 
 
 def test_an_object_of_an_unregistered_class_is_not_written() -> None:
@@ -245,7 +275,7 @@ def test_a_value_whose_attributes_are_not_json_is_not_written(attribute: Any,
 def test_a_value_that_holds_itself_is_not_written(trusted: None) -> None:
     loop = Point(0, 0)
     loop.x = [loop]
-    with pytest.raises(ValueError, match="nested more than 64 levels deep"):
+    with pytest.raises(ValueError, match="nested more than 100 levels deep"):
         to_xml(setter(loop))
 
 

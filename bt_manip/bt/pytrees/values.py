@@ -30,8 +30,9 @@ from bt_manip.bt.registry import registry
 
 TYPE_KEY = "$type"
 STATE_KEY = "state"
-MAX_DEPTH = 64
-"""The deepest nesting of lists, dicts and values that a value type's attributes may have."""
+MAX_DEPTH = 100
+"""The deepest nesting of JSON lists and objects in a constructor argument, read or written (a
+value counts two: its ``$type`` object and its ``state``)."""
 
 _RESERVED = re.compile(r"\$+type")
 _JSON_SCALARS = (str, int, float, bool, type(None))
@@ -67,12 +68,12 @@ def encode_value(value: Any, depth: int = 0) -> dict[str, Any]:
     state: dict[str, Any] = {}
     for key, item in vars(value).items():
         where = f"the {name}'s attribute '{key}'"
-        state[escape_key(str(key))] = _state_item(item, where, depth + 1)
+        state[escape_key(str(key))] = _state_item(item, where, depth + 2)
     return {TYPE_KEY: name, STATE_KEY: state}
 
 
 def _state_item(value: Any, where: str, depth: int) -> Any:
-    if depth > MAX_DEPTH:
+    if depth >= MAX_DEPTH:
         raise ValueError(f"{where} is nested more than {MAX_DEPTH} levels deep")
     if type(value) in _JSON_SCALARS:
         return value
@@ -97,11 +98,37 @@ def loads(text: str) -> Any:
     """``json.loads(text)`` with ``$type`` objects built and escaped keys restored.
 
     Raises json.JSONDecodeError for text that is not JSON, ValueTypeError for a ``$type``
-    object that cannot be built or JSON nested too deeply."""
+    object that cannot be built or JSON nested more than :data:`MAX_DEPTH` levels deep."""
+    too_deep = ValueTypeError(f"the JSON is nested more than {MAX_DEPTH} levels deep")
     try:
-        return json.loads(text, object_hook=_object_hook)
+        value = json.loads(text, object_hook=_object_hook)
     except RecursionError:
-        raise ValueTypeError("the JSON is nested too deeply") from None
+        raise too_deep from None
+    if _depth(value) > MAX_DEPTH:
+        raise too_deep
+    return value
+
+
+def _depth(value: Any) -> int:
+    """How many lists and dicts are nested in ``value`` (a value's attributes counted as a
+    ``$type`` object holding its ``state``); no recursion."""
+    deepest = 0
+    pending = [(value, 0)]
+    while pending:
+        item, depth = pending.pop()
+        if isinstance(item, list):
+            children, depth = item, depth + 1
+        elif isinstance(item, dict):
+            children, depth = list(item.values()), depth + 1
+        elif is_value(item):
+            children, depth = list(vars(item).values()), depth + 2
+        else:
+            continue
+        deepest = max(deepest, depth)
+        if depth > MAX_DEPTH:
+            break
+        pending.extend((child, depth) for child in children)
+    return deepest
 
 
 def _object_hook(obj: dict[str, Any]) -> Any:
