@@ -201,6 +201,8 @@ def test_an_unregistered_value_type_is_a_load_error_naming_file_line_node_and_ty
     ('{"$type": "Point", "state": [1, 2]}',
      'the "state" of a Point is a JSON object of its attributes, got [1, 2]'),
     ('[{"$type": "Nowhere", "state": {}}]', "value type 'Nowhere' is not registered"),
+    ('{"$type": "Now\\nhere' + "x" * 100 + '", "state": {}}',
+     "value type 'Now\\nhere" + "x" * 51 + "...' is not registered"),
 ])
 def test_malformed_values_are_load_errors(trusted: None, written: str, problem: str) -> None:
     with pytest.raises(InputError) as raised:

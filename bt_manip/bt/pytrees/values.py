@@ -156,11 +156,14 @@ def _build(obj: dict[str, Any]) -> Any:
         raise ValueTypeError(f'"{TYPE_KEY}" names a value type, got {_short(name)}')
     cls: Any = registry.value_type(name)
     if cls is None:
-        known = ", ".join(sorted(registry.value_types())) or "none"
+        names = sorted(registry.value_types())
+        known = ", ".join(names[:10]) + (f" and {len(names) - 10} more" if names[10:] else "")
+        shown = _short(name)[1:-1]  # the file's text, escaped and cut short
         raise ValueTypeError(
-            f"value type '{name}' is not registered (registered: {known}); the program that "
-            f"loads this tree must trust its class first: registry.register_value_type({name}) "
-            "(for bt-manip's commands, in a module given with --import)")
+            f"value type '{shown}' is not registered (registered: {known or 'none'}); the "
+            "program that loads this tree must trust its class first: "
+            f"registry.register_value_type({shown}) (for bt-manip's commands, in a module "
+            "given with --import)")
     if not isinstance(state, dict):
         raise ValueTypeError(f'the "{STATE_KEY}" of a {name} is a JSON object of its '
                              f"attributes, got {_short(state)}")
