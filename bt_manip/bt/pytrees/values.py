@@ -158,7 +158,8 @@ def _build(obj: dict[str, Any]) -> Any:
     if cls is None:
         names = sorted(registry.value_types())
         known = ", ".join(names[:10]) + (f" and {len(names) - 10} more" if names[10:] else "")
-        shown = _short(name)[1:-1]  # the file's text, escaped and cut short
+        shown = json.dumps(name)[1:-1]  # the file's text, escaped and cut short
+        shown = shown if len(shown) <= 60 else shown[:60] + "..."
         raise ValueTypeError(
             f"value type '{shown}' is not registered (registered: {known or 'none'}); the "
             "program that loads this tree must trust its class first: "
