@@ -8,7 +8,12 @@ optional value, JSON for lists and dicts (``queue='["SUCCESS", "RUNNING"]'``), p
 and a function of the ``operator`` module by its name (``operator="xor"``). Each argument is
 declared as an input port (:func:`port_info`) in the TreeNodesModel.
 
-A value none of these can hold (an object of another class, a lambda) is kept as
+An object of a class the program registered as a value type
+(``registry.register_value_type(Nested)``) is written in that JSON as its type's name and its
+attributes, ``{"$type": "Nested", "state": {"foo": "bar"}}``, and built back only where the
+loading program registered that name (:mod:`bt_manip.bt.pytrees.values`).
+
+A value none of these can hold (an object of an unregistered class, a lambda) is kept as
 :class:`UnwritableText`: ``to_xml`` refuses to write it rather than write a file that loads
 with another meaning.
 """
@@ -31,6 +36,8 @@ from py_trees.ports import PortInformation
 
 from bt_manip.bt.attributes import UnwritableText
 from bt_manip.bt.ports import convert_literal
+from bt_manip.bt.pytrees import values
+from bt_manip.bt.pytrees.values import ValueTypeError
 
 _NONE_TEXT = ("", "null", "none")
 
@@ -90,6 +97,8 @@ def convert_param(text: str, annotation: Any) -> Any:
     for option in options:
         try:
             return _convert_one(text, option)
+        except ValueTypeError:  # a registered value's JSON: no other reading makes sense
+            raise
         except ValueError as e:
             errors.append(str(e))
     raise ValueError("; ".join(dict.fromkeys(errors)))
@@ -103,13 +112,13 @@ def _convert_one(text: str, annotation: Any) -> Any:
     origin = get_origin(annotation)
     if origin in (list, tuple, dict, set) or annotation in (list, tuple, dict, set):
         try:
-            value = json.loads(text)
+            value = values.loads(text)
         except json.JSONDecodeError as e:
             raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
         return _from_json(value, annotation)
     if annotation is ComparisonExpression:
         try:
-            return _comparison(json.loads(text))
+            return _comparison(values.loads(text))
         except json.JSONDecodeError as e:
             raise ValueError(f"expected JSON ({e.msg} at column {e.colno}), got '{text}'") from None
     if origin is Callable or annotation is Callable:
@@ -118,7 +127,7 @@ def _convert_one(text: str, annotation: Any) -> Any:
         return convert_literal(text, annotation)
     if annotation is Any or annotation is object or annotation is inspect.Parameter.empty:
         try:
-            return json.loads(text)
+            return values.loads(text)
         except json.JSONDecodeError:
             return text
     name = getattr(annotation, "__name__", str(annotation))
@@ -205,11 +214,15 @@ def format_param(value: Any) -> str:
             return json.dumps(_jsonable(value))
         if isinstance(value, (int, float, str)):
             return str(value)
+        if values.is_value(value):
+            return json.dumps(values.encode_value(value))
         if callable(value):
             return _operator_name(value)
     except (TypeError, ValueError) as e:
         return UnwritableText(value, str(e))
-    return UnwritableText(value, f"a {type(value).__name__} cannot be written in XML")
+    kind = type(value).__name__
+    return UnwritableText(value, f"a {kind} cannot be written in XML; to write it as its "
+                          f"attributes, register its class: registry.register_value_type({kind})")
 
 
 def _operator_name(function: Any) -> str:
@@ -231,11 +244,13 @@ def _jsonable(value: Any) -> Any:
         return {"variable": value.variable, "value": _jsonable(generator()),
                 "operator": _operator_name(value.operator)}
     if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
+        return {values.escape_key(str(k)): _jsonable(v) for k, v in value.items()}
     if isinstance(value, (list, tuple, set)):
         return [_jsonable(v) for v in value]
     if isinstance(value, (str, int, float, bool, type(None))):
         return value
+    if values.is_value(value):
+        return values.encode_value(value)
     raise ValueError(f"a {type(value).__name__} cannot be written in XML")
 
 
