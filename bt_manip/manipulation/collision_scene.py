@@ -599,23 +599,28 @@ class CollisionScene:
         meshes: a stricter answer (never free where the meshes touch), several times cheaper
         near obstacles."""
         n = max(1, math.ceil(float(np.abs(b - a).max()) / step))
-        configs = a + np.multiply.outer(_fractions(n), b - a)
         self._fresh()
         if hulls_only:
             model, data, broad = self.model, self.data, self._broad
             collisions = pin.computeCollisions
-            for k, q in enumerate(configs):
-                if collisions(model, data, broad, q, True):
-                    self.checks += k + 1
-                    return False
-            self.checks += n
+
+            def hit(q: np.ndarray) -> bool:
+                return bool(collisions(model, data, broad, q, True))
+        else:
+            hit = self._hit
+        # the end first (as the bisection order has it): most blocked segments stop here,
+        # before the others are computed
+        self.checks += 1
+        if hit(b):
+            return False
+        if n == 1:
             return True
-        hit = self._hit
+        configs = a + np.multiply.outer(_fractions(n)[1:], b - a)
         for k, q in enumerate(configs):
             if hit(q):
                 self.checks += k + 1
                 return False
-        self.checks += n
+        self.checks += n - 1
         return True
 
     def within_limits(self, q: np.ndarray) -> bool:

@@ -2,7 +2,10 @@
 
 :func:`plan` grows one tree from the start and one from the goal (RRT-Connect: each round one
 tree extends toward a random configuration and the other tries to connect to the new node all
-the way), joins them and shortcuts the path. Everything is deterministic: the random stream is
+the way), joins them and shortcuts the path. The trees take turns until one has outgrown the
+other several times over: the smaller one is then trapped (a goal deep in a shelf, from which
+few directions are free) and gets every round, half of them aimed near its own nodes, until it
+catches up. Everything is deterministic: the random stream is
 a ``numpy`` generator seeded by the caller (from the episode seed and the node's path), and the
 budget is a count of collision checks (:attr:`PlanOptions.max_checks`), never wall time, so a
 plan is the same on every machine. Segments are checked at :attr:`PlanOptions.step` rad per
@@ -26,6 +29,10 @@ from typing import Protocol
 import numpy as np
 
 from bt_manip.manipulation.collision_scene import CollisionScene, named_contacts
+
+# numpy's einsum without its Python wrapper, which costs more than the sums of a small tree
+_einsum: Callable[..., np.ndarray] = getattr(
+    getattr(getattr(np, "_core", None), "multiarray", None), "c_einsum", np.einsum)
 
 __all__ = [
     "PlanError", "PlanOptions", "PlanResult", "check_end", "path_length", "plan", "plan_steps",
@@ -54,6 +61,20 @@ class PlanOptions:
     near as short as the remaining attempts would make it, at a fraction of their checks."""
     goal_bias: float = 0.05
     """Share of samples that are the other tree's root."""
+    balance: float = 3.0
+    """A tree with more than this many times the other's nodes (and at least
+    :attr:`balance_from` of them) waits while the smaller one extends: a tree trapped in a
+    narrow region (a goal deep in a shelf) gets the samples instead of the tree that grows
+    easily (0: the trees take turns whatever their sizes)."""
+    balance_from: int = 100
+    """Nodes the larger tree must have before :attr:`balance` applies (an easy problem's
+    trees, smaller than this, take turns)."""
+    trapped_share: float = 0.5
+    """Share of a trapped tree's extensions (the smaller one while :attr:`balance` applies)
+    aimed near one of its own nodes rather than anywhere: from a narrow pocket, a short step
+    is far likelier to be free than one toward a far corner of the joint space."""
+    trapped_spread: float = 0.2
+    """Standard deviation (rad, per joint) of those nearby targets around the chosen node."""
     validate_step: float = 0.01
     """The found path is checked again at this resolution (rad per joint); a segment that
     clips an obstacle between the coarser checks is planned again at this resolution."""
@@ -95,7 +116,7 @@ class _Tree:
 
     def nearest(self, q: np.ndarray) -> int:
         d = self.q[: self.n] - q
-        return int(np.argmin(np.einsum("ij,ij->i", d, d)))
+        return int(_einsum("ij,ij->i", d, d).argmin())
 
     def branch(self, index: int) -> list[np.ndarray]:
         out = []
@@ -195,6 +216,7 @@ def plan_steps(
     lo = np.where(np.isfinite(scene.lower), scene.lower, -math.pi)
     hi = np.where(np.isfinite(scene.upper), scene.upper, math.pi)
     trees = (_Tree(start, 1024), _Tree(goal, 1024))
+    draws = _Draws(rng, lo, hi)
     samples = 0
     a, b = 0, 1
     while scene.checks - first < options.max_checks:
@@ -202,10 +224,14 @@ def plan_steps(
             raise PlanError(f"stopped after {samples} samples ({scene.checks - first} collision "
                             f"checks; trees of {trees[0].n} and {trees[1].n} nodes)")
         samples += 1
-        if rng.random() < options.goal_bias:
+        a, b, trapped = _turn(trees, a, b, options)
+        if draws.coin() < options.goal_bias:
             target = trees[b].q[0].copy()
+        elif trapped and draws.coin() < options.trapped_share:
+            near = trees[a].q[min(int(draws.coin() * trees[a].n), trees[a].n - 1)]
+            target = np.clip(near + options.trapped_spread * draws.normal(), lo, hi)
         else:
-            target = rng.uniform(lo, hi)
+            target = draws.config()
         grown = _extend(free, trees[a], target, options)
         if grown is not None:
             met = _connect(free, trees[b], trees[a].q[grown], options)
@@ -223,6 +249,55 @@ def plan_steps(
         f"no path within {options.max_checks} collision checks ({samples} samples; the start "
         f"tree grew to {trees[0].n} nodes, the goal tree to {trees[1].n})"
     )
+
+
+class _Draws:
+    """The search's random numbers, drawn from the generator in blocks (one draw of a block
+    costs about what one configuration's did): coin flips in [0, 1), configurations uniform
+    within the limits and standard normal steps, each kind in the order asked."""
+
+    BLOCK = 128
+
+    def __init__(self, rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray) -> None:
+        self._rng, self._lo, self._span = rng, lo, hi - lo
+        self._coins = np.empty(0)
+        self._configs: np.ndarray = np.empty((0, lo.size))
+        self._normals: np.ndarray = np.empty((0, lo.size))
+        self._c = self._q = self._g = 0
+
+    def coin(self) -> float:
+        if self._c == len(self._coins):
+            self._coins, self._c = self._rng.random(self.BLOCK), 0
+        self._c += 1
+        return float(self._coins[self._c - 1])
+
+    def config(self) -> np.ndarray:
+        if self._q == len(self._configs):
+            u = self._rng.random((self.BLOCK, self._lo.size))
+            self._configs, self._q = self._lo + self._span * u, 0
+        self._q += 1
+        row: np.ndarray = self._configs[self._q - 1]
+        return row
+
+    def normal(self) -> np.ndarray:
+        if self._g == len(self._normals):
+            self._normals = self._rng.standard_normal((self.BLOCK, self._lo.size))
+            self._g = 0
+        self._g += 1
+        row: np.ndarray = self._normals[self._g - 1]
+        return row
+
+
+def _turn(trees: tuple[_Tree, _Tree], a: int, b: int,
+          options: PlanOptions) -> tuple[int, int, bool]:
+    """Which tree extends this round and which connects, and whether the extending one is
+    trapped: the smaller one when the other outgrew it (:attr:`PlanOptions.balance`), else the
+    one whose turn it is."""
+    small, large = (0, 1) if trees[0].n < trees[1].n else (1, 0)
+    n = trees[large].n
+    if options.balance and n >= options.balance_from and trees[small].n * options.balance < n:
+        return small, large, True
+    return a, b, False
 
 
 def _validated(

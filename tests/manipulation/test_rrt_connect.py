@@ -3,6 +3,7 @@ beside a wall. Paths are checked again on the exact meshes at 0.01 rad per joint
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from typing import cast
 
@@ -276,3 +277,59 @@ def test_shortcut_attempts_end_after_the_failures_in_a_row() -> None:
         assert len(out) == 3 and all(np.array_equal(a, b) for a, b in zip(out, path,
                                                                             strict=True))
         assert rng.draws == attempts
+
+
+
+class _Pocket:
+    """A cube of 3 joints, -2..2 rad, with the goal in a hollow box (0.6 rad inside, walls 0.2
+    thick) whose only way out is a slot 0.1 x 0.1 in its wall facing the start."""
+
+    checks = 0
+    lower, upper = np.full(3, -2.0), np.full(3, 2.0)
+    joint_names = ("a", "b", "c")
+    centre = np.array([1.0, 0.0, 0.0])
+
+    def _blocked(self, qs: np.ndarray) -> np.ndarray:
+        d = np.abs(qs - self.centre)
+        far = d.max(axis=-1)
+        slot = (qs[..., 0] < 1.0) & (d[..., 1:].max(axis=-1) < 0.05)
+        return np.asarray((far >= 0.3) & (far < 0.5) & ~slot)
+
+    def collides(self, q: np.ndarray) -> bool:
+        self.checks += 1
+        return bool(self._blocked(q))
+
+    def segment_free(self, a: np.ndarray, b: np.ndarray, step: float) -> bool:
+        n = max(1, int(np.ceil(np.max(np.abs(b - a)) / step)))
+        blocked = self._blocked(a + np.multiply.outer(np.arange(1, n + 1) / n, b - a))
+        self.checks += int(np.argmax(blocked)) + 1 if blocked.any() else n
+        return not blocked.any()
+
+    def within_limits(self, q: np.ndarray) -> bool:
+        return bool(np.all(np.abs(q) <= 2.0))
+
+    def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
+        return [("point", "pocket")] if self.collides(q) else []
+
+
+def test_a_trapped_goal_tree_gets_the_rounds_and_nearby_targets() -> None:
+    # From the pocket, almost every step toward a random point hits its walls: taking turns,
+    # the goal tree stays a few nodes while the start tree fills the cube, and most seeds run
+    # out of checks. Balanced (the smaller tree extends once the other has three times its
+    # nodes), with half its targets near its own nodes, every seed finds the slot.
+    start, goal = np.array([-1.5, 0.0, 0.0]), np.array([1.1, 0.15, 0.0])
+    plain = PlanOptions(balance=0.0, max_checks=13_000)
+    balanced = dataclasses.replace(plain, balance=3.0, balance_from=100, trapped_share=0.5)
+    solved_plain = 0
+    for seed in range(4):
+        try:
+            plan(cast(CollisionScene, _Pocket()), start, goal, np.random.default_rng(seed), plain)
+            solved_plain += 1
+        except PlanError as e:
+            assert "no path within" in str(e)
+        scene = _Pocket()
+        result = plan(cast(CollisionScene, scene), start, goal, np.random.default_rng(seed),
+                      balanced)
+        assert np.array_equal(result.path[0], start) and np.array_equal(result.path[-1], goal)
+        assert all(scene.segment_free(a, b, 0.01) for a, b in itertools.pairwise(result.path))
+    assert solved_plain <= 1
