@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.bim import ifc_attributes as at
-from bt_manip.bim.hulls import hull_xy, unique_rows
+from bt_manip.bim.hulls import SMALL_HULL, hull_xy, monotone_chain, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
            "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
@@ -580,10 +580,44 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
 
     The yaw follows the longer horizontal side; of its two senses the one nearer ``hint_yaw``
     (the element's placement x axis) is taken, so a wall keeps the direction it was drawn in.
+
+    The box is the least of the boxes along the edges of the points' hull, the first of them
+    in Qhull's order when several are within 1e-9 m2 of the least. The hull of a few points
+    is found without Qhull (:func:`~bt_manip.bim.hulls.monotone_chain`): its edges are
+    Qhull's, in the same turn but from another corner, which changes nothing unless boxes
+    along different angles tie; only then is Qhull asked for its order.
     """
     xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
-    angles = _candidate_angles(xy)
+    chain = _chain_hull(xy)
+    found = _least_box(xy, _edge_angles(chain)) if chain is not None else None
+    if found is None or not found[3]:  # Qhull's order decides
+        found = _least_box(xy, _candidate_angles(xy))
+    angle, lo, hi, _ = found
+    a0 = angle
+    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    if width > length:
+        angle += math.pi / 2
+        length, width = width, length
+    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
+        angle += math.pi
+    angle = math.atan2(math.sin(angle), math.cos(angle))
+    mid_u, mid_v = (lo + hi) / 2
+    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
+    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
+    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+
+
+TIE = 1e-9
+"""Boxes whose footprints differ by less than this (m2) are equally small."""
+
+
+def _least_box(xy: np.ndarray,
+               angles: list[float]) -> tuple[float, np.ndarray, np.ndarray, bool]:
+    """The angle, and the low and high corners (along and across it), of the least of the
+    boxes along ``angles``: the first of the least, as :data:`TIE` apart; and whether that
+    box is the same in any order of ``angles`` (False when boxes within twice the tie of the
+    least lie along angles that are not all the same number)."""
     # every candidate at once: the points' coordinates along (u) and across (v) each angle
     c = np.array([math.cos(a) for a in angles])
     s = np.array([math.sin(a) for a in angles])
@@ -593,28 +627,36 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
     lows = np.stack([u.min(axis=0), v.min(axis=0)], axis=1)
     highs = np.stack([u.max(axis=0), v.max(axis=0)], axis=1)
     areas = (highs[:, 0] - lows[:, 0]) * (highs[:, 1] - lows[:, 1])
+    # the pick is one of the boxes within TIE of the least, whatever the order: when they all
+    # lie along the same angle, it is the same box
+    near = [angles[k] for k in np.flatnonzero(areas <= areas.min() + 2 * TIE)]
+    order_free = all(a == near[0] for a in near)
     pick = 0
-    for k in range(1, len(angles)):  # the first of the least, as 1e-9 apart
-        if areas[k] < areas[pick] - 1e-9:
+    for k in range(1, len(angles)):  # the first of the least, as TIE apart
+        if areas[k] < areas[pick] - TIE:
             pick = k
-    angle, lo, hi = angles[pick], lows[pick], highs[pick]
-    best = (float(areas[pick]), angle)
-    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
-    if width > length:
-        angle += math.pi / 2
-        length, width = width, length
-    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
-        angle += math.pi
-    angle = math.atan2(math.sin(angle), math.cos(angle))
-    mid_u, mid_v = (lo + hi) / 2
-    a0 = best[1]
-    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
-    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
-    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+    return angles[pick], lows[pick], highs[pick], order_free
+
+
+def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
+    """The corners, counter-clockwise, of the hull :func:`_candidate_angles` takes the edges
+    of, when it has few points and at least three corners (else None: Qhull's case)."""
+    pts = unique_rows(np.round(xy, 6))
+    if len(pts) < 3 or len(pts) > SMALL_HULL:
+        return None
+    chain = monotone_chain(pts)
+    return chain if len(chain) >= 3 else None
+
+
+def _edge_angles(hull: np.ndarray) -> list[float]:
+    """The directions, modulo 90 degrees, of the edges of a polygon (corners in turn)."""
+    edges = np.roll(hull, -1, axis=0) - hull
+    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
 
 
 def _candidate_angles(xy: np.ndarray) -> list[float]:
-    """Edge directions of the convex hull of ``xy`` (one of them bounds the least box)."""
+    """Edge directions of the convex hull of ``xy`` (one of them bounds the least box), in
+    Qhull's order."""
     from scipy.spatial import ConvexHull, QhullError
 
     pts = unique_rows(np.round(xy, 6))
@@ -628,8 +670,7 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     except QhullError:  # collinear points
         d = pts[-1] - pts[0]
         return [math.atan2(d[1], d[0])]
-    edges = np.roll(hull, -1, axis=0) - hull
-    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+    return _edge_angles(hull)
 
 
 def hull_prism(points: np.ndarray) -> np.ndarray:

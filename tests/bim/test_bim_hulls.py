@@ -77,3 +77,26 @@ def test_strip_boxes_are_hull_boxes() -> None:
         corners = hull_xy(xy)
         box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), 0.3)
         assert strip_boxes(corners, box, 0.0, 1.0) == hull_boxes(points, 0.0, 1.0, 0.3)
+
+
+def test_least_box_without_qhull_is_qhulls(monkeypatch: pytest.MonkeyPatch) -> None:
+    """footprint_box takes its candidate angles from the monotone chain, whose corners start
+    elsewhere than Qhull's: the boxes are Qhull's to the last bit, ties included (squares and
+    regular polygons, whose least boxes along different edges are equally small, go to
+    Qhull's order)."""
+    import bt_manip.bim.shapes as shapes
+
+    ties = []
+    for n in (4, 6, 8, 12):  # regular polygons, turned: boxes along different edges tie
+        angles = np.arange(n) * (2 * math.pi / n) + 0.3
+        ties.append(np.column_stack([np.cos(angles), np.sin(angles)]) * 2.0 + [5.0, -3.0])
+    sets = [*_shapes(3), *ties, np.array([[0, 0], [2, 0], [2, 1], [0, 1.0]])]
+    asked: list[int] = []
+    qhull_angles = shapes._candidate_angles
+    monkeypatch.setattr(shapes, "_candidate_angles",
+                        lambda xy: asked.append(len(xy)) or qhull_angles(xy))
+    fast = [footprint_box(np.column_stack([xy, np.zeros(len(xy))]), 0.4) for xy in sets]
+    assert 0 < len(asked) < len(sets)  # Qhull's order asked for the ties only
+    monkeypatch.setattr(shapes, "_chain_hull", lambda xy: None)  # Qhull's order always
+    assert fast == [footprint_box(np.column_stack([xy, np.zeros(len(xy))]), 0.4)
+                    for xy in sets]
