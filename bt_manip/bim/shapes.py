@@ -503,7 +503,7 @@ def _profile_points(profile: Any, axis: Any = None,
             pts = found
         else:
             return None
-        if len(pts) > 1 and np.allclose(pts[0], pts[-1]):
+        if len(pts) > 1 and _close(pts[0], pts[-1]):
             pts = pts[:-1]
         if len(pts) < 3:
             return None
@@ -562,6 +562,15 @@ def _composite_points(curve: Any, angle_unit: float, axis: Any) -> np.ndarray | 
     if not chunks:
         return None
     return np.vstack(chunks)
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    """``np.allclose(a, b)`` of two points: the same test (``|a - b| <= 1e-8 + 1e-5 * |b|``
+    for each coordinate) without numpy's setup, for finite coordinates."""
+    pairs = list(zip(a.tolist(), b.tolist(), strict=True))
+    if not all(math.isfinite(u) and math.isfinite(v) for u, v in pairs):
+        return bool(np.allclose(a, b))
+    return all(abs(u - v) <= 1e-08 + 1e-05 * abs(v) for u, v in pairs)
 
 
 def _polyline_points(polyline: Any) -> np.ndarray:
