@@ -100,3 +100,19 @@ def test_least_box_without_qhull_is_qhulls(monkeypatch: pytest.MonkeyPatch) -> N
     monkeypatch.setattr(shapes, "_chain_hull", lambda xy: None)  # Qhull's order always
     assert fast == [footprint_box(np.column_stack([xy, np.zeros(len(xy))]), 0.4)
                     for xy in sets]
+
+
+def test_full_footprints_without_geos_are_geos(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A hull that clearly fills its box is found full from its corners' polygon; GEOS's
+    hull gives the same boxes for every shape (boxes, polygons, round and scattered ones)."""
+    import bt_manip.bim.footprints as footprints
+
+    cases = []
+    for xy in _shapes(4):
+        corners = hull_xy(xy)
+        cases.append((corners, footprint_box(np.column_stack([corners, np.zeros(len(corners))]),
+                                             0.2)))
+    fast = [strip_boxes(corners, box, 0.0, 1.0) for corners, box in cases]
+    assert sum(len(boxes) == 1 for boxes in fast) > len(cases) // 4  # full ones among them
+    monkeypatch.setattr(footprints, "_shoelace", lambda pts: -math.inf)  # GEOS decides
+    assert fast == [strip_boxes(corners, box, 0.0, 1.0) for corners, box in cases]
