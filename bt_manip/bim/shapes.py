@@ -17,7 +17,8 @@ body whose volume is much less than that box's is not box-like (a curved or L-sh
 tilted element).
 
 A reader computes each placement once (object placements up their chains, the
-IfcAxis2Placements of items and mapping origins), as elements share them, and reads each
+IfcAxis2Placements of items and mapping origins, the mapped items' transformations), as
+elements share them, and reads each
 point of the polygon loops once. Attributes are read by position
 (:mod:`~bt_manip.bim.ifc_attributes`): by name, ifcopenshell takes several times longer.
 """
@@ -88,6 +89,7 @@ class ShapeReader:
         self._placements: dict[int, np.ndarray] = {}
         self._axes: dict[int, np.ndarray] = {}
         self._coordinates: dict[int, Any] = {}
+        self._mappings: dict[tuple[int, int], np.ndarray] = {}
         self._angle: float | None = None
 
     def placement(self, placement: Any) -> np.ndarray:
@@ -245,15 +247,23 @@ class ShapeReader:
 
     def _mapping(self, item: Any) -> np.ndarray:
         """The transformation of a mapped item (as ifcopenshell.util.placement's
-        get_mappeditem_transformation, its mapping origin's matrix kept per reader)."""
+        get_mappeditem_transformation), kept per reader for each pair of transformation
+        operator and mapped representation: exporters give many mapped items one operator
+        (often the identity) and one representation."""
         import ifcopenshell.util.placement as placement
 
-        origin = self.axis(item.get_argument(at.MAPPING_SOURCE).get_argument(at.MAPPING_ORIGIN))
+        source = item.get_argument(at.MAPPING_SOURCE)
         target = item.get_argument(at.MAPPING_TARGET)
-        if target.is_a("IfcCartesianTransformationOperator3D"):
-            found: np.ndarray = np.asarray(_operator_matrix(target) @ origin, dtype=float)
-            return found
-        return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+        key = (int(target.id()), int(source.id()))
+        found = self._mappings.get(key)
+        if found is None:
+            origin = self.axis(source.get_argument(at.MAPPING_ORIGIN))
+            if target.is_a("IfcCartesianTransformationOperator3D"):
+                found = np.asarray(_operator_matrix(target) @ origin, dtype=float)
+            else:
+                found = np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+            self._mappings[key] = found
+        return found
 
     @property
     def angle_unit(self) -> float | None:
