@@ -18,7 +18,9 @@ problems), :mod:`~bt_manip.bim.shapes` (element geometry as boxes), :mod:`~bt_ma
 and the elements to install), :mod:`~bt_manip.bim.floor_grid` (the floor as a grid: free spots,
 connected places), :mod:`~bt_manip.bim.routes` (carrying each element from the stock through
 the doors), :mod:`~bt_manip.bim.doorways` (the poses to cross them straight),
-:mod:`~bt_manip.bim.stock` (the stands), :mod:`~bt_manip.bim.world_file` (the world YAML),
+:mod:`~bt_manip.bim.stock` (the stands), :mod:`~bt_manip.bim.world_file` (the world YAML's
+entries), :mod:`~bt_manip.bim.world_yaml` (its text), :mod:`~bt_manip.bim.ifc_attributes` (the
+attribute positions the geometry is read by),
 :mod:`~bt_manip.bim.install_tree` (install.xml), :mod:`~bt_manip.bim.convert` (the whole
 conversion), :mod:`~bt_manip.bim.as_built` (the as-built table of a run),
 :mod:`~bt_manip.bim.as_built_plot` (its floor plan) and :mod:`~bt_manip.bim.seeds` (a

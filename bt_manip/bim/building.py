@@ -225,7 +225,7 @@ def read_building(
     ``band_top`` (m above the floor). Problems are collected in ``source``."""
     model = source.model
     single = len(model.by_type("IfcBuildingStorey")) == 1
-    climbed: dict[int, Any] = {}
+    climbed: dict[tuple[str, int], Any] = {}
     contained = {} if single else direct_containers(model)
 
     def on_storey(el: Any) -> bool:

@@ -27,8 +27,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from bt_manip.bim import require_ifcopenshell
 from bt_manip.bim.building import Building, Names, read_building
 from bt_manip.bim.doorways import crossings, door_poses
@@ -60,6 +58,7 @@ from bt_manip.bim.stock import (
 )
 from bt_manip.bim.storeys import StoreyChoice, choose_storey, storey_elevation, storey_of
 from bt_manip.bim.world_file import building_entries, r
+from bt_manip.bim.world_yaml import world_yaml
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_folder, make_folder
 from bt_manip.sim.robot_description import RobotDescription, find_descriptor
@@ -83,9 +82,6 @@ BAND_MARGIN = 0.1
 """Added (m) to the top of the robot's height band."""
 ROUTE_ROUNDS = 4
 """Stock placements tried, refusing the elements without a route each time, at most."""
-_FAST_DUMPER: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
-"""libyaml's emitter when installed: several times faster than PyYAML's, and the same text as
-long as no string needs double quotes (the two fold long double-quoted strings differently)."""
 
 
 @dataclass(frozen=True)
@@ -312,10 +308,7 @@ def convert(options: BimOptions) -> Conversion:
         "# furniture and spaces, the elements to install waiting in stands at the stock\n"
         "# (their order and target poses are in schedule.json), and the robot.\n"
     )
-    dumper = _FAST_DUMPER if _plain_ascii(world) else yaml.SafeDumper
-    text = header + yaml.dump(world, Dumper=dumper, sort_keys=False, default_flow_style=None,
-                              width=100)
-    world_path.write_text(text)
+    world_path.write_text(header + world_yaml(world))
     conversion = Conversion(
         source.path, source.schema, str(storey.Name or f"#{storey.id()}"), building, elements,
         stock, start, world_path, schedule_path, list(building.notes), storey_choice=choice,
@@ -337,23 +330,6 @@ def convert(options: BimOptions) -> Conversion:
     elif install_path.is_file():
         install_path.unlink()
     return conversion
-
-
-def _plain_ascii(data: Any) -> bool:
-    """Whether every string in ``data`` (dicts, lists, scalars) is printable ASCII on one
-    line: such strings are written plain or single-quoted, never double-quoted."""
-    stack = [data]
-    while stack:
-        item = stack.pop()
-        if isinstance(item, str):
-            if not (item.isascii() and item.isprintable()):
-                return False
-        elif isinstance(item, dict):
-            stack.extend(item.keys())
-            stack.extend(item.values())
-        elif isinstance(item, list | tuple):
-            stack.extend(item)
-    return True
 
 
 def _refused_entry(element: Any, reason: str) -> dict[str, Any]:

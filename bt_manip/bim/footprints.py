@@ -54,6 +54,9 @@ def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> lis
     c, s = math.cos(box.yaw), math.sin(box.yaw)
     xy = corners - np.array(box.centre[:2])
     uv = np.column_stack([xy @ np.array([c, s]), xy @ np.array([-s, c])])
+    if _shoelace(uv) >= HULL_FILL * area * (1.0 + 1e-9):
+        # the hull of the corners holds their polygon: clearly full, whatever GEOS's rounding
+        return [whole]
     hull = shapely.convex_hull(shapely.multipoints(uv))
     if hull.area >= HULL_FILL * area:
         return [whole]
@@ -75,6 +78,13 @@ def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> lis
         out.append(Box((box.centre[0] + c * u - s * v, box.centre[1] + s * u + c * v, z),
                        (u1 - u0, v1 - v0, height), box.yaw))
     return out or [whole]
+
+
+def _shoelace(pts: np.ndarray) -> float:
+    """The signed area of the polygon through ``pts`` in turn (positive counter-clockwise):
+    at most the area of their convex hull when it is simple."""
+    x, y = pts[:, 0], pts[:, 1]
+    return float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2.0
 
 
 def wall_gaps(

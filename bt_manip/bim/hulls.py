@@ -7,6 +7,8 @@ points a footprint has: those go through :func:`monotone_chain` in Python instea
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 SMALL_HULL = 256
@@ -20,15 +22,23 @@ def monotone_chain(pts: np.ndarray) -> np.ndarray:
     out, as Qhull leaves them (the two may differ on a point within about 1e-15 of the
     coordinates' size of an edge)."""
     rows = pts.tolist()
+    xs, ys = [r[0] for r in rows], [r[1] for r in rows]
+    if all(math.isfinite(v) for v in xs + ys):  # numpy's max and ptp, in Python
+        big = max(max(map(abs, xs)), max(map(abs, ys)))
+        span = max(max(xs) - min(xs), max(ys) - min(ys))
+    else:
+        big, span = float(np.abs(pts).max()), float(np.ptp(pts, axis=0).max())
     # a turn this small is rounding, not a corner: about where Qhull draws the line
-    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
+    eps = 1e-15 * float(big) * float(span)
 
     def half(points: list[list[float]]) -> list[list[float]]:
         out: list[list[float]] = []
         for p in points:
+            px, py = p
             while len(out) >= 2:
-                (ax, ay), (bx, by) = out[-2], out[-1]
-                if (bx - ax) * (p[1] - ay) - (by - ay) * (p[0] - ax) > eps:
+                ax, ay = out[-2]
+                bx, by = out[-1]
+                if (bx - ax) * (py - ay) - (by - ay) * (px - ax) > eps:
                     break
                 out.pop()
             out.append(p)

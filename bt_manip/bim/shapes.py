@@ -17,7 +17,10 @@ body whose volume is much less than that box's is not box-like (a curved or L-sh
 tilted element).
 
 A reader computes each placement once (object placements up their chains, the
-IfcAxis2Placements of items and mapping origins), as elements share them.
+IfcAxis2Placements of items and mapping origins, the mapped items' transformations), as
+elements share them, and reads each
+point of the polygon loops once. Attributes are read by position
+(:mod:`~bt_manip.bim.ifc_attributes`): by name, ifcopenshell takes several times longer.
 """
 
 from __future__ import annotations
@@ -28,7 +31,8 @@ from typing import Any
 
 import numpy as np
 
-from bt_manip.bim.hulls import hull_xy, unique_rows
+from bt_manip.bim import ifc_attributes as at
+from bt_manip.bim.hulls import SMALL_HULL, hull_xy, monotone_chain, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
            "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
@@ -84,6 +88,8 @@ class ShapeReader:
         self._mapped: dict[int, np.ndarray | None] = {}
         self._placements: dict[int, np.ndarray] = {}
         self._axes: dict[int, np.ndarray] = {}
+        self._coordinates: dict[int, Any] = {}
+        self._mappings: dict[tuple[int, int], np.ndarray] = {}
         self._angle: float | None = None
 
     def placement(self, placement: Any) -> np.ndarray:
@@ -94,9 +100,11 @@ class ShapeReader:
         key = int(placement.id())
         found = self._placements.get(key)
         if found is None:
-            parent = getattr(placement, "PlacementRelTo", None)
-            if placement.is_a("IfcLocalPlacement") and parent is not None:
-                found = self.placement(parent) @ self.axis(placement.RelativePlacement)
+            local = placement.is_a("IfcLocalPlacement")
+            parent = placement.get_argument(at.PLACEMENT_REL_TO) if local else None
+            if parent is not None:
+                found = self.placement(parent) @ self.axis(
+                    placement.get_argument(at.RELATIVE_PLACEMENT))
             else:
                 found = np.asarray(util.get_local_placement(placement), dtype=float)
             self._placements[key] = found
@@ -116,11 +124,17 @@ class ShapeReader:
             self._axes[key] = found
         return found
 
+    def _position(self, item: Any) -> np.ndarray:
+        """An extrusion's Position matrix (the identity without one)."""
+        position = item.get_argument(at.POSITION)
+        return self.axis(position) if position is not None else np.eye(4)
+
     def yaw(self, element: Any) -> float | None:
         """:func:`placement_yaw` of ``element`` from the placements computed once per reader."""
-        if getattr(element, "ObjectPlacement", None) is None:
+        placement = _object_placement(element)
+        if placement is None:
             return None
-        return _yaw_of(self.placement(element.ObjectPlacement))
+        return _yaw_of(self.placement(placement))
 
     def solid(self, element: Any) -> Solid:
         """The element's body; UnsupportedGeometry when it has none or the kernel fails."""
@@ -133,24 +147,25 @@ class ShapeReader:
     # -- simple extrusions, read directly -------------------------------------------------
     def _extrusions(self, element: Any, rep: Any) -> Solid | None:
 
-        items = [_uncut(item) for item in rep.Items]
+        items = [_uncut(item) for item in rep.get_argument(at.ITEMS)]
         if not items or any(not item.is_a("IfcExtrudedAreaSolid") for item in items):
             return None
-        if element.ObjectPlacement is None:
+        placement = _object_placement(element)
+        if placement is None:
             return None
-        world = self.placement(element.ObjectPlacement)
+        world = self.placement(placement)
         all_points: list[np.ndarray] = []
         volume = 0.0
         for item in items:
-            profile = _profile_points(item.SweptArea, self.axis)
+            profile = _profile_points(item.get_argument(at.SWEPT_AREA), self.axis)
             if profile is None:
                 return None
-            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
-            direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
+            local = self._position(item)
+            direction = _direction(item)
             norm = float(np.linalg.norm(direction))
             if norm < 1e-12 or len(direction) != 3:
                 return None
-            direction = direction / norm * float(item.Depth)
+            direction = direction / norm * float(item.get_argument(at.DEPTH))
             base = np.column_stack([profile, np.zeros(len(profile)), np.ones(len(profile))])
             top = base.copy()
             top[:, :3] += direction
@@ -197,9 +212,10 @@ class ShapeReader:
         rep = body_representation(element)
         if rep is None:
             raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
-        if element.ObjectPlacement is not None:
-            world = self.placement(element.ObjectPlacement)
-            parts = [self._item_points(item) for item in rep.Items]
+        placement = _object_placement(element)
+        if placement is not None:
+            world = self.placement(placement)
+            parts = [self._item_points(item) for item in rep.get_argument(at.ITEMS)]
             if parts and all(p is not None and len(p) for p in parts):
                 local = np.vstack([p for p in parts if p is not None])
                 pts: np.ndarray = (local @ world[:3, :3].T + world[:3, 3]) * self.scale
@@ -210,7 +226,7 @@ class ShapeReader:
         """A mapped representation's points, read once per file: directly, else from the
         kernel's mesh of the representation itself (not of each element mapping it); only
         the corners of their footprint's hull are kept, at the lowest and highest z."""
-        parts = [self._item_points(i) for i in representation.Items]
+        parts = [self._item_points(i) for i in representation.get_argument(at.ITEMS)]
         if parts and all(p is not None and len(p) for p in parts):
             pts = np.vstack([p for p in parts if p is not None])
         else:
@@ -231,15 +247,23 @@ class ShapeReader:
 
     def _mapping(self, item: Any) -> np.ndarray:
         """The transformation of a mapped item (as ifcopenshell.util.placement's
-        get_mappeditem_transformation, its mapping origin's matrix kept per reader)."""
+        get_mappeditem_transformation), kept per reader for each pair of transformation
+        operator and mapped representation: exporters give many mapped items one operator
+        (often the identity) and one representation."""
         import ifcopenshell.util.placement as placement
 
-        origin = self.axis(item.MappingSource.MappingOrigin)
-        target = item.MappingTarget
-        if target.is_a("IfcCartesianTransformationOperator3D"):
-            found: np.ndarray = np.asarray(_operator_matrix(target) @ origin, dtype=float)
-            return found
-        return np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+        source = item.get_argument(at.MAPPING_SOURCE)
+        target = item.get_argument(at.MAPPING_TARGET)
+        key = (int(target.id()), int(source.id()))
+        found = self._mappings.get(key)
+        if found is None:
+            origin = self.axis(source.get_argument(at.MAPPING_ORIGIN))
+            if target.is_a("IfcCartesianTransformationOperator3D"):
+                found = np.asarray(_operator_matrix(target) @ origin, dtype=float)
+            else:
+                found = np.asarray(placement.get_mappeditem_transformation(item), dtype=float)
+            self._mappings[key] = found
+        return found
 
     @property
     def angle_unit(self) -> float | None:
@@ -256,23 +280,25 @@ class ShapeReader:
 
         item = _uncut(item)
         if item.is_a("IfcExtrudedAreaSolid"):
-            profile = _profile_points(item.SweptArea, self.axis, self.angle_unit)
+            profile = _profile_points(item.get_argument(at.SWEPT_AREA), self.axis,
+                                      self.angle_unit)
             if profile is None:
                 return None
-            local = self.axis(item.Position) if item.Position is not None else np.eye(4)
-            direction = np.asarray(item.ExtrudedDirection.DirectionRatios, dtype=float)
+            local = self._position(item)
+            direction = _direction(item)
             norm = float(np.linalg.norm(direction))
             if norm < 1e-12 or len(direction) != 3:
                 return None
             base = np.column_stack([profile, np.zeros(len(profile))])
-            prism = np.vstack([base, base + direction / norm * float(item.Depth)])
+            prism = np.vstack([base, base + direction / norm * float(item.get_argument(at.DEPTH))])
             out: np.ndarray = prism @ local[:3, :3].T + local[:3, 3]
             return out
         if item.is_a("IfcMappedItem"):
-            source = item.MappingSource
+            source = item.get_argument(at.MAPPING_SOURCE)
             key = int(source.id())
             if key not in self._mapped:
-                self._mapped[key] = self._source_points(source.MappedRepresentation)
+                self._mapped[key] = self._source_points(
+                    source.get_argument(at.MAPPED_REPRESENTATION))
             mapped = self._mapped[key]
             if mapped is None:
                 return None
@@ -280,9 +306,10 @@ class ShapeReader:
             moved: np.ndarray = mapped @ m[:3, :3].T + m[:3, 3]
             return moved
         if item.is_a("IfcTessellatedFaceSet"):
-            return np.asarray(item.Coordinates.CoordList, dtype=float)
+            return np.asarray(item.get_argument(at.COORDINATES).get_argument(at.COORDINATES),
+                              dtype=float)
         if item.is_a() in _POINT_SETS and self.model is not None:
-            coords = _loop_points(item)
+            coords = _loop_points(item, self._coordinates)
             if coords is None:  # not polygon loops only: every point the item refers to
                 coords = [p.Coordinates for p in self.model.traverse(item)
                           if p.is_a("IfcCartesianPoint")]
@@ -311,23 +338,27 @@ def _axis_matrix(placement: Any) -> np.ndarray | None:
     A 2D placement's direction is padded with a zero here, where ifcopenshell resizes the
     array in place: that raises whenever a profiler or a tracer holds a reference to it."""
     kind = placement.is_a()
-    origin = getattr(placement.Location, "Coordinates", None)
+    if kind not in ("IfcAxis2Placement3D", "IfcAxis2Placement2D"):
+        return None
+    location = placement.get_argument(at.LOCATION)
+    if location is None or not location.is_a("IfcCartesianPoint"):
+        return None
+    origin = location.get_argument(at.COORDINATES)
     if not origin:
         return None
-    ref = placement.RefDirection
     if kind == "IfcAxis2Placement3D":
-        axis = placement.Axis
-        z = np.array(axis.DirectionRatios if axis else (0, 0, 1))
-        x = np.array(ref.DirectionRatios if ref else (1, 0, 0))
-    elif kind == "IfcAxis2Placement2D":
-        ratios = tuple(ref.DirectionRatios) if ref else (1, 0)
+        axis = placement.get_argument(at.AXIS)
+        ref = placement.get_argument(at.REF_DIRECTION_3D)
+        z = np.array(axis.get_argument(at.DIRECTION_RATIOS) if axis else (0, 0, 1))
+        x = np.array(ref.get_argument(at.DIRECTION_RATIOS) if ref else (1, 0, 0))
+    else:
+        ref = placement.get_argument(at.REF_DIRECTION_2D)
+        ratios = tuple(ref.get_argument(at.DIRECTION_RATIOS)) if ref else (1, 0)
         if len(origin) != 2 or len(ratios) != 2:
             return None
         z = np.array((0, 0, 1))
         x = np.array((*ratios, 0.0) if ref else (1, 0, 0))
         origin = (*origin, 0.0)
-    else:
-        return None
     return _frame(origin, z, x)
 
 
@@ -351,48 +382,57 @@ def _operator_matrix(operator: Any) -> np.ndarray:
     """An IfcCartesianTransformationOperator3D's matrix (and its non-uniform subtype's): the
     same numbers as ifcopenshell.util.placement's ``get_cartesiantransformationoperator3d``,
     from the same operations in the same order."""
-    origin = np.array(operator.LocalOrigin.Coordinates)
+    origin = np.array(operator.get_argument(at.LOCAL_ORIGIN).get_argument(at.COORDINATES))
     axes = [np.array((1.0, 0.0, 0.0)), np.array((0.0, 1.0, 0.0)), np.array((0.0, 0.0, 1.0))]
-    for k, given in enumerate((operator.Axis1, operator.Axis2, operator.Axis3)):
+    for k, position in enumerate((at.AXIS1, at.AXIS2, at.AXIS3)):
+        given = operator.get_argument(position)
         if given:
-            axes[k][0:3] = given.DirectionRatios
+            axes[k][0:3] = given.get_argument(at.DIRECTION_RATIOS)
     m = _frame(origin, axes[2], axes[0])
     if m.T[1][0:3].dot(axes[1]) < 0.0:  # a mirrored y axis
         m.T[1] *= -1.0
-    scale1 = operator.Scale if operator.Scale else 1.0
+    scale1 = operator.get_argument(at.SCALE) or 1.0
     scale2 = scale3 = scale1
     if operator.is_a("IfcCartesianTransformationOperator3DnonUniform"):
-        scale2 = operator.Scale2 if operator.Scale2 is not None else scale1
-        scale3 = operator.Scale3 if operator.Scale3 is not None else scale1
+        given2, given3 = operator.get_argument(at.SCALE2), operator.get_argument(at.SCALE3)
+        scale2 = given2 if given2 is not None else scale1
+        scale3 = given3 if given3 is not None else scale1
     m.T[0] *= scale1
     m.T[1] *= scale2
     m.T[2] *= scale3
     return m
 
 
-def _loop_points(item: Any) -> list[Any] | None:
+def _loop_points(item: Any, known: dict[int, Any] | None = None) -> list[Any] | None:
     """The coordinates of the polygon loops of a faceted brep or face-based surface model
-    (each point as often as loops use it); None when a face is bounded by anything else."""
+    (each point as often as loops use it); None when a face is bounded by anything else.
+    ``known`` keeps each point's coordinates by step id (loops share their corners: a
+    point's id is read faster than its coordinates)."""
     if item.is_a("IfcFacetedBrep"):
-        shells = [item.Outer, *(getattr(item, "Voids", None) or ())]
-    elif item.is_a("IfcFaceBasedSurfaceModel"):
-        shells = list(item.FbsmFaces)
-    elif item.is_a("IfcShellBasedSurfaceModel"):
-        shells = list(item.SbsmBoundary)
+        shells = [item.get_argument(at.OUTER)]
+        if item.is_a("IfcFacetedBrepWithVoids"):
+            shells += item.get_argument(at.VOIDS) or ()
+    elif item.is_a("IfcFaceBasedSurfaceModel") or item.is_a("IfcShellBasedSurfaceModel"):
+        shells = list(item.get_argument(at.FACES))
     else:
         return None
+    if known is None:
+        known = {}
     coords: list[Any] = []
-    # by attribute index (several times faster than by name): IfcConnectedFaceSet.CfsFaces,
-    # IfcFace.Bounds, IfcFaceBound.Bound, IfcPolyLoop.Polygon, IfcCartesianPoint.Coordinates
     for shell in shells:
         if not shell.is_a("IfcConnectedFaceSet"):
             return None
-        for face in shell.get_argument(0):
-            for bound in face.get_argument(0):
-                loop = bound.get_argument(0)
+        for face in shell.get_argument(at.FACES):
+            for bound in face.get_argument(at.BOUNDS):
+                loop = bound.get_argument(at.BOUND)
                 if not loop.is_a("IfcPolyLoop"):
                     return None
-                coords.extend(p.get_argument(0) for p in loop.get_argument(0))
+                for point in loop.get_argument(at.POLYGON):
+                    key = point.id()
+                    found = known.get(key)
+                    if found is None:
+                        found = known[key] = point.get_argument(at.COORDINATES)
+                    coords.append(found)
     return coords
 
 
@@ -401,24 +441,41 @@ def _uncut(item: Any) -> Any:
     for _ in range(64):
         if not item.is_a("IfcBooleanClippingResult"):
             return item
-        item = item.FirstOperand
+        item = item.get_argument(at.FIRST_OPERAND)
     return item
 
 
 def body_representation(element: Any) -> Any:
     """The element's 'Body' shape representation, else the first one that is not a known
     other kind (an axis, a footprint, a bounding box...), else None."""
-    shape = getattr(element, "Representation", None)
+    if element.is_a("IfcProduct"):
+        shape = element.get_argument(at.REPRESENTATION)
+    else:
+        shape = getattr(element, "Representation", None)
     if shape is None:
         return None
-    reps = list(shape.Representations)
-    for rep in reps:
-        if rep.RepresentationIdentifier == "Body":
+    reps = [(rep, rep.get_argument(at.REPRESENTATION_IDENTIFIER))
+            for rep in shape.get_argument(at.REPRESENTATIONS)]
+    for rep, identifier in reps:
+        if identifier == "Body":
             return rep
-    for rep in reps:
-        if rep.RepresentationIdentifier not in NOT_BODY:
+    for rep, identifier in reps:
+        if identifier not in NOT_BODY:
             return rep
     return None
+
+
+def _object_placement(element: Any) -> Any:
+    """The element's ObjectPlacement (None when it has none)."""
+    if element.is_a("IfcProduct"):
+        return element.get_argument(at.OBJECT_PLACEMENT)
+    return getattr(element, "ObjectPlacement", None)
+
+
+def _direction(item: Any) -> np.ndarray:
+    """An extrusion's direction ratios."""
+    ratios = item.get_argument(at.EXTRUDED_DIRECTION).get_argument(at.DIRECTION_RATIOS)
+    return np.asarray(ratios, dtype=float)
 
 
 def _profile_points(profile: Any, axis: Any = None,
@@ -432,21 +489,23 @@ def _profile_points(profile: Any, axis: Any = None,
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
-        hx, hy = float(profile.XDim) / 2, float(profile.YDim) / 2
+        hx = float(profile.get_argument(at.X_DIM)) / 2
+        hy = float(profile.get_argument(at.Y_DIM)) / 2
         pts = np.array([[-hx, -hy], [hx, -hy], [hx, hy], [-hx, hy]])
     elif profile.is_a("IfcCircleProfileDef") and not profile.is_a("IfcCircleHollowProfileDef"):
         # the 32-gon round the circle, its sides tangent to it (and four of them upright)
         angles = (np.arange(32) + 0.5) * (2 * math.pi / 32)
-        radius = float(profile.Radius) / math.cos(math.pi / 32)
+        radius = float(profile.get_argument(at.RADIUS)) / math.cos(math.pi / 32)
         pts = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
     elif profile.is_a("IfcArbitraryClosedProfileDef") and not profile.is_a(
         "IfcArbitraryProfileDefWithVoids"
     ):
-        curve = profile.OuterCurve
+        curve = profile.get_argument(at.OUTER_CURVE)
         if curve.is_a("IfcPolyline"):
-            pts = np.array([p.Coordinates[:2] for p in curve.Points], dtype=float)
-        elif curve.is_a("IfcIndexedPolyCurve") and curve.Segments is None:
-            pts = np.array([c[:2] for c in curve.Points.CoordList], dtype=float)
+            pts = _polyline_points(curve)
+        elif curve.is_a("IfcIndexedPolyCurve") and curve.get_argument(at.INDEXED_SEGMENTS) is None:
+            coords = curve.get_argument(at.POINTS).get_argument(at.COORDINATES)
+            pts = np.array([c[:2] for c in coords], dtype=float)
         elif curve.is_a("IfcCompositeCurve") and angle_unit is not None:
             found = _composite_points(curve, angle_unit, axis)
             if found is None:
@@ -454,13 +513,15 @@ def _profile_points(profile: Any, axis: Any = None,
             pts = found
         else:
             return None
-        if len(pts) > 1 and np.allclose(pts[0], pts[-1]):
+        if len(pts) > 1 and _close(pts[0], pts[-1]):
             pts = pts[:-1]
         if len(pts) < 3:
             return None
     else:
         return None
-    position = getattr(profile, "Position", None)
+    # only the parameterised profiles (the rectangle and the circle here) have a Position
+    position = (profile.get_argument(at.PROFILE_POSITION)
+                if profile.is_a("IfcParameterizedProfileDef") else None)
     if position is not None:
         m = (axis(position) if axis is not None
              else np.asarray(placement.get_axis2placement(position), dtype=float))
@@ -479,35 +540,53 @@ def _composite_points(curve: Any, angle_unit: float, axis: Any) -> np.ndarray | 
     polygon through them encloses the arc. None for any other segment (a B-spline, an arc
     trimmed by points, a basis curve that is not a circle)."""
     chunks: list[np.ndarray] = []
-    for segment in curve.Segments:
-        parent = segment.ParentCurve
+    for segment in curve.get_argument(at.SEGMENTS):
+        parent = segment.get_argument(at.PARENT_CURVE)
         if parent.is_a("IfcPolyline"):
-            chunks.append(np.array([p.Coordinates[:2] for p in parent.Points], dtype=float))
+            chunks.append(_polyline_points(parent))
             continue
         if not parent.is_a("IfcTrimmedCurve"):
             return None
-        circle = parent.BasisCurve
-        if not circle.is_a("IfcCircle") or circle.Position is None:
+        circle = parent.get_argument(at.BASIS_CURVE)
+        if not circle.is_a("IfcCircle"):
+            return None
+        position = circle.get_argument(at.CIRCLE_POSITION)
+        if position is None:
             return None
         trims = []
-        for trim in (parent.Trim1, parent.Trim2):
-            values = [t.wrappedValue for t in trim if t.is_a("IfcParameterValue")]
+        for trim in (parent.get_argument(at.TRIM1), parent.get_argument(at.TRIM2)):
+            values = [t.get_argument(0) for t in trim if t.is_a("IfcParameterValue")]
             if not values:
                 return None
             trims.append(float(values[0]) * angle_unit)
         t1, t2 = trims
         # the arc runs from Trim1 to Trim2, counter-clockwise when the sense agrees
-        sweep = (t2 - t1) % (2 * math.pi) if parent.SenseAgreement else \
+        sweep = (t2 - t1) % (2 * math.pi) if parent.get_argument(at.SENSE_AGREEMENT) else \
             -((t1 - t2) % (2 * math.pi))
         n = max(1, math.ceil(abs(sweep) / ARC_STEP))
         angles = t1 + sweep * np.arange(n + 1) / n
-        radius = float(circle.Radius) / math.cos(abs(sweep) / n / 2)
+        radius = float(circle.get_argument(at.CIRCLE_RADIUS)) / math.cos(abs(sweep) / n / 2)
         local = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
-        m = axis(circle.Position)
+        m = axis(position)
         chunks.append(local @ m[:2, :2].T + m[:2, 3])
     if not chunks:
         return None
     return np.vstack(chunks)
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    """``np.allclose(a, b)`` of two points: the same test (``|a - b| <= 1e-8 + 1e-5 * |b|``
+    for each coordinate) without numpy's setup, for finite coordinates."""
+    pairs = list(zip(a.tolist(), b.tolist(), strict=True))
+    if not all(math.isfinite(u) and math.isfinite(v) for u, v in pairs):
+        return bool(np.allclose(a, b))
+    return all(abs(u - v) <= 1e-08 + 1e-05 * abs(v) for u, v in pairs)
+
+
+def _polyline_points(polyline: Any) -> np.ndarray:
+    """The x and y of an IfcPolyline's points."""
+    return np.array([p.get_argument(at.COORDINATES)[:2]
+                     for p in polyline.get_argument(at.POINTS)], dtype=float)
 
 
 def _polygon_area(pts: np.ndarray) -> float:
@@ -520,10 +599,44 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
 
     The yaw follows the longer horizontal side; of its two senses the one nearer ``hint_yaw``
     (the element's placement x axis) is taken, so a wall keeps the direction it was drawn in.
+
+    The box is the least of the boxes along the edges of the points' hull, the first of them
+    in Qhull's order when several are within 1e-9 m2 of the least. The hull of a few points
+    is found without Qhull (:func:`~bt_manip.bim.hulls.monotone_chain`): its edges are
+    Qhull's, in the same turn but from another corner, which changes nothing unless boxes
+    along different angles tie; only then is Qhull asked for its order.
     """
     xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
-    angles = _candidate_angles(xy)
+    chain = _chain_hull(xy)
+    found = _least_box(xy, _edge_angles(chain)) if chain is not None else None
+    if found is None or not found[3]:  # Qhull's order decides
+        found = _least_box(xy, _candidate_angles(xy))
+    angle, lo, hi, _ = found
+    a0 = angle
+    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    if width > length:
+        angle += math.pi / 2
+        length, width = width, length
+    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
+        angle += math.pi
+    angle = math.atan2(math.sin(angle), math.cos(angle))
+    mid_u, mid_v = (lo + hi) / 2
+    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
+    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
+    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+
+
+TIE = 1e-9
+"""Boxes whose footprints differ by less than this (m2) are equally small."""
+
+
+def _least_box(xy: np.ndarray,
+               angles: list[float]) -> tuple[float, np.ndarray, np.ndarray, bool]:
+    """The angle, and the low and high corners (along and across it), of the least of the
+    boxes along ``angles``: the first of the least, as :data:`TIE` apart; and whether that
+    box is the same in any order of ``angles`` (False when boxes within twice the tie of the
+    least lie along angles that are not all the same number)."""
     # every candidate at once: the points' coordinates along (u) and across (v) each angle
     c = np.array([math.cos(a) for a in angles])
     s = np.array([math.sin(a) for a in angles])
@@ -533,28 +646,36 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
     lows = np.stack([u.min(axis=0), v.min(axis=0)], axis=1)
     highs = np.stack([u.max(axis=0), v.max(axis=0)], axis=1)
     areas = (highs[:, 0] - lows[:, 0]) * (highs[:, 1] - lows[:, 1])
+    # the pick is one of the boxes within TIE of the least, whatever the order: when they all
+    # lie along the same angle, it is the same box
+    near = [angles[k] for k in np.flatnonzero(areas <= areas.min() + 2 * TIE)]
+    order_free = all(a == near[0] for a in near)
     pick = 0
-    for k in range(1, len(angles)):  # the first of the least, as 1e-9 apart
-        if areas[k] < areas[pick] - 1e-9:
+    for k in range(1, len(angles)):  # the first of the least, as TIE apart
+        if areas[k] < areas[pick] - TIE:
             pick = k
-    angle, lo, hi = angles[pick], lows[pick], highs[pick]
-    best = (float(areas[pick]), angle)
-    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
-    if width > length:
-        angle += math.pi / 2
-        length, width = width, length
-    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
-        angle += math.pi
-    angle = math.atan2(math.sin(angle), math.cos(angle))
-    mid_u, mid_v = (lo + hi) / 2
-    a0 = best[1]
-    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
-    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
-    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+    return angles[pick], lows[pick], highs[pick], order_free
+
+
+def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
+    """The corners, counter-clockwise, of the hull :func:`_candidate_angles` takes the edges
+    of, when it has few points and at least three corners (else None: Qhull's case)."""
+    pts = unique_rows(np.round(xy, 6))
+    if len(pts) < 3 or len(pts) > SMALL_HULL:
+        return None
+    chain = monotone_chain(pts)
+    return chain if len(chain) >= 3 else None
+
+
+def _edge_angles(hull: np.ndarray) -> list[float]:
+    """The directions, modulo 90 degrees, of the edges of a polygon (corners in turn)."""
+    edges = np.roll(hull, -1, axis=0) - hull
+    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
 
 
 def _candidate_angles(xy: np.ndarray) -> list[float]:
-    """Edge directions of the convex hull of ``xy`` (one of them bounds the least box)."""
+    """Edge directions of the convex hull of ``xy`` (one of them bounds the least box), in
+    Qhull's order."""
     from scipy.spatial import ConvexHull, QhullError
 
     pts = unique_rows(np.round(xy, 6))
@@ -568,8 +689,7 @@ def _candidate_angles(xy: np.ndarray) -> list[float]:
     except QhullError:  # collinear points
         d = pts[-1] - pts[0]
         return [math.atan2(d[1], d[0])]
-    edges = np.roll(hull, -1, axis=0) - hull
-    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+    return _edge_angles(hull)
 
 
 def hull_prism(points: np.ndarray) -> np.ndarray:

@@ -38,12 +38,14 @@ class StoreyChoice:
                 f"storeys by elevation: {listed})")
 
 
-def storey_of(element: Any, memo: dict[int, Any] | None = None,
+def storey_of(element: Any, memo: dict[tuple[str, int], Any] | None = None,
               contained: dict[int, Any] | None = None) -> Any:
     """The IfcBuildingStorey containing ``element`` (through spaces and aggregates), or None.
 
-    With ``memo`` (one dict per file), the storey found above each container is kept: the
-    elements of a storey share their containers, so the climb is made once per container.
+    With ``memo`` (one dict per file), the storey found above each container, and the
+    container found above each element (ifcopenshell.util.element's ``get_container``, which
+    climbs an aggregated part's wholes to the first contained one), are kept: the elements of
+    a storey share their containers and wholes, so each climb is made once.
     ``contained`` (:func:`direct_containers`) gives the containers of the elements directly
     contained in one."""
     import ifcopenshell.util.element as util
@@ -52,13 +54,46 @@ def storey_of(element: Any, memo: dict[int, Any] | None = None,
     if contained is not None and key in contained:
         current = contained[key] or util.get_aggregate(element)
     else:
-        current = util.get_container(element) or util.get_aggregate(element)
+        current = _container(element, memo) or util.get_aggregate(element)
     if memo is None or current is None:
-        return _climb(current)
+        return _climb(current, memo)
     key = int(current.id())
-    if key not in memo:
-        memo[key] = _climb(current)
-    return memo[key]
+    if ("storey", key) not in memo:
+        memo["storey", key] = _climb(current, memo)
+    return memo["storey", key]
+
+
+MAX_CLIMB = 16
+"""Containers and aggregates climbed at most from an element to its storey."""
+
+
+def _container(element: Any, memo: dict[tuple[str, int], Any] | None) -> Any:
+    """ifcopenshell.util.element's ``get_container(element)`` (the first container of the
+    element or of its parents: aggregates, nests, fills, voids), each element's answer kept in
+    ``memo``; None after :data:`MAX_CLIMB` parents (a loop of parents in a broken file)."""
+    import ifcopenshell.util.element as util
+
+    if memo is None:
+        return util.get_container(element)
+    path: list[int] = []
+    found = None
+    current = element
+    for _ in range(MAX_CLIMB):
+        key = int(current.id())
+        if ("container", key) in memo:
+            found = memo["container", key]
+            break
+        path.append(key)
+        rels = getattr(current, "ContainedInStructure", None)
+        if rels:
+            found = rels[0].RelatingStructure
+            break
+        current = util.get_parent(current)
+        if current is None:
+            break
+    for key in path:
+        memo["container", key] = found
+    return found
 
 
 def direct_containers(model: Any) -> dict[int, Any]:
@@ -79,14 +114,14 @@ def direct_containers(model: Any) -> dict[int, Any]:
     return found
 
 
-def _climb(current: Any) -> Any:
+def _climb(current: Any, memo: dict[tuple[str, int], Any] | None = None) -> Any:
     """The first storey from ``current`` up its containers and aggregates (16 steps at most)."""
     import ifcopenshell.util.element as util
 
-    for _ in range(16):
+    for _ in range(MAX_CLIMB):
         if current is None or current.is_a("IfcBuildingStorey"):
             return current
-        current = util.get_container(current) or util.get_aggregate(current)
+        current = _container(current, memo) or util.get_aggregate(current)
     return None
 
 

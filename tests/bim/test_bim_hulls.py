@@ -77,3 +77,66 @@ def test_strip_boxes_are_hull_boxes() -> None:
         corners = hull_xy(xy)
         box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), 0.3)
         assert strip_boxes(corners, box, 0.0, 1.0) == hull_boxes(points, 0.0, 1.0, 0.3)
+
+
+def test_least_box_without_qhull_is_qhulls(monkeypatch: pytest.MonkeyPatch) -> None:
+    """footprint_box takes its candidate angles from the monotone chain, whose corners start
+    elsewhere than Qhull's: the boxes are Qhull's to the last bit, ties included (squares and
+    regular polygons, whose least boxes along different edges are equally small, go to
+    Qhull's order)."""
+    import bt_manip.bim.shapes as shapes
+
+    ties = []
+    for n in (4, 6, 8, 12):  # regular polygons, turned: boxes along different edges tie
+        angles = np.arange(n) * (2 * math.pi / n) + 0.3
+        ties.append(np.column_stack([np.cos(angles), np.sin(angles)]) * 2.0 + [5.0, -3.0])
+    sets = [*_shapes(3), *ties, np.array([[0, 0], [2, 0], [2, 1], [0, 1.0]])]
+    asked: list[int] = []
+    qhull_angles = shapes._candidate_angles
+    monkeypatch.setattr(shapes, "_candidate_angles",
+                        lambda xy: asked.append(len(xy)) or qhull_angles(xy))
+    fast = [footprint_box(np.column_stack([xy, np.zeros(len(xy))]), 0.4) for xy in sets]
+    assert 0 < len(asked) < len(sets)  # Qhull's order asked for the ties only
+    monkeypatch.setattr(shapes, "_chain_hull", lambda xy: None)  # Qhull's order always
+    assert fast == [footprint_box(np.column_stack([xy, np.zeros(len(xy))]), 0.4)
+                    for xy in sets]
+
+
+def test_full_footprints_without_geos_are_geos(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A hull that clearly fills its box is found full from its corners' polygon; GEOS's
+    hull gives the same boxes for every shape (boxes, polygons, round and scattered ones)."""
+    import bt_manip.bim.footprints as footprints
+
+    cases = []
+    for xy in _shapes(4):
+        corners = hull_xy(xy)
+        cases.append((corners, footprint_box(np.column_stack([corners, np.zeros(len(corners))]),
+                                             0.2)))
+    fast = [strip_boxes(corners, box, 0.0, 1.0) for corners, box in cases]
+    assert sum(len(boxes) == 1 for boxes in fast) > len(cases) // 4  # full ones among them
+    monkeypatch.setattr(footprints, "_shoelace", lambda pts: -math.inf)  # GEOS decides
+    assert fast == [strip_boxes(corners, box, 0.0, 1.0) for corners, box in cases]
+
+
+def _textbook_chain(pts: np.ndarray) -> np.ndarray:
+    """Andrew's monotone chain with numpy's extent for the rounding tolerance."""
+    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
+
+    def half(points: list[list[float]]) -> list[list[float]]:
+        out: list[list[float]] = []
+        for p in points:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= eps:
+                out.pop()
+            out.append(p)
+        return out
+
+    rows = pts.tolist()
+    return np.array(half(rows)[:-1] + half(rows[::-1])[:-1], dtype=float).reshape(-1, 2)
+
+
+def test_monotone_chain_is_the_textbook_chain() -> None:
+    rng = np.random.default_rng(5)
+    for xy in [*_shapes(5), *(np.round(rng.normal(size=(40, 2)) * 10, d) for d in range(4))]:
+        pts = unique_rows(np.round(xy, 9))
+        assert np.array_equal(monotone_chain(pts), _textbook_chain(pts))
