@@ -71,14 +71,7 @@ class NodeRegistry:
                 raise TypeError(f"{node_cls!r} is neither a bt-manip node class nor a "
                                 "py_trees.behaviour.Behaviour subclass")
             node_id = node_cls.NODE_ID
-            existing = self._classes.get(node_id)
-            if existing is not None and existing is not node_cls and not _same_origin(
-                existing, node_cls
-            ):
-                raise ValueError(
-                    f"node ID '{node_id}' is already registered by "
-                    f"{existing.__module__}.{existing.__qualname__}"
-                )
+            _refuse_another(self._classes.get(node_id), node_cls, f"node ID '{node_id}'")
             self._classes[node_id] = node_cls
             if builtin:
                 self._builtin.add(node_id)
@@ -146,11 +139,7 @@ class NodeRegistry:
             key = value_cls.__qualname__ if name is None else name
             if not key or not isinstance(key, str):
                 raise ValueError(f"a value type needs a non-empty name, got {key!r}")
-            existing = self._value_types.get(key)
-            if existing is not None and existing is not value_cls and \
-                    not _same_origin(existing, value_cls):
-                raise ValueError(f"value type '{key}' is already registered for "
-                                 f"{existing.__module__}.{existing.__qualname__}")
+            _refuse_another(self._value_types.get(key), value_cls, f"value type '{key}'")
             for other, registered in list(self._value_types.items()):
                 if registered is value_cls and other != key:
                     del self._value_types[other]  # one name per class
@@ -180,8 +169,15 @@ class NodeRegistry:
         return dict(self._value_types)
 
 
-def _same_origin(a: type, b: type) -> bool:
-    return a.__module__ == b.__module__ and a.__qualname__ == b.__qualname__
+def _refuse_another(existing: type | None, cls: type, what: str) -> None:
+    """ValueError when ``what`` is registered for another class than ``cls`` (one of the same
+    module and name, as a module imported again makes, is the same class)."""
+    if existing is None or existing is cls:
+        return
+    if existing.__module__ == cls.__module__ and existing.__qualname__ == cls.__qualname__:
+        return
+    raise ValueError(f"{what} is already registered by "
+                     f"{existing.__module__}.{existing.__qualname__}")
 
 
 registry = NodeRegistry()

@@ -286,7 +286,7 @@ def test_what_cannot_be_a_value_type() -> None:
     registry.register_value_type(Point)  # again: nothing changes
     other = type("Point", (), {"__module__": "elsewhere"})
     with pytest.raises(ValueError, match=re.escape(
-            f"value type 'Point' is already registered for {__name__}.Point")):
+            f"value type 'Point' is already registered by {__name__}.Point")):
         registry.register_value_type(other)
     with pytest.raises(TypeError, match="objects of Slotted keep no __dict__"):
         registry.register_value_type(Slotted)
