@@ -60,6 +60,12 @@ def unique_rows(xy: np.ndarray) -> np.ndarray:
     return out
 
 
+def next_rows(a: np.ndarray) -> np.ndarray:
+    """The rows of ``a`` each replaced by the next, the last by the first (a polygon's next
+    corners): ``np.roll(a, -1, axis=0)``, without its generic setup."""
+    return np.concatenate((a[1:], a[:1]))
+
+
 def hull_xy(xy: np.ndarray) -> np.ndarray:
     """The corners of the convex hull of 2D points (the points themselves when they are
     fewer than three or collinear)."""

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.bim import ifc_attributes as at
-from bt_manip.bim.hulls import SMALL_HULL, hull_xy, monotone_chain, unique_rows
+from bt_manip.bim.hulls import SMALL_HULL, hull_xy, monotone_chain, next_rows, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
            "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
@@ -365,7 +365,31 @@ def _axis_matrix(placement: Any) -> np.ndarray | None:
 def _frame(origin: Any, z: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The 4x4 matrix of the frame at ``origin`` whose z and x axes point along ``z`` and
     ``x``: ifcopenshell.util.placement's ``a2p``, its operations in the same order (the cross
-    product written out, the same numbers as numpy's)."""
+    product written out, the same numbers as numpy's).
+
+    The usual frame (three coordinates each, axes of finite non-zero length, not parallel) is
+    computed in Python floats: each length is the square root of numpy's dot product of the
+    axis with itself, as ``np.linalg.norm`` computes it, and each quotient and product is the
+    same IEEE operation numpy does; any other goes through numpy, warnings and all."""
+    if len(x) == 3 and len(z) == 3 and len(origin) == 3:
+        nx, nz = math.sqrt(x.dot(x)), math.sqrt(z.dot(z))
+        if 0.0 < nx < math.inf and 0.0 < nz < math.inf:
+            x0, x1, x2 = (v / nx for v in x.tolist())
+            z0, z1, z2 = (v / nz for v in z.tolist())
+            y = np.array((z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0))
+            ny = math.sqrt(y.dot(y))
+            if 0.0 < ny < math.inf:
+                y0, y1, y2 = (v / ny for v in y.tolist())
+                o0, o1, o2 = (float(v) for v in origin)
+                m = np.array(((x0, x1, x2, 0.0), (y0, y1, y2, 0.0), (z0, z1, z2, 0.0),
+                              (o0, o1, o2, 1.0)))
+                fast: np.ndarray = m.T
+                return fast
+    return _frame_numpy(origin, z, x)
+
+
+def _frame_numpy(origin: Any, z: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """:func:`_frame` in numpy's own operations, for any frame."""
     x = x / np.linalg.norm(x)
     z = z / np.linalg.norm(z)
     y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2],
@@ -558,7 +582,8 @@ def _polyline_points(polyline: Any) -> np.ndarray:
 
 def _polygon_area(pts: np.ndarray) -> float:
     x, y = pts[:, 0], pts[:, 1]
-    return abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2.0
+    return abs(float(np.dot(x, next_rows(y)) - np.dot(y, next_rows(x)))) / 2.0
+
 
 
 def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
@@ -636,7 +661,7 @@ def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
 
 def _edge_angles(hull: np.ndarray) -> list[float]:
     """The directions, modulo 90 degrees, of the edges of a polygon (corners in turn)."""
-    edges = np.roll(hull, -1, axis=0) - hull
+    edges = next_rows(hull) - hull
     return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
 
 
