@@ -23,9 +23,10 @@ def monotone_chain(pts: np.ndarray) -> np.ndarray:
     coordinates' size of an edge)."""
     rows = pts.tolist()
     xs, ys = [r[0] for r in rows], [r[1] for r in rows]
-    if all(math.isfinite(v) for v in xs + ys):  # numpy's max and ptp, in Python
-        big = max(max(map(abs, xs)), max(map(abs, ys)))
-        span = max(max(xs) - min(xs), max(ys) - min(ys))
+    if math.isfinite(sum(xs) + sum(ys)):  # all finite: numpy's max and ptp, in Python
+        x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+        big = max(-x0, x1, -y0, y1)  # the largest magnitude
+        span = max(x1 - x0, y1 - y0)
     else:
         big, span = float(np.abs(pts).max()), float(np.ptp(pts, axis=0).max())
     # a turn this small is rounding, not a corner: about where Qhull draws the line

@@ -643,8 +643,9 @@ def _least_box(xy: np.ndarray,
     near = [angles[k] for k in np.flatnonzero(areas <= areas.min() + 2 * TIE)]
     order_free = all(a == near[0] for a in near)
     pick = 0
+    each = areas.tolist()  # the same numbers, compared in Python
     for k in range(1, len(angles)):  # the first of the least, as TIE apart
-        if areas[k] < areas[pick] - TIE:
+        if each[k] < each[pick] - TIE:
             pick = k
     return angles[pick], lows[pick], highs[pick], order_free
 
@@ -662,7 +663,7 @@ def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
 def _edge_angles(hull: np.ndarray) -> list[float]:
     """The directions, modulo 90 degrees, of the edges of a polygon (corners in turn)."""
     edges = next_rows(hull) - hull
-    return [float(a) % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0])]
+    return [a % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0]).tolist()]
 
 
 def _candidate_angles(xy: np.ndarray) -> list[float]:
