@@ -22,8 +22,8 @@ RESOLUTION = 0.05
 """Cell size (m)."""
 MARGIN = 2.0
 """Free floor (m) around the building's extent (a robot may go round the outside)."""
-NEAR_TRIES = 400
-"""Cells :meth:`FloorGrid.nearest_clear` tries one by one before computing every clearance."""
+NEAR_TRIES = 8
+"""Cells :meth:`FloorGrid.nearest_clear` tries one by one before computing clearances."""
 _UNDECIDED = object()
 MAX_CELLS = 25_000_000
 """Cells at most, as for navigation grids (250 m x 250 m at 5 cm)."""
@@ -175,9 +175,14 @@ class FloorGrid:
         self, x: float, y: float, half_width: float, within: Rect
     ) -> tuple[float, float] | object | None:
         """:meth:`nearest_clear` inside ``within`` without the whole grid's clearances: the
-        same cell (the nearest, the first in row order among equally near ones), or
-        ``_UNDECIDED`` after :data:`NEAR_TRIES` cells that are not clear (or on a grid
-        without a blocked cell, where the distance transform has no answer to match)."""
+        same cell (the nearest, the first in row order among equally near ones); or
+        ``_UNDECIDED`` on a grid without a blocked cell (where the distance transform has no
+        answer to match).
+
+        The nearest :data:`NEAR_TRIES` cells are tried one by one (:meth:`_clear_at`); then
+        the clearances are computed on ``within``'s window grown by a margin wider than
+        ``half_width``: a blocked cell beyond it leaves every cell of the window clear, one
+        within it is as near as on the whole grid."""
         found = self._window(within)
         if found is None:
             return None
@@ -188,13 +193,27 @@ class FloorGrid:
         rows, cols = rows + j0, cols + i0
         xs = self.x0 + (cols + 0.5) * self.res
         ys = self.y0 + (rows + 0.5) * self.res
-        order = np.argsort((xs - x) ** 2 + (ys - y) ** 2, kind="stable")
+        near = (xs - x) ** 2 + (ys - y) ** 2
         # a blocked cell this many cells away (or farther) leaves a cell clear
         reach = math.ceil((half_width + self.res) / self.res) + 2
-        for k in order[:NEAR_TRIES].tolist():
+        for k in np.argsort(near, kind="stable")[:NEAR_TRIES].tolist():
             if self._clear_at(int(rows[k]), int(cols[k]), reach) >= half_width:
                 return (float(xs[k]), float(ys[k]))
-        return _UNDECIDED if len(order) > NEAR_TRIES else None
+        ny, nx = self.blocked.shape
+        r0, c0 = max(j0 - reach, 0), max(i0 - reach, 0)
+        sub = self.blocked[r0:min(j0 + inside.shape[0] + reach, ny),
+                           c0:min(i0 + inside.shape[1] + reach, nx)]
+        if sub.any():
+            from scipy.ndimage import distance_transform_edt
+
+            d = distance_transform_edt(~sub) * self.res - self.res / 2
+            ok = np.flatnonzero(np.maximum(d, 0.0)[rows - r0, cols - c0] >= half_width)
+        else:
+            ok = np.arange(len(rows))
+        if len(ok) == 0:
+            return None
+        k = int(ok[int(np.argmin(near[ok]))])
+        return (float(xs[k]), float(ys[k]))
 
     def _clear_at(self, row: int, col: int, reach: int) -> float:
         """The cell's clearance as :meth:`clearance` gives it (the same operations on the
