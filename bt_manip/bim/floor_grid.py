@@ -196,7 +196,7 @@ class FloorGrid:
         near = (xs - x) ** 2 + (ys - y) ** 2
         # a blocked cell this many cells away (or farther) leaves a cell clear
         reach = math.ceil((half_width + self.res) / self.res) + 2
-        for k in np.argsort(near, kind="stable")[:NEAR_TRIES].tolist():
+        for k in _nearest_first(near, NEAR_TRIES):
             if self._clear_at(int(rows[k]), int(cols[k]), reach) >= half_width:
                 return (float(xs[k]), float(ys[k]))
         ny, nx = self.blocked.shape
@@ -316,3 +316,13 @@ class FloorGrid:
                 out.append(d - 1)
             idx = int(parent[idx])
         return out[::-1]
+
+
+def _nearest_first(values: np.ndarray, count: int) -> list[int]:
+    """The indices of the ``count`` least of ``values``, least first, equal ones in index
+    order: the start of ``np.argsort(values, kind="stable")`` without sorting them all."""
+    if len(values) <= count:
+        return [int(k) for k in np.argsort(values, kind="stable")]
+    bound = np.partition(values, count - 1)[count - 1]
+    few = np.flatnonzero(values <= bound)
+    return [int(k) for k in few[np.argsort(values[few], kind="stable")][:count]]

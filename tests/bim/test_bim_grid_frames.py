@@ -94,3 +94,13 @@ def test_nearest_clear_on_an_empty_grid() -> None:
     grid = FloorGrid((0.0, 0.0, 4.0, 3.0))
     spot = grid.nearest_clear(1.0, 1.0, 0.4, within=Rect(1.0, 1.0, 2.0, 2.0))
     assert spot is not None and math.dist(spot, (1.0, 1.0)) < 0.05
+
+
+def test_nearest_first_is_the_start_of_a_stable_sort() -> None:
+    from bt_manip.bim.floor_grid import _nearest_first
+
+    rng = np.random.default_rng(2)
+    for _ in range(200):
+        values = np.round(rng.uniform(0, 3, int(rng.integers(1, 60))), 1)  # many ties
+        count = int(rng.integers(1, 12))
+        assert _nearest_first(values, count) == np.argsort(values, kind="stable")[:count].tolist()
