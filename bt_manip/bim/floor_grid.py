@@ -179,10 +179,8 @@ class FloorGrid:
         ``_UNDECIDED`` on a grid without a blocked cell (where the distance transform has no
         answer to match).
 
-        The nearest :data:`NEAR_TRIES` cells are tried one by one (:meth:`_clear_at`); then
-        the clearances are computed on ``within``'s window grown by a margin wider than
-        ``half_width``: a blocked cell beyond it leaves every cell of the window clear, one
-        within it is as near as on the whole grid."""
+        The nearest :data:`NEAR_TRIES` cells are tried one by one (:meth:`_clear_at`), then
+        the cells of ever wider discs round (x, y) all at once (:meth:`_clear_cells`)."""
         found = self._window(within)
         if found is None:
             return None
@@ -199,21 +197,40 @@ class FloorGrid:
         for k in _nearest_first(near, NEAR_TRIES):
             if self._clear_at(int(rows[k]), int(cols[k]), reach) >= half_width:
                 return (float(xs[k]), float(ys[k]))
-        ny, nx = self.blocked.shape
-        r0, c0 = max(j0 - reach, 0), max(i0 - reach, 0)
-        sub = self.blocked[r0:min(j0 + inside.shape[0] + reach, ny),
-                           c0:min(i0 + inside.shape[1] + reach, nx)]
-        if sub.any():
-            from scipy.ndimage import distance_transform_edt
+        # then discs round (x, y) growing twice as wide each time, up to the whole rectangle:
+        # the nearest clear cell of a disc is the rectangle's, as every cell outside the disc
+        # is farther
+        radius = (reach + 4) * self.res
+        while True:
+            some = np.flatnonzero(near <= radius * radius)
+            whole = len(some) == len(near)
+            ok = some[self._clear_cells(rows[some], cols[some], half_width, reach)]
+            if len(ok):
+                k = int(ok[int(np.argmin(near[ok]))])
+                return (float(xs[k]), float(ys[k]))
+            if whole:
+                return None
+            radius *= 2
 
-            d = distance_transform_edt(~sub) * self.res - self.res / 2
-            ok = np.flatnonzero(np.maximum(d, 0.0)[rows - r0, cols - c0] >= half_width)
-        else:
-            ok = np.arange(len(rows))
-        if len(ok) == 0:
-            return None
-        k = int(ok[int(np.argmin(near[ok]))])
-        return (float(xs[k]), float(ys[k]))
+    def _clear_cells(self, rows: np.ndarray, cols: np.ndarray, half_width: float,
+                     reach: int) -> np.ndarray:
+        """Which of the cells have ``half_width`` of clearance, as :meth:`clearance` tells,
+        from the clearances of their bounding window grown by ``reach`` cells (a blocked cell
+        beyond it leaves every one of them clear, one within it is as near as on the whole
+        grid)."""
+        if len(rows) == 0:
+            return np.zeros(0, dtype=bool)
+        ny, nx = self.blocked.shape
+        r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
+        sub = self.blocked[r0:min(int(rows.max()) + reach + 1, ny),
+                           c0:min(int(cols.max()) + reach + 1, nx)]
+        if not sub.any():
+            return np.ones(len(rows), dtype=bool)
+        from scipy.ndimage import distance_transform_edt
+
+        d = distance_transform_edt(~sub) * self.res - self.res / 2
+        clear: np.ndarray = np.maximum(d, 0.0)[rows - r0, cols - c0] >= half_width
+        return clear
 
     def _clear_at(self, row: int, col: int, reach: int) -> float:
         """The cell's clearance as :meth:`clearance` gives it (the same operations on the
