@@ -177,14 +177,14 @@ class FloorGrid:
         """:meth:`nearest_clear` inside ``within`` without the whole grid's clearances: the
         same cell (the nearest, the first in row order among equally near ones); or
         ``_UNDECIDED`` on a grid without a blocked cell (where the distance transform has no
-        answer to match).
+        answer to match) or for a point that is not finite.
 
         The nearest :data:`NEAR_TRIES` cells are tried one by one (:meth:`_clear_at`), then
         the cells of ever wider discs round (x, y) all at once (:meth:`_clear_cells`)."""
         found = self._window(within)
         if found is None:
             return None
-        if not self.blocked.any():
+        if not self.blocked.any() or not (math.isfinite(x) and math.isfinite(y)):
             return _UNDECIDED
         j0, i0, inside = found
         rows, cols = np.nonzero(inside)

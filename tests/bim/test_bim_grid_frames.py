@@ -104,3 +104,11 @@ def test_nearest_first_is_the_start_of_a_stable_sort() -> None:
         values = np.round(rng.uniform(0, 3, int(rng.integers(1, 60))), 1)  # many ties
         count = int(rng.integers(1, 12))
         assert _nearest_first(values, count) == np.argsort(values, kind="stable")[:count].tolist()
+
+
+def test_nearest_clear_of_a_point_that_is_not_finite_is_the_whole_grids() -> None:
+    grid = _grid(np.random.default_rng(4))
+    within = Rect(3.0, 3.0, 4.0, 4.0)
+    quick = grid.nearest_clear(math.nan, 1.0, 0.3, within=within)
+    grid.clearance()
+    assert grid.nearest_clear(math.nan, 1.0, 0.3, within=within) == quick
