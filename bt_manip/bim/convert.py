@@ -62,7 +62,7 @@ from bt_manip.bim.world_yaml import world_yaml
 from bt_manip.errors import InputError
 from bt_manip.outputs import check_output_folder, make_folder
 from bt_manip.sim.robot_description import RobotDescription, find_descriptor
-from bt_manip.sim.world_reader import parse_world
+from bt_manip.sim.world_reader import check_world
 
 DEFAULT_DENSITY = 420.0
 """Mass density (kg/m3) of an element whose material gives none: a light board, like Scenario
@@ -647,4 +647,4 @@ def _schedule_document(c: Conversion, options: BimOptions) -> dict[str, Any]:
 
 def _check_world(path: Path) -> None:
     """The written world must load: a problem here is bt-manip's, reported as such."""
-    parse_world(path)
+    check_world(path)

@@ -22,6 +22,9 @@ RESOLUTION = 0.05
 """Cell size (m)."""
 MARGIN = 2.0
 """Free floor (m) around the building's extent (a robot may go round the outside)."""
+NEAR_TRIES = 8
+"""Cells :meth:`FloorGrid.nearest_clear` tries one by one before computing clearances."""
+_UNDECIDED = object()
 MAX_CELLS = 25_000_000
 """Cells at most, as for navigation grids (250 m x 250 m at 5 cm)."""
 
@@ -145,7 +148,15 @@ class FloorGrid:
     def nearest_clear(
         self, x: float, y: float, half_width: float, within: Rect | None = None
     ) -> tuple[float, float] | None:
-        """The cell centre nearest (x, y) with ``half_width`` of clearance (inside ``within``)."""
+        """The cell centre nearest (x, y) with ``half_width`` of clearance (inside ``within``).
+
+        Before the grid's clearances are needed for anything else, the cells of ``within``
+        are tried nearest first, each against the blocked cells round it only
+        (:meth:`_clear_at`), rather than computing every cell's clearance."""
+        if self._clearance is None and within is not None and half_width > 0:
+            found = self._nearest_clear_within(x, y, half_width, within)
+            if found is not _UNDECIDED:
+                return found if isinstance(found, tuple) else None
         ok = self.clearance() >= half_width
         if within is not None:
             mask = np.zeros_like(ok)
@@ -159,6 +170,82 @@ class FloorGrid:
         ys = self.y0 + (rows + 0.5) * self.res
         k = int(np.argmin((xs - x) ** 2 + (ys - y) ** 2))
         return (float(xs[k]), float(ys[k]))
+
+    def _nearest_clear_within(
+        self, x: float, y: float, half_width: float, within: Rect
+    ) -> tuple[float, float] | object | None:
+        """:meth:`nearest_clear` inside ``within`` without the whole grid's clearances: the
+        same cell (the nearest, the first in row order among equally near ones); or
+        ``_UNDECIDED`` on a grid without a blocked cell (where the distance transform has no
+        answer to match) or for a point that is not finite.
+
+        The nearest :data:`NEAR_TRIES` cells are tried one by one (:meth:`_clear_at`), then
+        the cells of ever wider discs round (x, y) all at once (:meth:`_clear_cells`)."""
+        found = self._window(within)
+        if found is None:
+            return None
+        if not self.blocked.any() or not (math.isfinite(x) and math.isfinite(y)):
+            return _UNDECIDED
+        j0, i0, inside = found
+        rows, cols = np.nonzero(inside)
+        rows, cols = rows + j0, cols + i0
+        xs = self.x0 + (cols + 0.5) * self.res
+        ys = self.y0 + (rows + 0.5) * self.res
+        near = (xs - x) ** 2 + (ys - y) ** 2
+        # a blocked cell this many cells away (or farther) leaves a cell clear
+        reach = math.ceil((half_width + self.res) / self.res) + 2
+        for k in _nearest_first(near, NEAR_TRIES):
+            if self._clear_at(int(rows[k]), int(cols[k]), reach) >= half_width:
+                return (float(xs[k]), float(ys[k]))
+        # then discs round (x, y) growing twice as wide each time, up to the whole rectangle:
+        # the nearest clear cell of a disc is the rectangle's, as every cell outside the disc
+        # is farther
+        radius = (reach + 4) * self.res
+        while True:
+            some = np.flatnonzero(near <= radius * radius)
+            whole = len(some) == len(near)
+            ok = some[self._clear_cells(rows[some], cols[some], half_width, reach)]
+            if len(ok):
+                k = int(ok[int(np.argmin(near[ok]))])
+                return (float(xs[k]), float(ys[k]))
+            if whole:
+                return None
+            radius *= 2
+
+    def _clear_cells(self, rows: np.ndarray, cols: np.ndarray, half_width: float,
+                     reach: int) -> np.ndarray:
+        """Which of the cells have ``half_width`` of clearance, as :meth:`clearance` tells,
+        from the clearances of their bounding window grown by ``reach`` cells (a blocked cell
+        beyond it leaves every one of them clear, one within it is as near as on the whole
+        grid)."""
+        if len(rows) == 0:
+            return np.zeros(0, dtype=bool)
+        ny, nx = self.blocked.shape
+        r0, c0 = max(int(rows.min()) - reach, 0), max(int(cols.min()) - reach, 0)
+        sub = self.blocked[r0:min(int(rows.max()) + reach + 1, ny),
+                           c0:min(int(cols.max()) + reach + 1, nx)]
+        if not sub.any():
+            return np.ones(len(rows), dtype=bool)
+        from scipy.ndimage import distance_transform_edt
+
+        d = distance_transform_edt(~sub) * self.res - self.res / 2
+        clear: np.ndarray = np.maximum(d, 0.0)[rows - r0, cols - c0] >= half_width
+        return clear
+
+    def _clear_at(self, row: int, col: int, reach: int) -> float:
+        """The cell's clearance as :meth:`clearance` gives it (the same operations on the
+        same squared distance to the nearest blocked cell), when it is less than ``reach``
+        cells; else at least that."""
+        ny, nx = self.blocked.shape
+        r0, c0 = max(row - reach, 0), max(col - reach, 0)
+        near = self.blocked[r0:min(row + reach + 1, ny), c0:min(col + reach + 1, nx)]
+        br, bc = np.nonzero(near)
+        if len(br) == 0:
+            return reach * self.res
+        d2 = int(((br + (r0 - row)) ** 2 + (bc + (c0 - col)) ** 2).min())
+        if d2 > reach * reach:
+            return reach * self.res  # a farther blocked cell, outside the window, may be nearer
+        return max(math.sqrt(float(d2)) * self.res - self.res / 2, 0.0)
 
     def _near(
         self, x: float, y: float, reach: float, ok: np.ndarray
@@ -246,3 +333,13 @@ class FloorGrid:
                 out.append(d - 1)
             idx = int(parent[idx])
         return out[::-1]
+
+
+def _nearest_first(values: np.ndarray, count: int) -> list[int]:
+    """The indices of the ``count`` least of ``values``, least first, equal ones in index
+    order: the start of ``np.argsort(values, kind="stable")`` without sorting them all."""
+    if len(values) <= count:
+        return [int(k) for k in np.argsort(values, kind="stable")]
+    bound = np.partition(values, count - 1)[count - 1]
+    few = np.flatnonzero(values <= bound)
+    return [int(k) for k in few[np.argsort(values[few], kind="stable")][:count]]

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.bim.hulls import next_rows
 from bt_manip.bim.shapes import Box, footprint_box, hull_xy
 
 HULL_FILL = 0.85
@@ -84,7 +85,7 @@ def _shoelace(pts: np.ndarray) -> float:
     """The signed area of the polygon through ``pts`` in turn (positive counter-clockwise):
     at most the area of their convex hull when it is simple."""
     x, y = pts[:, 0], pts[:, 1]
-    return float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))) / 2.0
+    return float(np.dot(x, next_rows(y)) - np.dot(y, next_rows(x))) / 2.0
 
 
 def wall_gaps(

@@ -23,9 +23,10 @@ def monotone_chain(pts: np.ndarray) -> np.ndarray:
     coordinates' size of an edge)."""
     rows = pts.tolist()
     xs, ys = [r[0] for r in rows], [r[1] for r in rows]
-    if all(math.isfinite(v) for v in xs + ys):  # numpy's max and ptp, in Python
-        big = max(max(map(abs, xs)), max(map(abs, ys)))
-        span = max(max(xs) - min(xs), max(ys) - min(ys))
+    if math.isfinite(sum(xs) + sum(ys)):  # all finite: numpy's max and ptp, in Python
+        x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+        big = max(-x0, x1, -y0, y1)  # the largest magnitude
+        span = max(x1 - x0, y1 - y0)
     else:
         big, span = float(np.abs(pts).max()), float(np.ptp(pts, axis=0).max())
     # a turn this small is rounding, not a corner: about where Qhull draws the line
@@ -58,6 +59,12 @@ def unique_rows(xy: np.ndarray) -> np.ndarray:
     keep[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
     out: np.ndarray = ordered[keep]
     return out
+
+
+def next_rows(a: np.ndarray) -> np.ndarray:
+    """The rows of ``a`` each replaced by the next, the last by the first (a polygon's next
+    corners): ``np.roll(a, -1, axis=0)``, without its generic setup."""
+    return np.concatenate((a[1:], a[:1]))
 
 
 def hull_xy(xy: np.ndarray) -> np.ndarray:

@@ -44,6 +44,9 @@ class IfcSource:
     _starts: Any = None
     _offsets: dict[int, int] | None = None
     _lookups: int = 0
+    elevations: dict[int, float] = field(default_factory=dict)
+    """Storeys' floor heights (m) by step id, each computed once
+    (:func:`~bt_manip.bim.storeys.storey_elevation`)."""
 
     def line_of(self, step_id: int) -> int | None:
         """1-based line on which entity ``#step_id`` is defined (None if not found)."""

@@ -126,12 +126,19 @@ def _climb(current: Any, memo: dict[tuple[str, int], Any] | None = None) -> Any:
 
 
 def storey_elevation(source: IfcSource, storey: Any) -> float:
-    """Height (m) of the storey's floor: its placement, else its Elevation attribute."""
+    """Height (m) of the storey's floor: its placement, else its Elevation attribute (each
+    storey's once per source)."""
     import ifcopenshell.util.placement as placement
 
-    if storey.ObjectPlacement is not None:
-        return float(placement.get_local_placement(storey.ObjectPlacement)[2][3]) * source.scale
-    return float(storey.Elevation or 0.0) * source.scale
+    found = source.elevations.get(storey.id())
+    if found is None:
+        if storey.ObjectPlacement is not None:
+            found = float(placement.get_local_placement(storey.ObjectPlacement)[2][3]) * \
+                source.scale
+        else:
+            found = float(storey.Elevation or 0.0) * source.scale
+        source.elevations[storey.id()] = found
+    return found
 
 
 def choose_storey(source: IfcSource, wanted: str | None = None) -> StoreyChoice:

@@ -462,6 +462,19 @@ def parse_world(path: str | Path) -> WorldSpec:
     that names no URDF (whose files and meshes would need checking again), is not parsed
     again: the caller gets a copy of the spec parsed then, which is what parsing would give.
     """
+    spec, kept = _checked_world(path)
+    return copy.deepcopy(spec) if kept else spec
+
+
+def check_world(path: str | Path) -> None:
+    """Check a world file as :func:`parse_world` does (the same problems raised), for a caller
+    that needs no spec: one known already is not copied."""
+    _checked_world(path)
+
+
+def _checked_world(path: str | Path) -> tuple[WorldSpec, bool]:
+    """The world file's spec, and whether it is the one kept from an earlier read (which the
+    caller must not change)."""
     path = Path(path)
     data = read_bounded(path, MAX_YAML_BYTES, "YAML file")
     base = path.resolve().parent
@@ -470,12 +483,12 @@ def parse_world(path: str | Path) -> WorldSpec:
     if known is not None and all(
         find_descriptor(name, base) == found for name, found in known.descriptors
     ):
-        return copy.deepcopy(known.spec)
+        return known.spec, True
     spec = _parse_world(path, data)
     if all(b.urdf is None for b in spec.furniture + spec.objects + spec.models):
         found = tuple((r.description, r.description_path) for r in spec.robots)
         _WORLD_MEMO.put(key, _KnownWorld(copy.deepcopy(spec), found))
-    return spec
+    return spec, False
 
 
 def _parse_world(path: Path, raw: bytes) -> WorldSpec:

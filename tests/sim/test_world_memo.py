@@ -11,7 +11,7 @@ import pytest
 
 from bt_manip.errors import InputError
 from bt_manip.sim.world import World
-from bt_manip.sim.world_reader import parse_world
+from bt_manip.sim.world_reader import check_world, parse_world
 
 ROOT = Path(__file__).resolve().parents[2]
 TRIANGLE = "v 0 0 0\nv 0.1 0 0\nv 0 0.1 0\nf 1 2 3\n"
@@ -62,3 +62,24 @@ def test_every_load_gets_its_own_spec_equal_to_a_first_parse(tmp_path: Path) -> 
         pose_a = a.body_pose("panel")
     with World(world, seed=3) as b:
         assert b.body_pose("panel") == pose_a
+
+
+def test_checking_a_known_world_leaves_every_load_its_own_spec(tmp_path: Path) -> None:
+    world = tmp_path / "house.yaml"
+    shutil.copy(ROOT / "worlds" / "tb3_house.yaml", world)
+    check_world(world)  # parsed and kept
+    first = parse_world(world)
+    check_world(world)  # known: nothing to copy
+    first.walls.pop()
+    again = parse_world(world)
+    assert again != first and len(again.walls) == len(first.walls) + 1
+
+
+def test_checking_a_world_raises_what_parsing_raises(tmp_path: Path) -> None:
+    world = tmp_path / "bad.yaml"
+    world.write_text("name: bad\nwalls: 3\n")
+    with pytest.raises(InputError) as parsed:
+        parse_world(world)
+    with pytest.raises(InputError) as checked:
+        check_world(world)
+    assert str(checked.value) == str(parsed.value) and f"{world}:2" in str(checked.value)
