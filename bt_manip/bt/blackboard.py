@@ -20,7 +20,7 @@ import json
 import math
 import re
 import typing
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from bt_manip.bt.ports import convert_literal, type_name
@@ -199,9 +199,11 @@ class Blackboard:
         """Keys stored in this blackboard itself (not those reached through the parent)."""
         return iter(list(self._data))
 
-    def as_dict(self) -> dict[str, Any]:
-        """The entries of this blackboard as a JSON-serialisable dict."""
-        return {key: _jsonable(value) for key, value in sorted(self._data.items())}
+    def as_dict(self, other: Callable[[Any], Any] = str) -> dict[str, Any]:
+        """The entries of this blackboard as a JSON-serialisable dict; a value JSON has no
+        type for (not a number, text, list, dict, array or enum) is ``other(value)``, its text
+        by default."""
+        return {key: _jsonable(value, other) for key, value in sorted(self._data.items())}
 
     def __repr__(self) -> str:
         return f"Blackboard({self._data!r})"
@@ -258,18 +260,18 @@ def _from_text(name: str, text: str, data_type: Any) -> Any:
             f"({type_name(data_type)}): {e}") from None
 
 
-def _jsonable(value: Any) -> Any:
+def _jsonable(value: Any, other: Callable[[Any], Any] = str) -> Any:
     if value is None or isinstance(value, (bool, int, str)):
         return value
     if isinstance(value, float):
         return value if math.isfinite(value) else str(value)
     if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
+        return {str(k): _jsonable(v, other) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
+        return [_jsonable(v, other) for v in value]
     tolist = getattr(value, "tolist", None)
     if callable(tolist):
-        return _jsonable(tolist())
+        return _jsonable(tolist(), other)
     if hasattr(value, "value") and hasattr(value, "name"):  # enums
         return str(value.name)
-    return str(value)
+    return other(value)

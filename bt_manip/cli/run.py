@@ -18,6 +18,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
+from bt_manip.bt.pytrees import values
 from bt_manip.bundled import DEMO_TREE, DEMO_WORLD, shipped_or_given
 from bt_manip.cli.args import (
     DEFAULT_MAX_SIM_TIME,
@@ -299,13 +300,25 @@ def run_tree(command: RunCommand) -> int:
             path = command.report
             writes.append(("--report", path, lambda: report.write(path)))
         if command.bb_out:
-            entries = json.dumps(tree.blackboard.as_dict(), indent=2, default=str) + "\n"
+            entries = json.dumps(tree.blackboard.as_dict(_bb_value), indent=2) + "\n"
             bb_path = command.bb_out
             writes.append(("--bb-out", bb_path, lambda: write_text(bb_path, entries)))
         status = _write_outputs(writes) or report.exit_code
         if command.keep_serving and viz.viewing:
             viz.serve_until_interrupted()
         return status
+
+
+def _bb_value(value: Any) -> Any:
+    """``--bb-out``'s JSON for a value JSON has no type for: an object of a registered value
+    type as ``to_xml`` writes it (``{"$type": NAME, "state": {...}}``), anything else as its
+    text."""
+    if values.is_value(value):
+        try:
+            return values.encode_value(value)
+        except ValueError:  # attributes JSON cannot hold: its text, as for any other object
+            pass
+    return str(value)
 
 
 def _start_groot(command: RunCommand, episode: Any) -> Any:

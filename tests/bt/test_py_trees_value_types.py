@@ -9,6 +9,7 @@ attribute JSON cannot hold is refused when writing, and an unregistered name is 
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Iterator
 from pathlib import Path
@@ -327,5 +328,10 @@ def test_cli_validate_and_run_refuse_an_unregistered_type_and_take_one_from_impo
         assert err.startswith(expected) and "Traceback" not in err
     assert main(["validate", str(tree), "--import", str(plugin)]) == 0
     assert capsys.readouterr().out == f"{tree}: OK\n"
-    assert main(["run", str(tree), "--quiet", "--import", str(plugin)]) == 0
+    bb_out = tmp_path / "bb.json"
+    assert main(["run", str(tree), "--quiet", "--import", str(plugin),
+                 "--bb-out", str(bb_out)]) == 0
     assert "result: SUCCESS" in capsys.readouterr().out.splitlines()
+    # the blackboard file writes the value as the XML does
+    assert json.loads(bb_out.read_text())["v"] == {"$type": "Point",
+                                                   "state": {"x": 1.5, "y": -2}}
