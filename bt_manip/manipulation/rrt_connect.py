@@ -251,41 +251,44 @@ def plan_steps(
     )
 
 
+class _Block:
+    """Values drawn ``BLOCK`` at a time by ``draw`` and handed out one by one, in order."""
+
+    def __init__(self, draw: Callable[[], np.ndarray]) -> None:
+        self._draw = draw
+        self._rows: np.ndarray = np.empty(0)
+        self._next = 0
+
+    def take(self) -> np.ndarray:
+        if self._next == len(self._rows):
+            self._rows, self._next = self._draw(), 0
+        self._next += 1
+        row: np.ndarray = self._rows[self._next - 1]
+        return row
+
+
 class _Draws:
-    """The search's random numbers, drawn from the generator in blocks (one draw of a block
-    costs about what one configuration's did): coin flips in [0, 1), configurations uniform
-    within the limits and standard normal steps, each kind in the order asked."""
+    """The search's random numbers, drawn from the generator in blocks of :data:`BLOCK` (one
+    draw of a block costs about what one configuration's did): coin flips in [0, 1),
+    configurations uniform within the limits and standard normal steps, each kind in the
+    order asked."""
 
     BLOCK = 128
 
     def __init__(self, rng: np.random.Generator, lo: np.ndarray, hi: np.ndarray) -> None:
-        self._rng, self._lo, self._span = rng, lo, hi - lo
-        self._coins = np.empty(0)
-        self._configs: np.ndarray = np.empty((0, lo.size))
-        self._normals: np.ndarray = np.empty((0, lo.size))
-        self._c = self._q = self._g = 0
+        shape, span = (self.BLOCK, lo.size), hi - lo
+        self._coins = _Block(lambda: rng.random(self.BLOCK))
+        self._configs = _Block(lambda: lo + span * rng.random(shape))
+        self._normals = _Block(lambda: rng.standard_normal(shape))
 
     def coin(self) -> float:
-        if self._c == len(self._coins):
-            self._coins, self._c = self._rng.random(self.BLOCK), 0
-        self._c += 1
-        return float(self._coins[self._c - 1])
+        return float(self._coins.take())
 
     def config(self) -> np.ndarray:
-        if self._q == len(self._configs):
-            u = self._rng.random((self.BLOCK, self._lo.size))
-            self._configs, self._q = self._lo + self._span * u, 0
-        self._q += 1
-        row: np.ndarray = self._configs[self._q - 1]
-        return row
+        return self._configs.take()
 
     def normal(self) -> np.ndarray:
-        if self._g == len(self._normals):
-            self._normals = self._rng.standard_normal((self.BLOCK, self._lo.size))
-            self._g = 0
-        self._g += 1
-        row: np.ndarray = self._normals[self._g - 1]
-        return row
+        return self._normals.take()
 
 
 def _turn(trees: tuple[_Tree, _Tree], a: int, b: int,
