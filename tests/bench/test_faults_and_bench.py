@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from processes import sigint_default
 
 from bt_manip.bench.episodes import EpisodeResult
 from bt_manip.bench.stats import summarise, wilson_interval
@@ -245,15 +246,6 @@ def test_outcomes_plot_has_integer_seed_and_count_ticks() -> None:
     plt.close(fig)
 
 
-def _sigint_default() -> None:
-    """Run in the child before it starts: SIGINT to its default action, so that the child's
-    Python turns it into KeyboardInterrupt even when the tests run as a background job (a
-    shell starts those with SIGINT ignored, and their children inherit that)."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
     import os
     import signal
@@ -275,7 +267,7 @@ def test_bench_ctrl_c_stops_the_workers_and_exits_130(tmp_path: Path) -> None:
         text=True,
         env={**os.environ, "PYTHONUNBUFFERED": "1"},
         start_new_session=True,  # Ctrl-C reaches the whole process group, workers included
-        preexec_fn=_sigint_default,
+        preexec_fn=sigint_default,
     )
     assert proc.stdout is not None
     assert proc.stdout.readline().startswith("bench: 6 episodes")  # the workers are starting

@@ -11,6 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
+from processes import sigint_default
 from tree_files import write_tree
 
 from bt_manip.cli import main
@@ -92,15 +93,6 @@ def test_durations_run_on_the_sim_clock(
     assert data["seed"] == 0 and data["world"] == str(TABLE)
 
 
-def _sigint_default() -> None:
-    """Run in the child before it starts: SIGINT to its default action, so that the child's
-    Python turns it into KeyboardInterrupt even when the tests run as a background job (a
-    shell starts those with SIGINT ignored, and their children inherit that)."""
-    import signal
-
-    signal.signal(signal.SIGINT, signal.SIG_DFL)
-
-
 def test_ctrl_c_halts_and_exits_130(tmp_path: Path) -> None:
     tree = write_tree(tmp_path, '<Sleep msec="600000"/>')
     report = tmp_path / "r.json"
@@ -110,7 +102,7 @@ def test_ctrl_c_halts_and_exits_130(tmp_path: Path) -> None:
         stderr=subprocess.PIPE,
         text=True,
         env={**os.environ, "PYTHONUNBUFFERED": "1"},
-        preexec_fn=_sigint_default,
+        preexec_fn=sigint_default,
     )
     assert proc.stdout is not None
     first = proc.stdout.readline()  # the first status line: the tree is running
