@@ -57,7 +57,7 @@ def _tolerance_np(pts: np.ndarray) -> float:
 def _finite(rows: Sequence[Sequence[float]]) -> bool:
     """Whether every coordinate of the rows is finite (their sum is, unless it overflows:
     then the rows are taken for not finite, which only costs numpy's way)."""
-    return math.isfinite(sum(r[0] for r in rows) + sum(r[1] for r in rows))
+    return math.isfinite(sum(map(sum, rows)))
 
 
 def _chain(rows: Sequence[P], eps: float) -> list[P]:

@@ -705,7 +705,7 @@ def _extents_py(xy: np.ndarray, angles: list[float]) -> list[Extent] | None:
     extremes; None when they would not be the same numbers (a coordinate that is not finite,
     or an extreme that is zero, whose sign numpy's reduction picks its own way)."""
     rows = xy.tolist()
-    if not math.isfinite(sum(r[0] for r in rows) + sum(r[1] for r in rows)):
+    if not math.isfinite(sum(map(sum, rows))):  # else numpy's extremes (of a NaN, say)
         return None
     found: dict[float, Extent] = {}  # an angle met again (a box's opposite sides) is known
     out = []
