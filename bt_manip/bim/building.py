@@ -29,8 +29,6 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from bt_manip.bim.footprints import strip_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
@@ -38,6 +36,7 @@ from bt_manip.bim.shapes import (
     ShapeReader,
     UnsupportedGeometry,
     footprint_box,
+    hull_box,
     hull_xy,
     is_box_like,
 )
@@ -393,8 +392,7 @@ def _footprint(pts: Any, element: Any, building: Building, names: Names,
         return None
     bottom = max(bottom, 0.0)
     corners = hull_xy(pts[:, :2])
-    flat = np.column_stack([corners, np.zeros(len(corners))])
-    box = footprint_box(flat, yaw)
+    box = hull_box(corners, yaw)
     # the hull of the corners is the corners themselves, and their least box this one
     parts = [_shift(b, building.floor_z) for b in
              strip_boxes(corners, box, bottom + building.floor_z, top + building.floor_z)]

@@ -14,14 +14,14 @@ height) that no triangle covers are its openings.
 
 from __future__ import annotations
 
+import bisect
 import itertools
 import math
 from typing import Any
 
 import numpy as np
 
-from bt_manip.bim.hulls import next_rows
-from bt_manip.bim.shapes import Box, footprint_box, hull_xy
+from bt_manip.bim.shapes import Box, hull_box, hull_xy
 
 HULL_FILL = 0.85
 """A hull filling at least this share of its least box is the box itself."""
@@ -37,15 +37,19 @@ def hull_boxes(points: np.ndarray, bottom: float, top: float,
                hint_yaw: float | None = None) -> list[Box]:
     """The boxes (from ``bottom`` to ``top``, m) covering the hull of ``points``' footprint."""
     corners = hull_xy(points[:, :2])
-    box = footprint_box(np.column_stack([corners, np.zeros(len(corners))]), hint_yaw)
-    return strip_boxes(corners, box, bottom, top)
+    return strip_boxes(corners, hull_box(corners, hint_yaw), bottom, top)
 
 
 def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> list[Box]:
     """:func:`hull_boxes` of a footprint whose hull ``corners`` (N x 2) and least box ``box``
-    (:func:`~bt_manip.bim.shapes.footprint_box` of the corners) are known already."""
-    import shapely
+    (:func:`~bt_manip.bim.shapes.hull_box` of the corners) are known already.
 
+    GEOS's hull of the corners decides whether they fill their box and cuts the strips from
+    it, unless the corners' own polygon answers: clearly full (its area beyond the threshold
+    by more than rounding), or clearly not, and convex, its corners in turn (the hull of the
+    corners is then that polygon, and its strips are cut in Python, their bounds within
+    rounding of GEOS's).
+    """
     height = top - bottom
     z = (bottom + top) / 2
     whole = Box((box.centre[0], box.centre[1], z), (box.size[0], box.size[1], height), box.yaw)
@@ -53,16 +57,43 @@ def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> lis
     if area <= 1e-9:
         return [whole]
     c, s = math.cos(box.yaw), math.sin(box.yaw)
-    xy = corners - np.array(box.centre[:2])
-    uv = np.column_stack([xy @ np.array([c, s]), xy @ np.array([-s, c])])
+    cx, cy = box.centre[0], box.centre[1]
+    uv = [((x - cx) * c + (y - cy) * s, (y - cy) * c - (x - cx) * s)
+          for x, y in corners.tolist()]
     if _shoelace(uv) >= HULL_FILL * area * (1.0 + 1e-9):
         # the hull of the corners holds their polygon: clearly full, whatever GEOS's rounding
         return [whole]
-    hull = shapely.convex_hull(shapely.multipoints(uv))
-    if hull.area >= HULL_FILL * area:
-        return [whole]
+    convex = _convex_area(uv)
+    if convex is None or convex >= HULL_FILL * area * (1.0 - 1e-9):
+        return _geos_strips(corners, box, whole)
+    out: list[Box] = []
+    for u0, u1, v0, v1 in _strips(uv, _strip_edges(box), box.size[1]):
+        u, v = (u0 + u1) / 2, (v0 + v1) / 2
+        out.append(Box((cx + c * u - s * v, cy + s * u + c * v, z),
+                       (u1 - u0, v1 - v0, height), box.yaw))
+    return out or [whole]
+
+
+def _strip_edges(box: Box) -> np.ndarray:
+    """Where the strips across a box's length begin and end, from end to end (along its
+    yaw, from its centre): :data:`STRIP` apart, at most :data:`MAX_STRIPS` strips."""
     n = min(MAX_STRIPS, max(2, math.ceil(box.size[0] / STRIP)))
-    edges = np.linspace(-box.size[0] / 2, box.size[0] / 2, n + 1)
+    return np.linspace(-box.size[0] / 2, box.size[0] / 2, n + 1)
+
+
+def _geos_strips(corners: np.ndarray, box: Box, whole: Box) -> list[Box]:
+    """:func:`strip_boxes` by GEOS: the hull of the corners, its area against the box's, and
+    the strips cut from it."""
+    import shapely
+
+    z, height = whole.centre[2], whole.size[2]
+    c, s = math.cos(box.yaw), math.sin(box.yaw)
+    xy = corners - np.array(box.centre[:2])
+    uv = np.column_stack([xy @ np.array([c, s]), xy @ np.array([-s, c])])
+    hull = shapely.convex_hull(shapely.multipoints(uv))
+    if hull.area >= HULL_FILL * box.size[0] * box.size[1]:
+        return [whole]
+    edges = _strip_edges(box)
     # the strips cut from the hull all at once (one call into GEOS for all of them)
     strips = shapely.box(edges[:-1], -box.size[1], edges[1:], box.size[1])
     parts = shapely.intersection(hull, strips)
@@ -81,11 +112,77 @@ def strip_boxes(corners: np.ndarray, box: Box, bottom: float, top: float) -> lis
     return out or [whole]
 
 
-def _shoelace(pts: np.ndarray) -> float:
+def _strips(uv: list[tuple[float, float]], edges: np.ndarray,
+            width: float) -> list[tuple[float, float, float, float]]:
+    """The strips ``(u0, u1, v0, v1)`` of a polygon (corners ``uv`` in turn) between each two
+    ``edges`` in u, each the bounds of the polygon's part in it (and within ``width`` of
+    v = 0, as GEOS's strips reach), leaving out the strips it misses or only touches (its
+    part less than 1e-6 across).
+
+    A part's bounds are those of its corners: the polygon's corners within the strip (on its
+    edges included) and the points where its sides cross the strip's edges.
+    """
+    cuts = edges.tolist()
+    n = len(cuts) - 1
+    low, high = [math.inf] * n, [-math.inf] * n
+
+    def add(k0: int, k1: int, v: float) -> None:  # the point (u, v) lies in strips k0..k1
+        for k in range(max(k0, 0), min(k1, n - 1) + 1):
+            low[k] = min(low[k], v)
+            high[k] = max(high[k], v)
+
+    for (pu, pv), (qu, qv) in zip(uv, uv[1:] + uv[:1], strict=True):
+        add(bisect.bisect_left(cuts, pu) - 1, bisect.bisect_right(cuts, pu) - 1, pv)
+        if pu == qu:
+            continue
+        a, b = (pu, qu) if pu < qu else (qu, pu)
+        # the strip edges strictly between the side's ends, each in the strips on its sides
+        for j in range(bisect.bisect_right(cuts, a), bisect.bisect_left(cuts, b)):
+            v = pv + (cuts[j] - pu) * (qv - pv) / (qu - pu)
+            add(j - 1, j, v)
+    out = []
+    for k in range(n):
+        v0, v1 = max(low[k], -width), min(high[k], width)
+        if v1 - v0 < 1e-6:  # missed (no point in it, or none within the width) or touched
+            continue
+        out.append((cuts[k], cuts[k + 1], v0, v1))
+    return out
+
+
+def _shoelace(pts: list[tuple[float, float]]) -> float:
     """The signed area of the polygon through ``pts`` in turn (positive counter-clockwise):
     at most the area of their convex hull when it is simple."""
-    x, y = pts[:, 0], pts[:, 1]
-    return float(np.dot(x, next_rows(y)) - np.dot(y, next_rows(x))) / 2.0
+    total = 0.0
+    px, py = pts[-1]
+    for x, y in pts:
+        total += px * y - py * x
+        px, py = x, y
+    return total / 2.0
+
+
+def _convex_area(pts: list[tuple[float, float]]) -> float | None:
+    """The area of the polygon through ``pts`` in turn when it is convex and
+    counter-clockwise (every turn to the left, its sides going right, then left, once
+    round): the area of the hull of its corners; else None."""
+    if len(pts) < 3:
+        return None
+    total = 0.0
+    turns = 0  # how often the sides change from going right to going left in u, and back
+    (ax, ay), (bx, by) = pts[-2], pts[-1]
+    going = 0.0
+    for cx, cy in pts:
+        if (bx - ax) * (cy - by) - (by - ay) * (cx - bx) <= 0.0:
+            return None
+        du = cx - bx
+        if du != 0.0:
+            if going != 0.0 and (du > 0.0) != (going > 0.0):
+                turns += 1
+            going = du
+        total += bx * cy - by * cx
+        (ax, ay), (bx, by) = (bx, by), (cx, cy)
+    if turns > 2:
+        return None
+    return total / 2.0
 
 
 def wall_gaps(

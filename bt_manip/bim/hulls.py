@@ -2,18 +2,29 @@
 points (an obstacle's outline, a mapped shape's) and the distinct points under it.
 
 Qhull (scipy) finds any hull, but its setup costs far more than the hull of the tens of
-points a footprint has: those go through :func:`monotone_chain` in Python instead.
+points a footprint has: those go through :func:`monotone_chain` in Python instead, and their
+distinct points are sorted as Python tuples (:func:`sorted_rows`) rather than by numpy.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import TypeVar
 
 import numpy as np
 
 SMALL_HULL = 256
 """Hulls of at most this many distinct points are found by :func:`monotone_chain`, larger
 ones by Qhull."""
+SMALL_SORT = 128
+"""Point sets of at most this many rows are sorted and made distinct in Python (beyond, numpy's
+sort is the quicker)."""
+
+Row = tuple[float, float]
+"""A point's x and y."""
+P = TypeVar("P", bound=Sequence[float])
+"""A point as a sequence of its x and y (a tuple, or a list from ``tolist``)."""
 
 
 def monotone_chain(pts: np.ndarray) -> np.ndarray:
@@ -22,31 +33,72 @@ def monotone_chain(pts: np.ndarray) -> np.ndarray:
     out, as Qhull leaves them (the two may differ on a point within about 1e-15 of the
     coordinates' size of an edge)."""
     rows = pts.tolist()
-    xs, ys = [r[0] for r in rows], [r[1] for r in rows]
-    if math.isfinite(sum(xs) + sum(ys)):  # all finite: numpy's max and ptp, in Python
-        x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
-        big = max(-x0, x1, -y0, y1)  # the largest magnitude
-        span = max(x1 - x0, y1 - y0)
-    else:
-        big, span = float(np.abs(pts).max()), float(np.ptp(pts, axis=0).max())
+    chain = chain_rows(rows) if _finite(rows) else _chain(rows, _tolerance_np(pts))
+    return np.array(chain, dtype=float).reshape(-1, 2)
+
+
+def chain_rows(rows: Sequence[P]) -> list[P]:
+    """:func:`monotone_chain` of distinct finite points sorted by x then y, given and returned
+    as Python rows (the same corners, without the arrays)."""
+    xs = [r[0] for r in rows]
+    ys = [r[1] for r in rows]
+    x0, x1, y0, y1 = min(xs), max(xs), min(ys), max(ys)
+    big = max(-x0, x1, -y0, y1)  # the largest magnitude: numpy's max of the absolute values
+    span = max(x1 - x0, y1 - y0)  # numpy's largest ptp
     # a turn this small is rounding, not a corner: about where Qhull draws the line
-    eps = 1e-15 * float(big) * float(span)
+    return _chain(rows, 1e-15 * big * span)
 
-    def half(points: list[list[float]]) -> list[list[float]]:
-        out: list[list[float]] = []
-        for p in points:
-            px, py = p
-            while len(out) >= 2:
-                ax, ay = out[-2]
-                bx, by = out[-1]
-                if (bx - ax) * (py - ay) - (by - ay) * (px - ax) > eps:
-                    break
-                out.pop()
-            out.append(p)
-        return out
 
-    lower, upper = half(rows), half(rows[::-1])
-    return np.array(lower[:-1] + upper[:-1], dtype=float).reshape(-1, 2)
+def _tolerance_np(pts: np.ndarray) -> float:
+    """The chain's rounding tolerance from numpy's extent (points that are not all finite)."""
+    return 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
+
+
+def _finite(rows: Sequence[Sequence[float]]) -> bool:
+    """Whether every coordinate of the rows is finite (their sum is, unless it overflows:
+    then the rows are taken for not finite, which only costs numpy's way)."""
+    return math.isfinite(sum(map(sum, rows)))
+
+
+def _chain(rows: Sequence[P], eps: float) -> list[P]:
+    """The lower chain of the sorted rows, then the upper one, each without its last corner,
+    a turn of at most ``eps`` dropping its middle point."""
+    lower = _half(rows, eps)
+    upper = _half(rows[::-1], eps)
+    return lower[:-1] + upper[:-1]
+
+
+def _half(rows: Sequence[P], eps: float) -> list[P]:
+    """One half of the monotone chain: the rows in turn, each dropping the last ones the
+    chain would not turn left (by more than ``eps``) after."""
+    out: list[P] = []
+    n = 0
+    for p in rows:
+        px, py = p
+        while n >= 2:
+            ax, ay = out[n - 2]
+            bx, by = out[n - 1]
+            if (bx - ax) * (py - ay) - (by - ay) * (px - ax) > eps:
+                break
+            out.pop()
+            n -= 1
+        out.append(p)
+        n += 1
+    return out
+
+
+def sorted_rows(xy: np.ndarray) -> list[Row] | None:
+    """The distinct rows of a small N x 2 array of finite numbers, sorted by x then y, as
+    Python tuples (:func:`unique_rows`: of rows equal but for the sign of a zero, the first
+    one kept); None for a large array or one not all finite (numpy's way then)."""
+    if len(xy) > SMALL_SORT:
+        return None
+    rows = xy.tolist()
+    if not _finite(rows):
+        return None
+    # a set keeps the first of equal tuples (0.0 == -0.0 and their hashes are the same), as
+    # unique_rows's stable sort does; tuples sort by x, then y
+    return sorted(set(map(tuple, rows)))  # type: ignore[arg-type]
 
 
 def unique_rows(xy: np.ndarray) -> np.ndarray:
@@ -70,14 +122,22 @@ def next_rows(a: np.ndarray) -> np.ndarray:
 def hull_xy(xy: np.ndarray) -> np.ndarray:
     """The corners of the convex hull of 2D points (the points themselves when they are
     fewer than three or collinear)."""
-    from scipy.spatial import ConvexHull, QhullError
-
-    pts = unique_rows(np.round(xy, 9))
+    rounded = np.round(xy, 9)
+    rows = sorted_rows(rounded)
+    if rows is not None:  # a few finite points: all in Python
+        if len(rows) >= 3:
+            chain = chain_rows(rows)
+            if len(chain) >= 3:
+                return np.array(chain, dtype=float)
+        return np.array(rows, dtype=rounded.dtype).reshape(-1, 2)
+    pts = unique_rows(rounded)
     if len(pts) < 3:
         return pts
     if len(pts) <= SMALL_HULL:
-        chain = monotone_chain(pts)
-        return chain if len(chain) >= 3 else pts
+        chain_np = monotone_chain(pts)
+        return chain_np if len(chain_np) >= 3 else pts
+    from scipy.spatial import ConvexHull, QhullError
+
     try:
         corners: np.ndarray = pts[ConvexHull(pts).vertices]
         return corners

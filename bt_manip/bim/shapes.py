@@ -32,10 +32,19 @@ from typing import Any
 import numpy as np
 
 from bt_manip.bim import ifc_attributes as at
-from bt_manip.bim.hulls import SMALL_HULL, hull_xy, monotone_chain, next_rows, unique_rows
+from bt_manip.bim.hulls import (
+    SMALL_HULL,
+    chain_rows,
+    hull_xy,
+    monotone_chain,
+    next_rows,
+    sorted_rows,
+    unique_rows,
+)
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
-           "footprint_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw", "unique_rows"]
+           "footprint_box", "hull_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw",
+           "unique_rows"]
 
 BOX_FILL = 0.9
 """A body is box-like when its volume is at least this share of its upright bounding box's
@@ -598,65 +607,136 @@ def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
     Qhull's, in the same turn but from another corner, which changes nothing unless boxes
     along different angles tie; only then is Qhull asked for its order.
     """
-    xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
+    return _fit_box(points[:, :2], hint_yaw, z0, z1)
+
+
+def hull_box(corners: np.ndarray, hint_yaw: float | None = None) -> Box:
+    """:func:`footprint_box` of the points at z 0 whose x and y are ``corners`` (N x 2, a
+    footprint's hull as :func:`~bt_manip.bim.hulls.hull_xy` gives it): the same box, of no
+    height, without stacking the corners with their z first."""
+    return _fit_box(corners, hint_yaw, 0.0, 0.0)
+
+
+def _fit_box(xy: np.ndarray, hint_yaw: float | None, z0: float, z1: float) -> Box:
+    """:func:`footprint_box` of the points ``xy`` (N x 2) whose lowest and highest z are
+    ``z0`` and ``z1``."""
     chain = _chain_hull(xy)
     found = _least_box(xy, _edge_angles(chain)) if chain is not None else None
     if found is None or not found[3]:  # Qhull's order decides
         found = _least_box(xy, _candidate_angles(xy))
     angle, lo, hi, _ = found
     a0 = angle
-    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
+    length, width = hi[0] - lo[0], hi[1] - lo[1]
     if width > length:
         angle += math.pi / 2
         length, width = width, length
     if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
         angle += math.pi
     angle = math.atan2(math.sin(angle), math.cos(angle))
-    mid_u, mid_v = (lo + hi) / 2
+    mid_u, mid_v = (lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2
     cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
     cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
-    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+    return Box((cx, cy, (z0 + z1) / 2), (length, width, z1 - z0), angle)
 
 
 TIE = 1e-9
 """Boxes whose footprints differ by less than this (m2) are equally small."""
+SMALL_BOX = 96
+"""The boxes of at most this many points times angles are measured in Python floats, larger
+sets by numpy (the same numbers either way)."""
+
+Extent = tuple[float, float, float, float]
+"""The least and greatest coordinates of points along an angle (u) and across it (v):
+``(u0, u1, v0, v1)``."""
 
 
-def _least_box(xy: np.ndarray,
-               angles: list[float]) -> tuple[float, np.ndarray, np.ndarray, bool]:
+def _least_box(xy: np.ndarray, angles: list[float],
+               ) -> tuple[float, tuple[float, float], tuple[float, float], bool]:
     """The angle, and the low and high corners (along and across it), of the least of the
     boxes along ``angles``: the first of the least, as :data:`TIE` apart; and whether that
     box is the same in any order of ``angles`` (False when boxes within twice the tie of the
     least lie along angles that are not all the same number)."""
-    # every candidate at once: the points' coordinates along (u) and across (v) each angle
+    extents = _extents_py(xy, angles) if len(xy) * len(angles) <= SMALL_BOX else None
+    if extents is None:
+        extents = _extents_np(xy, angles)
+    areas = [(u1 - u0) * (v1 - v0) for u0, u1, v0, v1 in extents]
+    # the pick is one of the boxes within TIE of the least, whatever the order: when they all
+    # lie along the same angle, it is the same box
+    limit = min(areas) + 2 * TIE
+    near = [a for a, area in zip(angles, areas, strict=True) if area <= limit]
+    order_free = all(a == near[0] for a in near)
+    pick = 0
+    for k in range(1, len(angles)):  # the first of the least, as TIE apart
+        if areas[k] < areas[pick] - TIE:
+            pick = k
+    u0, u1, v0, v1 = extents[pick]
+    return angles[pick], (u0, v0), (u1, v1), order_free
+
+
+def _extents_np(xy: np.ndarray, angles: list[float]) -> list[Extent]:
+    """The extents of the points along and across each angle, every candidate at once."""
+    c = [math.cos(a) for a in angles]
+    s = [math.sin(a) for a in angles]
+    x, y = xy[:, :1], xy[:, 1:2]
+    # u = x cos + y sin and v = y cos - x sin (the same sums: x (-sin) is -(x sin)) side by side
+    both = x * np.array(c + [-b for b in s]) + y * np.array(s + c)
+    k = len(angles)
+    lows, highs = both.min(axis=0).tolist(), both.max(axis=0).tolist()
+    if 0.0 in lows or 0.0 in highs:  # which zero numpy's reduction keeps depends on its shape
+        return _extents_apart(xy, angles)
+    return list(zip(lows[:k], highs[:k], lows[k:], highs[k:], strict=True))
+
+
+def _extents_apart(xy: np.ndarray, angles: list[float]) -> list[Extent]:
+    """:func:`_extents_np` reduced along and across the angles apart (the sign of a zero
+    extreme as each reduction gives it)."""
     c = np.array([math.cos(a) for a in angles])
     s = np.array([math.sin(a) for a in angles])
     x, y = xy[:, :1], xy[:, 1:2]
     u = x * c + y * s
     v = y * c - x * s
-    lows = np.stack([u.min(axis=0), v.min(axis=0)], axis=1)
-    highs = np.stack([u.max(axis=0), v.max(axis=0)], axis=1)
-    areas = (highs[:, 0] - lows[:, 0]) * (highs[:, 1] - lows[:, 1])
-    # the pick is one of the boxes within TIE of the least, whatever the order: when they all
-    # lie along the same angle, it is the same box
-    near = [angles[k] for k in np.flatnonzero(areas <= areas.min() + 2 * TIE)]
-    order_free = all(a == near[0] for a in near)
-    pick = 0
-    each = areas.tolist()  # the same numbers, compared in Python
-    for k in range(1, len(angles)):  # the first of the least, as TIE apart
-        if each[k] < each[pick] - TIE:
-            pick = k
-    return angles[pick], lows[pick], highs[pick], order_free
+    return list(zip(u.min(axis=0).tolist(), u.max(axis=0).tolist(),
+                    v.min(axis=0).tolist(), v.max(axis=0).tolist(), strict=True))
+
+
+def _extents_py(xy: np.ndarray, angles: list[float]) -> list[Extent] | None:
+    """:func:`_extents_np` of a few points, in Python floats: the same products, sums and
+    extremes; None when they would not be the same numbers (a coordinate that is not finite,
+    or an extreme that is zero, whose sign numpy's reduction picks its own way)."""
+    rows = xy.tolist()
+    if not math.isfinite(sum(map(sum, rows))):  # else numpy's extremes (of a NaN, say)
+        return None
+    found: dict[float, Extent] = {}  # an angle met again (a box's opposite sides) is known
+    out = []
+    for a in angles:
+        extent = found.get(a)
+        if extent is None:
+            c, s = math.cos(a), math.sin(a)
+            us = [x * c + y * s for x, y in rows]
+            vs = [y * c - x * s for x, y in rows]
+            extent = (min(us), max(us), min(vs), max(vs))
+            if 0.0 in extent:  # numpy's sign of zero
+                return _extents_apart(xy, angles)
+            found[a] = extent
+        out.append(extent)
+    return out
 
 
 def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
     """The corners, counter-clockwise, of the hull :func:`_candidate_angles` takes the edges
     of, when it has few points and at least three corners (else None: Qhull's case)."""
-    pts = unique_rows(np.round(xy, 6))
-    if len(pts) < 3 or len(pts) > SMALL_HULL:
-        return None
-    chain = monotone_chain(pts)
+    rounded = np.round(xy, 6)
+    rows = sorted_rows(rounded)
+    if rows is not None:  # a few finite points: sorted and chained in Python
+        if len(rows) < 3:
+            return None
+        chain = np.array(chain_rows(rows), dtype=float).reshape(-1, 2)
+    else:
+        pts = unique_rows(rounded)
+        if len(pts) < 3 or len(pts) > SMALL_HULL:
+            return None
+        chain = monotone_chain(pts)
     return chain if len(chain) >= 3 else None
 
 
