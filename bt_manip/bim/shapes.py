@@ -484,8 +484,8 @@ def _profile_points(profile: Any, axis: Any = None,
     ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without).
     With ``angle_unit`` (radians per the file's plane-angle unit), an outline that is a
     composite curve of polylines and circular arcs is read too, each arc as points of a
-    polygon that encloses it (:func:`_composite_points`): the points of an obstacle's
-    footprint, not an outline whose area counts."""
+    polygon that encloses it (:func:`_composite_points`), and a profile with voids by its
+    outer curve: the points of an obstacle's footprint, not an outline whose area counts."""
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
@@ -497,9 +497,11 @@ def _profile_points(profile: Any, axis: Any = None,
         angles = (np.arange(32) + 0.5) * (2 * math.pi / 32)
         radius = float(profile.get_argument(at.RADIUS)) / math.cos(math.pi / 32)
         pts = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
-    elif profile.is_a("IfcArbitraryClosedProfileDef") and not profile.is_a(
-        "IfcArbitraryProfileDefWithVoids"
+    elif profile.is_a("IfcArbitraryClosedProfileDef") and (
+        angle_unit is not None or not profile.is_a("IfcArbitraryProfileDefWithVoids")
     ):
+        # a profile with voids is read by its outer curve for a footprint: the voids lie
+        # within it, so they change neither the hull of the points nor their heights
         curve = profile.get_argument(at.OUTER_CURVE)
         if curve.is_a("IfcPolyline"):
             pts = _polyline_points(curve)
