@@ -628,6 +628,13 @@ def _fit_box(xy: np.ndarray, hint_yaw: float | None, z0: float, z1: float) -> Bo
     if found is None or not found[3]:  # Qhull's order decides
         found = _least_box(xy, _candidate_angles(xy))
     angle, lo, hi, _ = found
+    return _box_along(angle, lo, hi, hint_yaw, z0, z1)
+
+
+def _box_along(angle: float, lo: tuple[float, float], hi: tuple[float, float],
+               hint_yaw: float | None, z0: float, z1: float) -> Box:
+    """The box from ``lo`` to ``hi`` along (u) and across (v) ``angle``, from ``z0`` to
+    ``z1``: its length along its yaw, the sense of the yaw the one nearer ``hint_yaw``."""
     a0 = angle
     length, width = hi[0] - lo[0], hi[1] - lo[1]
     if width > length:

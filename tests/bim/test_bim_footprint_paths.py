@@ -21,46 +21,28 @@ pytest.importorskip("scipy")
 pytest.importorskip("shapely")
 
 import shapely
+from hull_reference import textbook_chain
 
 from bt_manip.bim.footprints import HULL_FILL, MAX_STRIPS, STRIP, hull_boxes, strip_boxes
-from bt_manip.bim.hulls import hull_xy
-from bt_manip.bim.shapes import TIE, Box, _candidate_angles, footprint_box, hull_box
-
-
-def _unique(xy: np.ndarray) -> np.ndarray:
-    if len(xy) == 0:
-        return np.empty((0, 2), dtype=float)
-    ordered = xy[np.lexsort((xy[:, 1], xy[:, 0]))]
-    keep = np.ones(len(ordered), dtype=bool)
-    keep[1:] = (ordered[1:] != ordered[:-1]).any(axis=1)
-    out: np.ndarray = ordered[keep]
-    return out
-
-
-def _chain(pts: np.ndarray) -> np.ndarray:
-    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
-
-    def half(points: list[list[float]]) -> list[list[float]]:
-        out: list[list[float]] = []
-        for p in points:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= eps:
-                out.pop()
-            out.append(p)
-        return out
-
-    rows = pts.tolist()
-    return np.array(half(rows)[:-1] + half(rows[::-1])[:-1], dtype=float).reshape(-1, 2)
+from bt_manip.bim.hulls import hull_xy, unique_rows
+from bt_manip.bim.shapes import (
+    TIE,
+    Box,
+    _box_along,
+    _candidate_angles,
+    footprint_box,
+    hull_box,
+)
 
 
 def _plain_hull(xy: np.ndarray) -> np.ndarray:
     from scipy.spatial import ConvexHull, QhullError
 
-    pts = _unique(np.round(xy, 9))
+    pts = unique_rows(np.round(xy, 9))
     if len(pts) < 3:
         return pts
     if len(pts) <= 256:
-        chain = _chain(pts)
+        chain = textbook_chain(pts)
         return chain if len(chain) >= 3 else pts
     try:
         corners: np.ndarray = pts[ConvexHull(pts).vertices]
@@ -90,10 +72,10 @@ def _plain_least(xy: np.ndarray,
 def _plain_box(points: np.ndarray, hint_yaw: float | None) -> Box:
     xy = points[:, :2]
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
-    pts = _unique(np.round(xy, 6))
+    pts = unique_rows(np.round(xy, 6))
     found = None
     if 3 <= len(pts) <= 256:
-        chain = _chain(pts)
+        chain = textbook_chain(pts)
         if len(chain) >= 3:
             edges = np.roll(chain, -1, axis=0) - chain
             angles = [a % (math.pi / 2) for a in np.arctan2(edges[:, 1], edges[:, 0]).tolist()]
@@ -101,18 +83,8 @@ def _plain_box(points: np.ndarray, hint_yaw: float | None) -> Box:
     if found is None or not found[3]:
         found = _plain_least(xy, _candidate_angles(xy))
     angle, lo, hi, _ = found
-    a0 = angle
-    length, width = float(hi[0] - lo[0]), float(hi[1] - lo[1])
-    if width > length:
-        angle += math.pi / 2
-        length, width = width, length
-    if hint_yaw is not None and math.cos(angle - hint_yaw) < 0:
-        angle += math.pi
-    angle = math.atan2(math.sin(angle), math.cos(angle))
-    mid_u, mid_v = (lo + hi) / 2
-    cx = mid_u * math.cos(a0) - mid_v * math.sin(a0)
-    cy = mid_u * math.sin(a0) + mid_v * math.cos(a0)
-    return Box((float(cx), float(cy), (z0 + z1) / 2), (length, width, z1 - z0), angle)
+    return _box_along(angle, (float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])),
+                      hint_yaw, z0, z1)
 
 
 def _geos_strips(corners: np.ndarray, box: Box, bottom: float, top: float) -> list[Box]:

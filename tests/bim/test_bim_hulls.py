@@ -16,6 +16,7 @@ import pytest
 pytest.importorskip("scipy")
 pytest.importorskip("shapely")
 
+from hull_reference import textbook_chain
 from scipy.spatial import ConvexHull
 
 from bt_manip.bim.footprints import hull_boxes, strip_boxes
@@ -118,25 +119,8 @@ def test_full_footprints_without_geos_are_geos(monkeypatch: pytest.MonkeyPatch) 
     assert fast == [strip_boxes(corners, box, 0.0, 1.0) for corners, box in cases]
 
 
-def _textbook_chain(pts: np.ndarray) -> np.ndarray:
-    """Andrew's monotone chain with numpy's extent for the rounding tolerance."""
-    eps = 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
-
-    def half(points: list[list[float]]) -> list[list[float]]:
-        out: list[list[float]] = []
-        for p in points:
-            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
-                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= eps:
-                out.pop()
-            out.append(p)
-        return out
-
-    rows = pts.tolist()
-    return np.array(half(rows)[:-1] + half(rows[::-1])[:-1], dtype=float).reshape(-1, 2)
-
-
 def test_monotone_chain_is_the_textbook_chain() -> None:
     rng = np.random.default_rng(5)
     for xy in [*_shapes(5), *(np.round(rng.normal(size=(40, 2)) * 10, d) for d in range(4))]:
         pts = unique_rows(np.round(xy, 9))
-        assert np.array_equal(monotone_chain(pts), _textbook_chain(pts))
+        assert np.array_equal(monotone_chain(pts), textbook_chain(pts))
