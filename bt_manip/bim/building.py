@@ -453,6 +453,11 @@ def _read_wall(source: IfcSource, reader: ShapeReader, wall: Any, building: Buil
         shifted = verts - [0.0, 0.0, floor_z]
         gaps = wall_gaps(shifted, faces, start, box.yaw, box.size[0], max(box.bottom, 0.0),
                          box.top)
+        # an uncovered part at the top of the body, wholly above the band, is where the wall's
+        # top runs lower (sloped or stepped under a roof), not an opening: kept as one, it
+        # would merge with the windows below it into a single opening the length of the wall
+        gaps = [g for g in gaps
+                if g[3] < box.top - FLOOR_TOLERANCE or g[2] < building.band_top]
     name = names.make(wall.Name, f"wall_{wall.id()}")
     c, s = box.axis()
     half = box.size[0] / 2

@@ -288,3 +288,27 @@ def real_features(b: Building) -> Building:
     api("spatial.assign_container", f, products=[bodiless], relating_structure=b.storey)
     b.walls["Sketch"] = bodiless
     return b
+
+
+WINDOW = (7.0, 8.2, 0.9, 2.1)
+"""The window cut into the body of :func:`stepped_top`'s office-store wall: from x, to x, from
+z, to z (m)."""
+
+
+def stepped_top(b: Building) -> Building:
+    """The three rooms with the office-store wall's body a mesh with a window cut into it
+    (:data:`WINDOW`, no IfcOpeningElement) and a top that steps down from 2.5 m to 2.4 m west
+    of the window's east jamb, as a wall runs under a sloping roof."""
+    f = b.file
+    store = b.walls["Store"]
+    half = WALL_T / 2
+    x0, x1, z0, z1 = WINDOW
+    b.walls["Store"] = _mesh_element(
+        f, b.body, "IfcWall", "Store", [
+            ((5.0, 3.0 - half, 0.0), (10.0, 3.0 + half, z0)),
+            ((5.0, 3.0 - half, z0), (x0, 3.0 + half, 2.4)),
+            ((x0, 3.0 - half, z1), (x1, 3.0 + half, 2.4)),
+            ((x1, 3.0 - half, z0), (10.0, 3.0 + half, WALL_H)),
+        ], b.storey)
+    api("root.remove_product", f, product=store)
+    return b

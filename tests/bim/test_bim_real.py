@@ -9,12 +9,13 @@ import math
 from pathlib import Path
 
 import pytest
+import yaml
 
 pytest.importorskip("ifcopenshell")
 
 import ifcopenshell
 import ifcopenshell.util.element as util
-from ifc_buildings import HOLE, PANELS, Panel, real_features, three_rooms
+from ifc_buildings import HOLE, PANELS, WINDOW, Panel, real_features, stepped_top, three_rooms
 
 from bt_manip.bim.convert import BimOptions, convert
 from bt_manip.bim.ifc_input import open_ifc
@@ -172,6 +173,30 @@ def test_holed_wall_curtain_wall_gable_and_bodiless_wall(real):
     assert c.building.counts == {"walls": 8, "curtain walls": 1, "plates": 2, "members": 3,
                                  "doors": 2, "windows": 1, "other obstacles": 1}
     assert len(c.elements) == 6  # every panel still installable
+
+
+def test_a_wall_top_stepping_down_is_no_opening(tmp_path):
+    # a wall under a sloping roof: its body's top is lower along part of it; only the window
+    # cut into the body is an opening, not the strip above the lower top, nor both merged
+    path = stepped_top(three_rooms(with_tasks=False)).write(tmp_path / "stepped.ifc")
+    c = convert(BimOptions(path, tmp_path / "out"))
+    store = next(w for w in c.building.walls if w.name == "store")
+    (window,) = store.openings
+    assert window.kind == "hole" and not window.passage
+    x0, x1, z0, z1 = WINDOW
+    assert (window.start + 5.0, window.end + 5.0, window.bottom, window.top) == pytest.approx(
+        (x0, x1, z0, z1), abs=0.01)
+    spec = parse_world(c.world_path)
+    wall = next(w for w in spec.walls if w.name == "store")
+    # the window's gap in the wall, filled below and above by a sill and a lintel
+    (gap,) = wall.doors
+    assert (gap.at + 5.0, gap.width) == pytest.approx(((x0 + x1) / 2, x1 - x0), abs=0.01)
+    assert wall.height == pytest.approx(2.5, abs=0.01)
+    furniture = yaml.safe_load(c.world_path.read_text())["furniture"]
+    (sill,) = [f for f in furniture if f["name"].startswith("store_sill")]
+    (lintel,) = [f for f in furniture if f["name"].startswith("store_lintel")]
+    assert sill["size"][2] == pytest.approx(z0, abs=0.01)
+    assert lintel["pose"]["xyz"][2] - lintel["size"][2] / 2 == pytest.approx(z1, abs=0.01)
 
 
 @pytest.mark.slow
