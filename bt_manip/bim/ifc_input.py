@@ -132,13 +132,16 @@ def open_ifc(path: str | Path) -> IfcSource:
         raise InputError.single(
             str(path), line, f"schema {schema} is not read; IFC2X3 and IFC4 files are"
         )
-    text = data.decode("utf-8", errors="replace")
+    try:
+        text, exact = data.decode("utf-8"), True
+    except UnicodeDecodeError:
+        text, exact = data.decode("utf-8", errors="replace"), False
     clear_log()
     try:
         model = ifcopenshell.file.from_string(text)
     except Exception as exc:
         raise InputError.single(str(path), None, f"cannot parse the IFC file: {exc}") from None
-    problems = parse_problems(str(path), text)
+    problems = parse_problems(str(path), text, data if exact else None)
     if problems:
         raise InputError(problems)
     scale = float(ifcopenshell.util.unit.calculate_unit_scale(model))

@@ -34,17 +34,18 @@ def clear_log() -> None:
     wrapper.get_log()
 
 
-def parse_problems(path: str, text: str) -> list[Problem]:
+def parse_problems(path: str, text: str, encoded: bytes | None = None) -> list[Problem]:
     """The errors ifcopenshell logged since :func:`clear_log`, as problems of ``path``,
     whose text (as parsed) is ``text``: at most :data:`MAX_PARSE_PROBLEMS`, each at its line
-    and column when the message gives an offset."""
+    and column when the message gives an offset. ``encoded``, when given, is ``text`` in
+    UTF-8 (the file's bytes, when they decoded without a replacement): the parser's offsets
+    count its bytes."""
     import ifcopenshell.ifcopenshell_wrapper as wrapper
 
     errors = [message for level, message in _entries(str(wrapper.get_log()))
               if level in ("error", "critical", "fatal")]
     if not errors:
         return []
-    encoded: bytes | None = None
     out: list[Problem] = []
     for message in errors[:MAX_PARSE_PROBLEMS]:
         line = column = None

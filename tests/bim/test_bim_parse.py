@@ -50,6 +50,25 @@ def test_a_broken_line_is_reported_at_its_line(tmp_path, capsys, damage):
     assert not (out / "world.yaml").exists()
 
 
+def test_a_broken_line_after_bytes_that_are_not_utf8_is_reported_at_its_line(tmp_path,
+                                                                               capsys):
+    # the parser reads the text with each invalid byte replaced (three bytes in UTF-8), so
+    # its offsets are counted in that text, not in the file's bytes
+    path = three_rooms().write(tmp_path / "three.ifc")
+    number = _entity_lines(path)[-2]
+    lines = path.read_bytes().split(b"\n")
+    named = max(i for i in range(number - 1) if b"'" in lines[i])  # a line with a string
+    quote = lines[named].index(b"'")
+    lines[named] = lines[named][:quote + 1] + b"\xff" * 40 + lines[named][quote + 1:]
+    path.write_bytes(b"\n".join(lines))
+    _break_line(path, number, b"=", b"=XX")
+    code = main(["bim", str(path), "--out", str(tmp_path / "out")])
+    first = capsys.readouterr().err.strip().splitlines()[0]
+    assert code == 2
+    assert first.startswith(f"{path}:{number}:")
+    assert "XX" in first
+
+
 def test_the_sound_file_converts(tmp_path, capsys):
     path = three_rooms().write(tmp_path / "three.ifc")
     assert main(["bim", str(path), "--out", str(tmp_path / "out")]) == 0
