@@ -33,7 +33,7 @@ def monotone_chain(pts: np.ndarray) -> np.ndarray:
     out, as Qhull leaves them (the two may differ on a point within about 1e-15 of the
     coordinates' size of an edge)."""
     rows = pts.tolist()
-    chain = chain_rows(rows) if _finite(rows) else _chain(rows, _tolerance_np(pts))
+    chain = chain_rows(rows) if finite_rows(rows) else _chain(rows, _tolerance_np(pts))
     return np.array(chain, dtype=float).reshape(-1, 2)
 
 
@@ -54,7 +54,7 @@ def _tolerance_np(pts: np.ndarray) -> float:
     return 1e-15 * float(np.abs(pts).max()) * float(np.ptp(pts, axis=0).max())
 
 
-def _finite(rows: Sequence[Sequence[float]]) -> bool:
+def finite_rows(rows: Sequence[Sequence[float]]) -> bool:
     """Whether every coordinate of the rows is finite (their sum is, unless it overflows:
     then the rows are taken for not finite, which only costs numpy's way)."""
     return math.isfinite(sum(map(sum, rows)))
@@ -94,7 +94,7 @@ def sorted_rows(xy: np.ndarray) -> list[Row] | None:
     if len(xy) > SMALL_SORT:
         return None
     rows = xy.tolist()
-    if not _finite(rows):
+    if not finite_rows(rows):
         return None
     # a set keeps the first of equal tuples (0.0 == -0.0 and their hashes are the same), as
     # unique_rows's stable sort does; tuples sort by x, then y
@@ -119,23 +119,29 @@ def next_rows(a: np.ndarray) -> np.ndarray:
     return np.concatenate((a[1:], a[:1]))
 
 
+def distinct_chain(rounded: np.ndarray) -> tuple[list[Row] | np.ndarray, np.ndarray | None]:
+    """The distinct rows of ``rounded`` (N x 2) sorted by x then y (Python tuples for a few
+    finite ones, :func:`sorted_rows`, else an array, :func:`unique_rows`), and their monotone
+    chain (:func:`monotone_chain`) when there are 3 to :data:`SMALL_HULL` of them, else None
+    (too few, or Qhull's case)."""
+    rows = sorted_rows(rounded)
+    if rows is not None:  # a few finite points: sorted and chained in Python
+        chain = np.array(chain_rows(rows), dtype=float).reshape(-1, 2) if len(rows) >= 3 else None
+        return rows, chain
+    pts = unique_rows(rounded)
+    return pts, (monotone_chain(pts) if 3 <= len(pts) <= SMALL_HULL else None)
+
+
 def hull_xy(xy: np.ndarray) -> np.ndarray:
     """The corners of the convex hull of 2D points (the points themselves when they are
     fewer than three or collinear)."""
     rounded = np.round(xy, 9)
-    rows = sorted_rows(rounded)
-    if rows is not None:  # a few finite points: all in Python
-        if len(rows) >= 3:
-            chain = chain_rows(rows)
-            if len(chain) >= 3:
-                return np.array(chain, dtype=float)
-        return np.array(rows, dtype=rounded.dtype).reshape(-1, 2)
-    pts = unique_rows(rounded)
-    if len(pts) < 3:
-        return pts
+    distinct, chain = distinct_chain(rounded)
+    if chain is not None and len(chain) >= 3:
+        return chain
+    pts = np.asarray(distinct, dtype=rounded.dtype).reshape(-1, 2)
     if len(pts) <= SMALL_HULL:
-        chain_np = monotone_chain(pts)
-        return chain_np if len(chain_np) >= 3 else pts
+        return pts
     from scipy.spatial import ConvexHull, QhullError
 
     try:

@@ -32,15 +32,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.bim import ifc_attributes as at
-from bt_manip.bim.hulls import (
-    SMALL_HULL,
-    chain_rows,
-    hull_xy,
-    monotone_chain,
-    next_rows,
-    sorted_rows,
-    unique_rows,
-)
+from bt_manip.bim.hulls import distinct_chain, finite_rows, hull_xy, next_rows, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
            "footprint_box", "hull_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw",
@@ -714,7 +706,7 @@ def _extents_py(xy: np.ndarray, angles: list[float]) -> list[Extent] | None:
     extremes; None when they would not be the same numbers (a coordinate that is not finite,
     or an extreme that is zero, whose sign numpy's reduction picks its own way)."""
     rows = xy.tolist()
-    if not math.isfinite(sum(map(sum, rows))):  # else numpy's extremes (of a NaN, say)
+    if not finite_rows(rows):  # else numpy's extremes (of a NaN, say)
         return None
     found: dict[float, Extent] = {}  # an angle met again (a box's opposite sides) is known
     out = []
@@ -735,18 +727,8 @@ def _extents_py(xy: np.ndarray, angles: list[float]) -> list[Extent] | None:
 def _chain_hull(xy: np.ndarray) -> np.ndarray | None:
     """The corners, counter-clockwise, of the hull :func:`_candidate_angles` takes the edges
     of, when it has few points and at least three corners (else None: Qhull's case)."""
-    rounded = np.round(xy, 6)
-    rows = sorted_rows(rounded)
-    if rows is not None:  # a few finite points: sorted and chained in Python
-        if len(rows) < 3:
-            return None
-        chain = np.array(chain_rows(rows), dtype=float).reshape(-1, 2)
-    else:
-        pts = unique_rows(rounded)
-        if len(pts) < 3 or len(pts) > SMALL_HULL:
-            return None
-        chain = monotone_chain(pts)
-    return chain if len(chain) >= 3 else None
+    _, chain = distinct_chain(np.round(xy, 6))
+    return chain if chain is not None and len(chain) >= 3 else None
 
 
 def _edge_angles(hull: np.ndarray) -> list[float]:
