@@ -21,8 +21,11 @@ spaces as named poses), unless ``require_install``.
 
 from __future__ import annotations
 
+import gc
 import json
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -177,7 +180,33 @@ def _count(n: int, noun: str) -> str:
 
 
 def convert(options: BimOptions) -> Conversion:
-    """Read the building, check it, write the world and the schedule; InputError on problems."""
+    """Read the building, check it, write the world and the schedule; InputError on problems.
+
+    Python's cycle collector is paused while it runs (:func:`paused_cycle_collection`)."""
+    with paused_cycle_collection():
+        return _convert(options)
+
+
+@contextmanager
+def paused_cycle_collection() -> Iterator[None]:
+    """Pause Python's cycle collector for the block, then restore it as it was.
+
+    A conversion makes about a hundred thousand short-lived Python objects (ifcopenshell's
+    entity proxies, tuples of coordinates, small lists), none of which form reference cycles;
+    each 700 of them would start a collection, and every few dozen collections one over all
+    the process's objects (the modules of numpy, scipy and ifcopenshell among them). Reference
+    counting frees everything the conversion drops, as it goes; what cycles there are wait for
+    the collector to run again after the block."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
+
+
+def _convert(options: BimOptions) -> Conversion:
     require_ifcopenshell()
     check_output_folder("--out", options.out)
     descriptor = find_descriptor(options.robot)

@@ -277,3 +277,34 @@ def test_schedule_follows_its_json_schema(converted):
     broken = {**document, "elements": [{**document["elements"][0], "mass": -1}]}
     with pytest.raises(jsonschema.ValidationError):
         jsonschema.validate(broken, schema)
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_the_cycle_collector_is_paused_and_left_as_it_was(tmp_path, monkeypatch, enabled):
+    import gc
+
+    import bt_manip.bim.convert as convert_module
+    from bt_manip.errors import InputError
+
+    seen: list[bool] = []
+    reading = convert_module.read_building
+
+    def read_building(*args, **kwargs):
+        seen.append(gc.isenabled())
+        return reading(*args, **kwargs)
+
+    monkeypatch.setattr(convert_module, "read_building", read_building)
+    ifc = three_rooms().write(tmp_path / "rooms.ifc")
+    broken = tmp_path / "broken.ifc"
+    broken.write_text("ISO-10303-21;\nHEADER;\nENDSEC;\n")
+    was = gc.isenabled()
+    try:
+        gc.enable() if enabled else gc.disable()
+        convert(BimOptions(ifc, tmp_path / "out"))
+        assert gc.isenabled() is enabled
+        with pytest.raises(InputError):
+            convert(BimOptions(broken, tmp_path / "broken"))
+        assert gc.isenabled() is enabled
+    finally:
+        gc.enable() if was else gc.disable()
+    assert seen == [False]
