@@ -11,7 +11,9 @@ included; these exports schedule nothing, so the world alone is written), and to
 first error of the same file with one line broken near its end (a copy whose last entity's
 class name is misspelt, ``#9= XIFCWALL(...)``: the error must name that line). One JSON
 line per file, with the ratios conversion / parse and first error / parse, in wall time and in
-CPU time (the process's, also medians: on a shared machine the steadier of the two).
+CPU time (the process's: on a shared machine the steadier of the two). Each ratio is the
+median of the ratios of single rounds, a conversion or a first error against the parses
+timed just before and after it (see ``_paired_times``), not a ratio of medians.
 
 Generates with ``ifcopenshell.api`` (in millimetres, IFC4) a storey of N x N rooms of 6 m x 6 m
 (default 7 x 7: 112 walls, each room side its own IfcWall, 0.2 m thick and 2.5 m high), with a
@@ -129,20 +131,37 @@ def generate(rooms: int, path: Path) -> dict[str, int]:
     return counts
 
 
-def _median_times(runs: list[Any], repeat: int) -> list[tuple[float, float]]:
-    """Median wall and median CPU seconds of each of ``runs`` over ``repeat`` rounds, the
-    runs taking turns within each round (so that a change of the machine's load falls on
-    all of them alike)."""
-    wall: list[list[float]] = [[] for _ in runs]
-    cpu: list[list[float]] = [[] for _ in runs]
+def _timed(run: Any) -> tuple[float, float]:
+    """Wall and CPU seconds of one call of ``run``."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    run()
+    return time.perf_counter() - t0, time.process_time() - c0
+
+
+def _paired_times(parse: Any, convert: Any, first_error: Any, repeat: int) -> dict[str, float]:
+    """Medians over ``repeat`` rounds of the three times (wall and CPU), and of each round's
+    conversion and first error over the parses timed next to them.
+
+    A round parses, converts, parses, reports the first error and parses again; a conversion
+    is compared with the mean of the parses just before and after it, the first error with
+    the mean of the two around it. This machine's speed drifts by half from one second to
+    the next, and a ratio of medians taken over the whole run mixes times from different
+    speeds; a ratio within one round does not."""
+    rows: dict[str, list[float]] = {k: [] for k in (
+        "parse_s", "convert_s", "first_error_s", "parse_cpu_s", "convert_cpu_s",
+        "first_error_cpu_s", "convert_over_parse", "first_error_over_parse",
+        "convert_over_parse_cpu", "first_error_over_parse_cpu")}
     for _ in range(repeat):
-        for k, run in enumerate(runs):
-            t0, c0 = time.perf_counter(), time.process_time()
-            run()
-            wall[k].append(time.perf_counter() - t0)
-            cpu[k].append(time.process_time() - c0)
-    return [(sorted(w)[len(w) // 2], sorted(c)[len(c) // 2])
-            for w, c in zip(wall, cpu, strict=True)]
+        p0, c, p1, e, p2 = (_timed(parse), _timed(convert), _timed(parse), _timed(first_error),
+                            _timed(parse))
+        for k, suffix in ((0, ""), (1, "_cpu")):
+            rows[f"parse{suffix}_s"] += [p0[k], p1[k], p2[k]]
+            rows[f"convert{suffix}_s"].append(c[k])
+            rows[f"first_error{suffix}_s"].append(e[k])
+            rows[f"convert_over_parse{suffix}"].append(c[k] / ((p0[k] + p1[k]) / 2))
+            rows[f"first_error_over_parse{suffix}"].append(e[k] / ((p1[k] + p2[k]) / 2))
+    return {k: round(float(np.median(v)), 3 if k.endswith("_s") else 2)
+            for k, v in rows.items()}
 
 
 def broken_copy(path: Path, out: Path) -> tuple[Path, int]:
@@ -175,19 +194,11 @@ def time_samples(folder: Path, out: Path, repeat: int) -> None:
             else:
                 raise AssertionError(f"{broken}: the broken line {line} was not reported")
 
-        (parse, parse_cpu), (conversion, conversion_cpu), (error, error_cpu) = _median_times(
-            [lambda path=path: open_ifc(path),
-             lambda path=path: convert(BimOptions(path, out / path.stem)), first_error], repeat)
-        print(json.dumps({
-            "bench": "bim_convert", "file": path.name, "ifc_bytes": path.stat().st_size,
-            "parse_s": round(parse, 3), "convert_s": round(conversion, 3),
-            "first_error_s": round(error, 3), "convert_over_parse": round(conversion / parse, 2),
-            "first_error_over_parse": round(error / parse, 2),
-            "parse_cpu_s": round(parse_cpu, 3), "convert_cpu_s": round(conversion_cpu, 3),
-            "first_error_cpu_s": round(error_cpu, 3),
-            "convert_over_parse_cpu": round(conversion_cpu / parse_cpu, 2),
-            "first_error_over_parse_cpu": round(error_cpu / parse_cpu, 2),
-        }), flush=True)
+        times = _paired_times(lambda path=path: open_ifc(path),
+                              lambda path=path: convert(BimOptions(path, out / path.stem)),
+                              first_error, repeat)
+        print(json.dumps({"bench": "bim_convert", "file": path.name,
+                          "ifc_bytes": path.stat().st_size, **times}), flush=True)
 
 
 def main() -> None:
