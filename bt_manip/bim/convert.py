@@ -344,7 +344,8 @@ def _convert(options: BimOptions) -> Conversion:
         refused=[_refused_entry(el, why) for el, why in refusals],
     )
     if not elements:
-        conversion.notes.append(_no_elements_text(source, options, refused=bool(refusals))
+        conversion.notes.append(_no_elements_text(source, options, refused=bool(refusals),
+                                                  required=False)
                                 + "; the world holds the building alone")
     if planned:
         schedule_path.write_text(
@@ -431,10 +432,14 @@ def _no_elements(source: IfcSource, options: BimOptions, refused: bool = False) 
     raise InputError.single(str(source.path), None, message)
 
 
-def _no_elements_text(source: IfcSource, options: BimOptions, refused: bool = False) -> str:
+def _no_elements_text(source: IfcSource, options: BimOptions, refused: bool = False,
+                      required: bool = True) -> str:
+    """Why there is nothing to install: a problem when ``required`` (``--require-install``),
+    else a note."""
     if refused:
-        message = ("nothing to install: every element was refused (see --skip-uninstallable's "
-                   "list), and --require-install asks for one")
+        message = "nothing to install: every element was refused " + (
+            "(see --skip-uninstallable's list), and --require-install asks for one" if required
+            else "(schedule.json's 'refused' lists each with its reason)")
     elif options.schedule is not None:
         message = "the schedule lists no element"
     elif source.schema == "IFC2X3":

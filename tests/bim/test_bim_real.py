@@ -253,6 +253,9 @@ def test_a_partition_thicker_than_the_gripper_opens_is_refused(tmp_path, capsys)
                  "--skip-uninstallable", "--png", str(tmp_path / "top.png")]) == 0
     out = capsys.readouterr().out
     assert "0 elements to install" in out and f"wrote {tmp_path / 'top.png'}" in out
+    assert ("note: nothing to install: every element was refused (schedule.json's 'refused' "
+            "lists each with its reason); the world holds the building alone") in out
+    assert "--require-install" not in out
     assert (tmp_path / "top.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     assert json.loads((tmp_path / "o" / "schedule.json").read_text())["elements"] == []
     assert not (tmp_path / "o" / "install.xml").exists()
