@@ -46,7 +46,6 @@ from bt_manip.bim.schedule import (
     schedule_from_tasks,
 )
 from bt_manip.bim.shapes import ShapeReader, UnsupportedGeometry, footprint_box, is_box_like
-from bt_manip.bim.shapes import placement_yaw as _placement_yaw
 from bt_manip.bim.stock import (
     Slot,
     StockPose,
@@ -485,7 +484,7 @@ def _elements(
         except UnsupportedGeometry as exc:
             refusals.append((el, f"unsupported geometry: {exc}"))
             continue
-        box = footprint_box(solid.points, _placement_yaw(el))
+        box = footprint_box(solid.points, reader.yaw(el))
         if not is_box_like(solid, box):
             refusals.append((
                 el,

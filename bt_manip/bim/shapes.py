@@ -35,7 +35,7 @@ from bt_manip.bim import ifc_attributes as at
 from bt_manip.bim.hulls import distinct_chain, finite_rows, hull_xy, next_rows, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
-           "footprint_box", "hull_box", "hull_prism", "hull_xy", "is_box_like", "placement_yaw",
+           "footprint_box", "hull_box", "hull_prism", "hull_xy", "is_box_like",
            "unique_rows"]
 
 BOX_FILL = 0.9
@@ -130,7 +130,8 @@ class ShapeReader:
         return self.axis(position) if position is not None else np.eye(4)
 
     def yaw(self, element: Any) -> float | None:
-        """:func:`placement_yaw` of ``element`` from the placements computed once per reader."""
+        """Heading of the element's placement x axis (None when it is vertical, or the element
+        has no placement), from the placements computed once per reader."""
         placement = _object_placement(element)
         if placement is None:
             return None
@@ -474,10 +475,11 @@ def _profile_points(profile: Any, axis: Any = None,
                     angle_unit: float | None = None) -> np.ndarray | None:
     """The 2D outline of a rectangle or polygon profile, in its own frame; None otherwise.
     ``axis`` gives an IfcAxis2Placement's matrix (ifcopenshell's, computed anew, without).
-    With ``angle_unit`` (radians per the file's plane-angle unit), an outline that is a
-    composite curve of polylines and circular arcs is read too, each arc as points of a
-    polygon that encloses it (:func:`_composite_points`), and a profile with voids by its
-    outer curve: the points of an obstacle's footprint, not an outline whose area counts."""
+    With ``angle_unit`` (radians per the file's plane-angle unit), an outline with circular
+    arcs is read too (a composite curve of polylines and arcs, :func:`_composite_points`, or
+    an indexed poly curve with arc segments, :func:`_indexed_points`), each arc as points of a
+    polygon that encloses it, and a profile with voids by its outer curve: the points of an
+    obstacle's footprint, not an outline whose area counts."""
     import ifcopenshell.util.placement as placement
 
     if profile.is_a("IfcRectangleProfileDef") and not profile.is_a("IfcRoundedRectangleProfileDef"):
@@ -497,9 +499,11 @@ def _profile_points(profile: Any, axis: Any = None,
         curve = profile.get_argument(at.OUTER_CURVE)
         if curve.is_a("IfcPolyline"):
             pts = _polyline_points(curve)
-        elif curve.is_a("IfcIndexedPolyCurve") and curve.get_argument(at.INDEXED_SEGMENTS) is None:
-            coords = curve.get_argument(at.POINTS).get_argument(at.COORDINATES)
-            pts = np.array([c[:2] for c in coords], dtype=float)
+        elif curve.is_a("IfcIndexedPolyCurve"):
+            found = _indexed_points(curve, angle_unit is not None)
+            if found is None:
+                return None
+            pts = found
         elif curve.is_a("IfcCompositeCurve") and angle_unit is not None:
             found = _composite_points(curve, angle_unit, axis)
             if found is None:
@@ -557,15 +561,74 @@ def _composite_points(curve: Any, angle_unit: float, axis: Any) -> np.ndarray | 
         # the arc runs from Trim1 to Trim2, counter-clockwise when the sense agrees
         sweep = (t2 - t1) % (2 * math.pi) if parent.get_argument(at.SENSE_AGREEMENT) else \
             -((t1 - t2) % (2 * math.pi))
-        n = max(1, math.ceil(abs(sweep) / ARC_STEP))
-        angles = t1 + sweep * np.arange(n + 1) / n
-        radius = float(circle.get_argument(at.CIRCLE_RADIUS)) / math.cos(abs(sweep) / n / 2)
-        local = np.column_stack([radius * np.cos(angles), radius * np.sin(angles)])
+        local = _arc_points(float(circle.get_argument(at.CIRCLE_RADIUS)), t1, sweep)
         m = axis(position)
         chunks.append(local @ m[:2, :2].T + m[:2, 3])
     if not chunks:
         return None
     return np.vstack(chunks)
+
+
+def _arc_points(radius: float, start: float, sweep: float) -> np.ndarray:
+    """Points (N x 2, about the centre) of a polygon enclosing the arc of ``radius`` from the
+    angle ``start`` through ``sweep`` (negative: clockwise): at most :data:`ARC_STEP` apart, on
+    the circle enlarged by ``1 / cos(step / 2)``, the first and last on the arc's ends' rays."""
+    n = max(1, math.ceil(abs(sweep) / ARC_STEP))
+    angles = start + sweep * np.arange(n + 1) / n
+    enclosing = radius / math.cos(abs(sweep) / n / 2)
+    return np.column_stack([enclosing * np.cos(angles), enclosing * np.sin(angles)])
+
+
+def _indexed_points(curve: Any, arcs: bool) -> np.ndarray | None:
+    """The points (N x 2) of an IfcIndexedPolyCurve: its points in turn without segments, else
+    those each segment lists (a point shared by two segments once); an arc segment (three
+    points: start, one on the arc, end) read as a polygon enclosing the arc when ``arcs``
+    (a footprint), else None, as for an index off the point list or another kind of segment
+    (then the geometry kernel reads the curve). Bonsai writes its profiles this way."""
+    coords = curve.get_argument(at.POINTS).get_argument(at.COORDINATES)
+    segments = curve.get_argument(at.INDEXED_SEGMENTS)
+    if segments is None:
+        return np.array([c[:2] for c in coords], dtype=float)
+    out: list[tuple[float, float]] = []
+    for segment in segments:
+        kind = segment.is_a()
+        indices = segment.get_argument(0)
+        if not indices or any(not 1 <= i <= len(coords) for i in indices):
+            return None
+        points = [(float(coords[i - 1][0]), float(coords[i - 1][1])) for i in indices]
+        if kind == "IfcLineIndex" and len(points) >= 2:
+            chunk = points
+        elif kind == "IfcArcIndex" and arcs and len(points) == 3:
+            found = _arc_through(*points)
+            if found is None:
+                return None
+            chunk = [(float(x), float(y)) for x, y in found]
+        else:
+            return None
+        out.extend(chunk[1:] if out and out[-1] == chunk[0] else chunk)
+    return np.array(out, dtype=float)
+
+
+def _arc_through(a: tuple[float, float], b: tuple[float, float], c: tuple[float, float],
+                 ) -> np.ndarray | None:
+    """:func:`_arc_points` (in the points' frame) of the circular arc from ``a`` through ``b``
+    to ``c``; None when the three are on one line (no circle passes through them)."""
+    (ax, ay), (bx, by), (cx, cy) = a, b, c
+    d = 2.0 * (ax * (by - cy) + bx * (cy - ay) + cx * (ay - by))
+    span = max(abs(ax - cx), abs(ay - cy), abs(ax - bx), abs(ay - by))
+    if abs(d) <= 1e-12 * max(span, 1e-300) ** 2:
+        return None
+    a2, b2, c2 = ax * ax + ay * ay, bx * bx + by * by, cx * cx + cy * cy
+    ox = (a2 * (by - cy) + b2 * (cy - ay) + c2 * (ay - by)) / d
+    oy = (a2 * (cx - bx) + b2 * (ax - cx) + c2 * (bx - ax)) / d
+    t_a = math.atan2(ay - oy, ax - ox)
+    t_b = math.atan2(by - oy, bx - ox)
+    t_c = math.atan2(cy - oy, cx - ox)
+    # counter-clockwise from a to c when b lies on that way round, else clockwise
+    ccw = (t_b - t_a) % (2 * math.pi) <= (t_c - t_a) % (2 * math.pi)
+    sweep = (t_c - t_a) % (2 * math.pi) if ccw else -((t_a - t_c) % (2 * math.pi))
+    out: np.ndarray = _arc_points(math.hypot(ax - ox, ay - oy), t_a, sweep) + np.array([ox, oy])
+    return out
 
 
 def _close(a: np.ndarray, b: np.ndarray) -> bool:
@@ -586,7 +649,6 @@ def _polyline_points(polyline: Any) -> np.ndarray:
 def _polygon_area(pts: np.ndarray) -> float:
     x, y = pts[:, 0], pts[:, 1]
     return abs(float(np.dot(x, next_rows(y)) - np.dot(y, next_rows(x)))) / 2.0
-
 
 
 def footprint_box(points: np.ndarray, hint_yaw: float | None = None) -> Box:
@@ -764,16 +826,6 @@ def hull_prism(points: np.ndarray) -> np.ndarray:
     z0, z1 = float(points[:, 2].min()), float(points[:, 2].max())
     return np.vstack([np.column_stack([xy, np.full(len(xy), z0)]),
                       np.column_stack([xy, np.full(len(xy), z1)])])
-
-
-def placement_yaw(element: Any) -> float | None:
-    """Heading of the element's placement x axis, when it is not vertical."""
-    import ifcopenshell.util.placement as placement
-
-    if getattr(element, "ObjectPlacement", None) is None:
-        return None
-    return _yaw_of(np.asarray(placement.get_local_placement(element.ObjectPlacement),
-                              dtype=float))
 
 
 def _yaw_of(m: np.ndarray) -> float | None:
