@@ -16,7 +16,9 @@ The moves are checked every few centimetres of footprint travel: every outline p
 ``min_clearance`` from obstacles (the clearance grid is a lower bound on the distance from a
 cell's centre, so the point's own offset in its cell is subtracted too; the points are looked
 at a group at a time where the cells around a group all keep the margin, with the same answer
-as point by point, see :mod:`bt_manip.navigation.outline_check`). A start closer than
+as point by point, see :mod:`bt_manip.navigation.outline_check`). When no plan keeps the
+margin, one keeping ``squeeze_clearance`` is looked for: a doorway only a little wider than
+the base is passed with a few centimetres to spare. A start closer than
 that but not touching (a robot that has just lifted a load out of a stand beside it) is
 accepted: within ``tight_start`` of it, moves from a pose without the margin need only keep
 the footprint off the obstacles, at three times the cost, so the plan
@@ -32,7 +34,7 @@ The result is a list of poses with the move that reaches each (:class:`PosePlan`
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -75,6 +77,11 @@ class LatticeOptions:
     tight_start: float = 0.6
     """Within this distance (m) of a start that lacks ``min_clearance`` (but touches nothing),
     moves need only keep the footprint off the obstacles (see the module)."""
+    squeeze_clearance: float = 0.02
+    """When no sequence of moves keeps ``min_clearance`` (or the goal lacks it), the search is
+    run once more keeping only this much (m) from obstacles: a base a few centimetres narrower
+    than a doorway (a Husky's 0.67 m in a house's 0.885 m door) passes it with the smaller
+    margin rather than not at all. No second search when it is not below ``min_clearance``."""
 
 
 @dataclass(frozen=True)
@@ -87,6 +94,11 @@ class PosePlan:
     moves: np.ndarray | None = None
     length: float = math.inf
     expanded: int = 0
+    margin: float = math.nan
+    """The clearance (m) the plan keeps from obstacles: ``min_clearance``, or
+    ``squeeze_clearance`` when only that fits (NaN without a plan)."""
+    start_blocked: bool = False
+    """The footprint touches obstacles at the start (no margin would make a plan)."""
 
 
 def outline_samples(footprint: PlanarFootprint, spacing: float = 0.05) -> np.ndarray:
@@ -145,7 +157,35 @@ def plan_poses(
     them, so a panel may pass over a low stand the wheels must avoid. Each is a clearance
     grid (m, float) or, using half the memory, the grid's squared cell distances (integers,
     :func:`bt_manip.navigation.distance.squared_distances`), which give the same clearances.
+
+    Every pose keeps ``options.min_clearance`` from obstacles; when no plan does, or the goal
+    does not, one keeping ``options.squeeze_clearance`` is searched for (the plan's
+    ``margin`` says which); when neither is found, the reason is the first search's.
     """
+    found = _plan_keeping(grid, clear, footprint, start, goal, pivot, options, carried,
+                          clear_high)
+    squeeze = max(options.squeeze_clearance, 0.0)
+    if found.ok or squeeze >= options.min_clearance or found.start_blocked:
+        return found
+    tight = _plan_keeping(grid, clear, footprint, start, goal, pivot,
+                          replace(options, min_clearance=squeeze), carried, clear_high)
+    if tight.ok:
+        return tight
+    return replace(found, expanded=found.expanded + tight.expanded)
+
+
+def _plan_keeping(
+    grid: OccupancyGrid,
+    clear: np.ndarray,
+    footprint: PlanarFootprint,
+    start: tuple[float, float, float],
+    goal: tuple[float, float, float],
+    pivot: float,
+    options: LatticeOptions,
+    carried: PlanarFootprint | None,
+    clear_high: np.ndarray | None,
+) -> PosePlan:
+    """:func:`plan_poses` keeping ``options.min_clearance`` throughout (one search)."""
     o = options
     pts = outline_samples(footprint, 0.05)
     if carried is not None and clear_high is not None:
@@ -170,7 +210,8 @@ def plan_poses(
         return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
     need_low = grid.resolution / math.sqrt(2.0)
     if not pose_fits(clear, high, x0, y0, res, pts, pts_high, *start, need_low):
-        return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
+        return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start",
+                        start_blocked=True)
     free = clearance_at_least(clear, res, footprint.half_width + o.min_clearance)
     gc = grid.world_to_cell(goal[0], goal[1])
     field = GoalField(free, gc if grid.inside(gc) else None)
@@ -241,4 +282,4 @@ def plan_poses(
     kinds = np.array([FORWARD] * 3 + [BACKWARD] * 3 + [TURN] * 2)
     moves = kinds[move_of[chain[1:]]]
     length = float(np.hypot(*np.diff(poses[:, :2], axis=0).T).sum())
-    return PosePlan(True, "ok", poses, moves, length, expanded)
+    return PosePlan(True, "ok", poses, moves, length, expanded, o.min_clearance)

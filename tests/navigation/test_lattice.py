@@ -243,3 +243,38 @@ def test_outline_samples_are_even_steps_along_each_edge() -> None:
                 expected.append(a + (np.arange(n)[:, None] / n) * (b - a))
         got = outline_samples(fp, spacing)
         assert got.tobytes() == np.concatenate(expected).tobytes()
+
+
+def test_a_doorway_only_a_little_wider_than_the_base_is_passed_with_the_smaller_margin() -> None:
+    grid = room()
+    grid.occupied[:33, 80:82] = True  # a partition at x = 4.0-4.1, its door at y 1.65-2.40
+    grid.occupied[48:, 80:82] = True
+    clear = clearance(grid)
+    base = PlanarFootprint.rectangle(0.9, 0.6, label="base")  # 7.5 cm to spare each side
+    start, goal = (1.5, 2.025, 0.0), (6.5, 2.025, 0.0)
+    strict = LatticeOptions(squeeze_clearance=LatticeOptions().min_clearance)
+    refused = plan_poses(grid, clear, base, start, goal, options=strict)
+    assert not refused.ok and "no sequence of moves" in refused.reason
+    plan = plan_poses(grid, clear, base, start, goal)
+    assert plan.ok, plan.reason
+    assert plan.margin == LatticeOptions().squeeze_clearance
+    assert plan.poses is not None
+    assert plan.poses[0][0] < 4.0 < plan.poses[-1][0]  # through the door
+    # every pose keeps the smaller margin: each outline point's cell is at least that far
+    # (less the point's own offset in its cell) from the nearest blocked cell
+    pts = outline_samples(base)
+    for x, y, th in plan.poses:
+        c, s = math.cos(th), math.sin(th)
+        wx = x + c * pts[:, 0] - s * pts[:, 1]
+        wy = y + s * pts[:, 0] + c * pts[:, 1]
+        cells = np.floor(np.column_stack([wy, wx]) / 0.05).astype(int)
+        assert (clear[cells[:, 0], cells[:, 1]] >= plan.margin).all()
+
+
+def test_no_plan_with_either_margin_gives_the_first_search_s_reason() -> None:
+    grid = room()
+    grid.occupied[:, 80:82] = True  # a partition with no door at all
+    plan = plan_poses(grid, clearance(grid), PlanarFootprint.rectangle(0.9, 0.6, label="base"),
+                      (1.5, 2.0, 0.0), (6.5, 2.0, 0.0))
+    assert not plan.ok and "no sequence of moves fits the footprint (base" in plan.reason
+    assert math.isnan(plan.margin)
