@@ -162,30 +162,6 @@ def plan_poses(
     does not, one keeping ``options.squeeze_clearance`` is searched for (the plan's
     ``margin`` says which); when neither is found, the reason is the first search's.
     """
-    found = _plan_keeping(grid, clear, footprint, start, goal, pivot, options, carried,
-                          clear_high)
-    squeeze = max(options.squeeze_clearance, 0.0)
-    if found.ok or squeeze >= options.min_clearance or found.start_blocked:
-        return found
-    tight = _plan_keeping(grid, clear, footprint, start, goal, pivot,
-                          replace(options, min_clearance=squeeze), carried, clear_high)
-    if tight.ok:
-        return tight
-    return replace(found, expanded=found.expanded + tight.expanded)
-
-
-def _plan_keeping(
-    grid: OccupancyGrid,
-    clear: np.ndarray,
-    footprint: PlanarFootprint,
-    start: tuple[float, float, float],
-    goal: tuple[float, float, float],
-    pivot: float,
-    options: LatticeOptions,
-    carried: PlanarFootprint | None,
-    clear_high: np.ndarray | None,
-) -> PosePlan:
-    """:func:`plan_poses` keeping ``options.min_clearance`` throughout (one search)."""
     o = options
     pts = outline_samples(footprint, 0.05)
     if carried is not None and clear_high is not None:
@@ -203,83 +179,96 @@ def _plan_keeping(
         )
     )
     reach = float(np.hypot(both[:, 0] - pivot, both[:, 1]).max()) + abs(pivot)
-    need = o.min_clearance + grid.resolution / math.sqrt(2.0)
     x0, y0 = grid.origin
     res = grid.resolution
-    if not pose_fits(clear, high, x0, y0, res, pts, pts_high, *goal, need):
-        return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
-    need_low = grid.resolution / math.sqrt(2.0)
-    if not pose_fits(clear, high, x0, y0, res, pts, pts_high, *start, need_low):
-        return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start",
-                        start_blocked=True)
-    free = clearance_at_least(clear, res, footprint.half_width + o.min_clearance)
-    gc = grid.world_to_cell(goal[0], goal[1])
-    field = GoalField(free, gc if grid.inside(gc) else None)
-    params = np.array(
-        [
-            o.step,
-            1.0 / o.turn_radius,
-            o.heading_bins,
-            o.xy_bin,
-            o.turn_step,
-            o.turn_cost,
-            o.reverse_factor,
-            o.goal_xy,
-            o.goal_yaw,
-            o.max_expansions,
-            o.check_spacing,
-            pivot,
-            need_low,
-            o.tight_start,
-            o.steer_cost,
-        ]
-    )
+    need_low = res / math.sqrt(2.0)
+    start_fits = pose_fits(clear, high, x0, y0, res, pts, pts_high, *start, need_low)
     groups, groups_high = point_groups(pts), point_groups(pts_high)
     window = max(window_cells(groups, res), window_cells(groups_high, res))
     windows = WindowMinima(clear.shape, window)
     windows_high = windows if high is clear else WindowMinima(high.shape, window)
-    parent, move_of, pose, end, expanded = search_poses(
-        clear,
-        high,
-        x0,
-        y0,
-        res,
-        pts,
-        pts_high,
-        reach,
-        need,
-        (groups.points, groups.first, groups.centre, groups.radius, groups.reach),
-        (
-            groups_high.points,
-            groups_high.first,
-            groups_high.centre,
-            groups_high.radius,
-            groups_high.reach,
-        ),
-        (windows.low, windows.done, windows.window),
-        (windows_high.low, windows_high.done, windows_high.window),
-        field.free,
-        field.dist,
-        field.heap_d,
-        field.heap_i,
-        field.state,
-        field.frontier,
-        np.asarray(start, float),
-        np.asarray(goal, float),
-        params,
-    )
-    if end < 0:
-        return PosePlan(
-            False,
-            f"no sequence of moves fits the footprint ({whole}) from the start to the goal",
-            expanded=expanded,
+
+    def keeping(margin: float) -> PosePlan:
+        """The plan whose every pose keeps ``margin`` from obstacles (one search)."""
+        need = margin + need_low
+        if not pose_fits(clear, high, x0, y0, res, pts, pts_high, *goal, need):
+            return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
+        if not start_fits:
+            return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start",
+                            start_blocked=True)
+        free = clearance_at_least(clear, res, footprint.half_width + margin)
+        gc = grid.world_to_cell(goal[0], goal[1])
+        field = GoalField(free, gc if grid.inside(gc) else None)
+        params = np.array(
+            [
+                o.step,
+                1.0 / o.turn_radius,
+                o.heading_bins,
+                o.xy_bin,
+                o.turn_step,
+                o.turn_cost,
+                o.reverse_factor,
+                o.goal_xy,
+                o.goal_yaw,
+                o.max_expansions,
+                o.check_spacing,
+                pivot,
+                need_low,
+                o.tight_start,
+                o.steer_cost,
+            ]
         )
-    chain = [end]
-    while parent[chain[-1]] >= 0:
-        chain.append(int(parent[chain[-1]]))
-    chain.reverse()
-    poses = pose[chain].copy()
-    kinds = np.array([FORWARD] * 3 + [BACKWARD] * 3 + [TURN] * 2)
-    moves = kinds[move_of[chain[1:]]]
-    length = float(np.hypot(*np.diff(poses[:, :2], axis=0).T).sum())
-    return PosePlan(True, "ok", poses, moves, length, expanded, o.min_clearance)
+        parent, move_of, pose, end, expanded = search_poses(
+            clear,
+            high,
+            x0,
+            y0,
+            res,
+            pts,
+            pts_high,
+            reach,
+            need,
+            (groups.points, groups.first, groups.centre, groups.radius, groups.reach),
+            (
+                groups_high.points,
+                groups_high.first,
+                groups_high.centre,
+                groups_high.radius,
+                groups_high.reach,
+            ),
+            (windows.low, windows.done, windows.window),
+            (windows_high.low, windows_high.done, windows_high.window),
+            field.free,
+            field.dist,
+            field.heap_d,
+            field.heap_i,
+            field.state,
+            field.frontier,
+            np.asarray(start, float),
+            np.asarray(goal, float),
+            params,
+        )
+        if end < 0:
+            return PosePlan(
+                False,
+                f"no sequence of moves fits the footprint ({whole}) from the start to the goal",
+                expanded=expanded,
+            )
+        chain = [end]
+        while parent[chain[-1]] >= 0:
+            chain.append(int(parent[chain[-1]]))
+        chain.reverse()
+        poses = pose[chain].copy()
+        kinds = np.array([FORWARD] * 3 + [BACKWARD] * 3 + [TURN] * 2)
+        moves = kinds[move_of[chain[1:]]]
+        length = float(np.hypot(*np.diff(poses[:, :2], axis=0).T).sum())
+        return PosePlan(True, "ok", poses, moves, length, expanded, margin)
+
+    found = keeping(o.min_clearance)
+    squeeze = max(o.squeeze_clearance, 0.0)
+    if found.ok or found.start_blocked or squeeze >= o.min_clearance:
+        return found
+    tight = keeping(squeeze)
+    if tight.ok:
+        return tight
+    return replace(found, expanded=found.expanded + tight.expanded)

@@ -49,13 +49,22 @@ def test_long_footprint_backs_up_before_turning() -> None:
     assert math.hypot(end[0] - goal[0], end[1] - goal[1]) <= 0.15
     assert abs((end[2] - goal[2] + math.pi) % (2 * math.pi) - math.pi) <= 0.2
     # every pose keeps the whole outline off the walls
+    for rows, cols in _outline_cells(fp, plan.poses):
+        assert not grid.occupied[rows, cols].any()
+
+
+def _outline_cells(fp: PlanarFootprint, poses: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The rows and columns (5 cm cells from the origin) of the footprint's outline samples
+    at each pose."""
     pts = outline_samples(fp)
-    for x, y, th in plan.poses:
+    out = []
+    for x, y, th in poses:
         c, s = math.cos(th), math.sin(th)
         wx = x + c * pts[:, 0] - s * pts[:, 1]
         wy = y + s * pts[:, 0] + c * pts[:, 1]
         cells = np.floor(np.column_stack([wy, wx]) / 0.05).astype(int)
-        assert not grid.occupied[cells[:, 0], cells[:, 1]].any()
+        out.append((cells[:, 0], cells[:, 1]))
+    return out
 
 
 def test_no_room_is_reported() -> None:
@@ -262,13 +271,8 @@ def test_a_doorway_only_a_little_wider_than_the_base_is_passed_with_the_smaller_
     assert plan.poses[0][0] < 4.0 < plan.poses[-1][0]  # through the door
     # every pose keeps the smaller margin: each outline point's cell is at least that far
     # (less the point's own offset in its cell) from the nearest blocked cell
-    pts = outline_samples(base)
-    for x, y, th in plan.poses:
-        c, s = math.cos(th), math.sin(th)
-        wx = x + c * pts[:, 0] - s * pts[:, 1]
-        wy = y + s * pts[:, 0] + c * pts[:, 1]
-        cells = np.floor(np.column_stack([wy, wx]) / 0.05).astype(int)
-        assert (clear[cells[:, 0], cells[:, 1]] >= plan.margin).all()
+    for rows, cols in _outline_cells(base, plan.poses):
+        assert (clear[rows, cols] >= plan.margin).all()
 
 
 def test_no_plan_with_either_margin_gives_the_first_search_s_reason() -> None:
