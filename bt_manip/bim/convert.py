@@ -192,8 +192,9 @@ def paused_cycle_collection() -> Iterator[None]:
 
     A conversion makes about a hundred thousand short-lived Python objects (ifcopenshell's
     entity proxies, tuples of coordinates, small lists), none of which form reference cycles;
-    each 700 of them would start a collection, and every few dozen collections one over all
-    the process's objects (the modules of numpy, scipy and ifcopenshell among them). Reference
+    each 700 of them would start a collection, every tenth of those one over older objects
+    too, and now and then one over all the process's objects (the modules of numpy, scipy and
+    ifcopenshell among them). Reference
     counting frees everything the conversion drops, as it goes; what cycles there are wait for
     the collector to run again after the block."""
     was_enabled = gc.isenabled()
