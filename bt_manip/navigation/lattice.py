@@ -97,8 +97,6 @@ class PosePlan:
     margin: float = math.nan
     """The clearance (m) the plan keeps from obstacles: ``min_clearance``, or
     ``squeeze_clearance`` when only that fits (NaN without a plan)."""
-    start_blocked: bool = False
-    """The footprint touches obstacles at the start (no margin would make a plan)."""
 
 
 def outline_samples(footprint: PlanarFootprint, spacing: float = 0.05) -> np.ndarray:
@@ -194,8 +192,7 @@ def plan_poses(
         if not pose_fits(clear, high, x0, y0, res, pts, pts_high, *goal, need):
             return PosePlan(False, f"the footprint ({whole}) does not fit at the goal")
         if not start_fits:
-            return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start",
-                            start_blocked=True)
+            return PosePlan(False, f"the footprint ({whole}) touches obstacles at the start")
         free = clearance_at_least(clear, res, footprint.half_width + margin)
         gc = grid.world_to_cell(goal[0], goal[1])
         field = GoalField(free, gc if grid.inside(gc) else None)
@@ -266,7 +263,7 @@ def plan_poses(
 
     found = keeping(o.min_clearance)
     squeeze = max(o.squeeze_clearance, 0.0)
-    if found.ok or found.start_blocked or squeeze >= o.min_clearance:
+    if found.ok or not start_fits or squeeze >= o.min_clearance:
         return found
     tight = keeping(squeeze)
     if tight.ok:
