@@ -18,8 +18,9 @@ plain box is read as the obstacle it is: a straight one with holes cut into its 
 holes as openings (:func:`~bt_manip.bim.footprints.wall_gaps`), any other becomes its footprint
 (:func:`~bt_manip.bim.footprints.hull_boxes`). Curtain walls (IfcCurtainWall: its body, else its
 plates and members), columns, stairs, ramps, railings, beams, coverings (but floor and ceiling
-finishes), proxies, plates and members become obstacles of their footprint, furniture
-(IfcFurnishingElement) too.
+finishes), proxies, plates and members, lifts (IfcTransportElement) and the building services
+that stand in rooms (:data:`SERVICE_CLASSES`: a bathtub, a radiator, a boiler) become obstacles
+of their footprint, furniture (IfcFurnishingElement) too.
 """
 
 from __future__ import annotations
@@ -40,7 +41,13 @@ from bt_manip.bim.shapes import (
     hull_xy,
     is_box_like,
 )
-from bt_manip.bim.storeys import choose_storey, direct_containers, storey_elevation, storey_of
+from bt_manip.bim.storeys import (
+    choose_storey,
+    direct_containers,
+    one_level,
+    storey_elevation,
+    storey_of,
+)
 
 __all__ = ["Building", "Furniture", "Names", "Opening", "Space", "Wall", "choose_storey",
            "read_building", "storey_elevation", "storey_of"]
@@ -58,11 +65,17 @@ MAX_OPENINGS = 10000
 MAX_SPACES = 2000
 MAX_FURNITURE = 5000
 MAX_SLABS = 2000
+SERVICE_CLASSES = ("IfcFlowTerminal", "IfcEnergyConversionDevice", "IfcFlowStorageDevice",
+                   "IfcFlowMovingDevice", "IfcFlowTreatmentDevice")
+"""Building services that stand in rooms: sanitary terminals (a bathtub, a toilet), appliances,
+radiators, boilers, tanks, pumps. Pipes, ducts, their fittings and valves (IfcFlowSegment,
+IfcFlowFitting, IfcFlowController), thousands in a services model and mostly under ceilings,
+are not read."""
 MAX_OBSTACLES = 20000
 """Obstacles of the other classes (columns, stairs, proxies...) and curtain wall parts at most."""
 OBSTACLE_CLASSES = ("IfcColumn", "IfcStair", "IfcStairFlight", "IfcRamp", "IfcRampFlight",
                     "IfcRailing", "IfcBeam", "IfcCovering", "IfcBuildingElementProxy",
-                    "IfcPlate", "IfcMember")
+                    "IfcPlate", "IfcMember", "IfcTransportElement", *SERVICE_CLASSES)
 """Classes read as obstacles besides walls, curtain walls and furniture."""
 FINISHES = ("FLOORING", "CEILING", "ROOFING")
 """Covering types that are no obstacle: the robot drives on a floor finish."""
@@ -147,7 +160,8 @@ class Building:
     storey: Any
     floor_z: float
     extent: tuple[float, float, float, float]
-    """(xmin, ymin, xmax, ymax) of the slabs (of the walls when there is no slab)."""
+    """(xmin, ymin, xmax, ymax) of the slabs (of the walls when there is no slab, of the other
+    obstacles and furniture when there is no wall either)."""
     walls: list[Wall] = field(default_factory=list)
     raised: list[Furniture] = field(default_factory=list)
     """Walls that do not stand on the floor, kept as static boxes."""
@@ -178,7 +192,7 @@ class Building:
             f"({c.get('plates', 0)} plates, {c.get('members', 0)} members), "
             f"{c.get('doors', 0)} doors, {c.get('windows', 0)} windows, "
             f"{c.get('other obstacles', 0)} other obstacles of storey "
-            f"'{self.storey.Name or self.storey.id()}'"
+            f"'{self.storey.Name or '#' + str(self.storey.id())}'"
         )
         if self.skipped:
             groups: dict[str, list[str]] = {}
@@ -223,7 +237,7 @@ def read_building(
     ``exclude`` (step ids of the elements to install) are left out, and so is anything above
     ``band_top`` (m above the floor). Problems are collected in ``source``."""
     model = source.model
-    single = len(model.by_type("IfcBuildingStorey")) == 1
+    single = one_level(model)
     climbed: dict[tuple[str, int], Any] = {}
     contained = {} if single else direct_containers(model)
 
@@ -341,7 +355,21 @@ def read_building(
         )
     elif xs:
         out.extent = (min(xs), min(ys), max(xs), max(ys))
+    else:  # neither slabs nor walls (a row of columns): what stands on the floor
+        corners = [c for f in out.curtain_walls + out.obstacles + out.furniture
+                   for box in f.boxes for c in _corners(box)]
+        if corners:
+            out.extent = (min(c[0] for c in corners), min(c[1] for c in corners),
+                          max(c[0] for c in corners), max(c[1] for c in corners))
     return out
+
+
+def _corners(box: Box) -> list[tuple[float, float]]:
+    """The four corners (x, y) of a box's footprint."""
+    c, s = math.cos(box.yaw), math.sin(box.yaw)
+    hx, hy = box.size[0] / 2, box.size[1] / 2
+    return [(box.centre[0] + c * a - s * b, box.centre[1] + s * a + c * b)
+            for a, b in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))]
 
 
 def _doors_on_a_raised_floor(building: Building) -> None:

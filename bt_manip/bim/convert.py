@@ -33,7 +33,7 @@ from typing import Any
 from bt_manip.bim import require_ifcopenshell
 from bt_manip.bim.building import Building, Names, read_building
 from bt_manip.bim.doorways import crossings, door_poses
-from bt_manip.bim.floor_grid import FloorGrid, Rect
+from bt_manip.bim.floor_grid import MARGIN, FloorGrid, Rect
 from bt_manip.bim.ifc_input import IfcSource, open_ifc
 from bt_manip.bim.install_tree import install_tree
 from bt_manip.bim.robot_fit import RobotFit, robot_fit
@@ -58,7 +58,13 @@ from bt_manip.bim.stock import (
     stock_group,
     stock_poses,
 )
-from bt_manip.bim.storeys import StoreyChoice, choose_storey, storey_elevation, storey_of
+from bt_manip.bim.storeys import (
+    StoreyChoice,
+    choose_storey,
+    one_level,
+    storey_elevation,
+    storey_of,
+)
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.bim.world_yaml import world_yaml
 from bt_manip.errors import InputError
@@ -466,7 +472,7 @@ def _elements(
 
     storey = choice.storey
     reader = ShapeReader(source.scale, source.model)
-    single = len(source.model.by_type("IfcBuildingStorey")) == 1
+    single = one_level(source.model)
     out: list[InstallElement] = []
     for i, p in enumerate(planned):
         el = p.entity
@@ -539,6 +545,16 @@ def _largest_space(building: Building) -> Rect:
     return Rect((xmin + xmax) / 2, (ymin + ymax) / 2, xmax - xmin, ymax - ymin)
 
 
+def _free_areas(building: Building) -> tuple[list[Rect], str]:
+    """Where the robot's start or the stock is looked for, in turn, and how to name it: the
+    largest space; without spaces, the building's extent, then the floor around it too (a
+    single wall or a row of columns leaves no room within its own extent)."""
+    area = _largest_space(building)
+    if building.spaces:
+        return [area], "the largest space"
+    return [area, area.grown(MARGIN)], "the building's extent or the floor around it"
+
+
 def _with_work_zones(grid: FloorGrid, elements: list[InstallElement], depth: float) -> FloorGrid:
     """A copy of ``grid`` with the floor ``depth`` m deep on both sides of each element's place
     blocked (where the robot stands and lines up to place it; 0: none)."""
@@ -590,32 +606,33 @@ def _stock_pose(
                 "or furniture; give a free spot",
             )
         return pose
-    area = _largest_space(building)
-    placed = None
-    trials = 0
-    for depth in WORK_ZONES:  # keep the floor before the places free, if there is room
-        for pose in stock_poses(_with_work_zones(grid, elements, depth), area, sizes):
-            placed = placed or pose
-            if trials >= MAX_STOCK_TRIALS:
-                break
-            trials += 1
-            if _routes_clear(source, building, grid, elements, sizes, pose, robot_width):
-                return pose
-    if placed is None:
-        raise InputError.single(
-            str(source.path), None,
-            f"no free spot for the stock ({len(sizes)} stands) in the largest space: give one "
-            "with --stock X;Y;YAW",
-        )
-    return placed
+    areas, label = _free_areas(building)
+    for area in areas:
+        placed = None
+        trials = 0
+        for depth in WORK_ZONES:  # keep the floor before the places free, if there is room
+            for pose in stock_poses(_with_work_zones(grid, elements, depth), area, sizes):
+                placed = placed or pose
+                if trials >= MAX_STOCK_TRIALS:
+                    break
+                trials += 1
+                if _routes_clear(source, building, grid, elements, sizes, pose, robot_width):
+                    return pose
+        if placed is not None:
+            return placed
+    raise InputError.single(
+        str(source.path), None,
+        f"no free spot for the stock ({len(sizes)} stands) in {label}: give one with "
+        "--stock X;Y;YAW",
+    )
 
 
 def _robot_start(
     options: BimOptions, building: Building, grid: FloorGrid, robot_radius: float
 ) -> tuple[tuple[float, float, float], float]:
     """The robot's start (nearest the centre of its space with room to turn) and jitter."""
-    area = _largest_space(building)
-    label = "the largest space"
+    areas, label = _free_areas(building)
+    where = str(options.ifc)
     if options.start_space is not None:
         wanted = options.start_space.lower()
         match = [s for s in building.spaces if s.name.lower() == wanted or
@@ -624,15 +641,17 @@ def _robot_start(
             known = ", ".join(sorted(s.name for s in building.spaces)) or "none"
             raise InputError.single("--start", None,
                                     f"no space named '{options.start_space}'; spaces: {known}")
-        area = _space_rect(match[0])
+        areas = [_space_rect(match[0])]
         label = f"space '{match[0].name}'"
-    for jitter in (START_JITTER, 0.0):
-        half = robot_radius + jitter * math.sqrt(2) + CLEARANCE
-        spot = grid.nearest_clear(area.x, area.y, half, within=area)
-        if spot is not None:
-            return (spot[0], spot[1], area.yaw), jitter
+        where = "--start"
+    for area in areas:
+        for jitter in (START_JITTER, 0.0):
+            half = robot_radius + jitter * math.sqrt(2) + CLEARANCE
+            spot = grid.nearest_clear(area.x, area.y, half, within=area)
+            if spot is not None:
+                return (spot[0], spot[1], area.yaw), jitter
     raise InputError.single(
-        "--start", None,
+        where, None,
         f"no free spot for the robot ({2 * robot_radius:.2f} m across) in {label}",
     )
 

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from bt_manip.bim import ifc_attributes as at
+from bt_manip.bim.grid_placement import UnreadGrid, grid_placement_matrix
 from bt_manip.bim.hulls import distinct_chain, finite_rows, hull_xy, next_rows, unique_rows
 
 __all__ = ["BOX_FILL", "Box", "ShapeReader", "Solid", "UnsupportedGeometry", "body_representation",
@@ -94,7 +95,9 @@ class ShapeReader:
 
     def placement(self, placement: Any) -> np.ndarray:
         """The 4x4 matrix (file units) of an object placement, each placement of a chain
-        computed once per reader (elements share their storey's and building's)."""
+        computed once per reader (elements share their storey's and building's): a local
+        placement, or one on a design grid (:mod:`bt_manip.bim.grid_placement`);
+        UnsupportedGeometry for any other kind (an IFC4.3 linear placement)."""
         import ifcopenshell.util.placement as util
 
         key = int(placement.id())
@@ -105,8 +108,15 @@ class ShapeReader:
             if parent is not None:
                 found = self.placement(parent) @ self.axis(
                     placement.get_argument(at.RELATIVE_PLACEMENT))
-            else:
+            elif local:
                 found = np.asarray(util.get_local_placement(placement), dtype=float)
+            elif placement.is_a("IfcGridPlacement"):
+                try:
+                    found = grid_placement_matrix(placement, self.placement)
+                except UnreadGrid as exc:
+                    raise UnsupportedGeometry(f"its grid placement: {exc}") from None
+            else:
+                raise UnsupportedGeometry(f"its placement ({placement.is_a()}) is not read")
             self._placements[key] = found
         return found
 

@@ -4,6 +4,11 @@
 elevation); by default it is the ground storey: the elevation nearest 0, ties broken by the
 most walls, then by the file's order. :class:`StoreyChoice` says which one and why, and lists
 them all for the printed summary.
+
+A file without any IfcBuildingStorey (its elements contained in the IfcBuilding or the IfcSite
+directly, as small exports and IFC4.3 sample files often are) is read whole, as one level:
+its IfcBuilding stands for the storey (else its IfcSite, else its IfcProject), at the height of
+that entity's placement.
 """
 
 from __future__ import annotations
@@ -12,7 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from bt_manip.bim.ifc_input import IfcSource
-from bt_manip.errors import InputError, Problem
+from bt_manip.errors import InputError
 
 ELEVATION_TIE = 0.01
 """Storeys whose elevations (m) differ by less than this are at the same level."""
@@ -32,7 +37,11 @@ class StoreyChoice:
         return str(self.storey.Name or f"#{self.storey.id()}")
 
     def text(self) -> str:
-        """``storey 'Level 1' (elevation 0.00 m, the ground storey; others: ...)``."""
+        """``storey 'Level 1' (elevation 0.00 m, the ground storey; others: ...)``, or for a
+        file without storeys ``level 'Building' (IfcBuilding, elevation 0.00 m: ...)``."""
+        if not self.storeys:
+            return (f"level '{self.name}' ({self.storey.is_a()}, elevation "
+                    f"{self.elevation:.2f} m: {self.reason})")
         listed = ", ".join(f"{i} '{n}' {z:.2f} m" for i, (n, z) in enumerate(self.storeys))
         return (f"storey '{self.name}' (elevation {self.elevation:.2f} m, {self.reason}; "
                 f"storeys by elevation: {listed})")
@@ -125,34 +134,35 @@ def _climb(current: Any, memo: dict[tuple[str, int], Any] | None = None) -> Any:
     return None
 
 
+def one_level(model: Any) -> bool:
+    """Whether every element of the file is on the level built: it has one storey, or none
+    (read whole, see the module)."""
+    return len(model.by_type("IfcBuildingStorey")) <= 1
+
+
 def storey_elevation(source: IfcSource, storey: Any) -> float:
     """Height (m) of the storey's floor: its placement, else its Elevation attribute (each
-    storey's once per source)."""
+    storey's once per source); for the building, site or project standing for the level of a
+    file without storeys, its placement's height, else 0."""
     import ifcopenshell.util.placement as placement
 
     found = source.elevations.get(storey.id())
     if found is None:
-        if storey.ObjectPlacement is not None:
-            found = float(placement.get_local_placement(storey.ObjectPlacement)[2][3]) * \
-                source.scale
+        at = getattr(storey, "ObjectPlacement", None)
+        if at is not None and at.is_a("IfcLocalPlacement"):
+            found = float(placement.get_local_placement(at)[2][3]) * source.scale
         else:
-            found = float(storey.Elevation or 0.0) * source.scale
+            found = float(getattr(storey, "Elevation", None) or 0.0) * source.scale
         source.elevations[storey.id()] = found
     return found
 
 
 def choose_storey(source: IfcSource, wanted: str | None = None) -> StoreyChoice:
-    """The storey to build (see the module docstring). A file without one is a problem, and
-    so is a ``wanted`` storey that matches none."""
+    """The storey to build (see the module docstring). A ``wanted`` storey that matches none
+    is a problem, and so is a file with neither a storey nor a building, site or project."""
     storeys = source.model.by_type("IfcBuildingStorey")
     if not storeys:
-        message = "no IfcBuildingStorey: the world is built from the walls of one storey"
-        projects = source.model.by_type("IfcProject")
-        if projects:
-            source.fail(projects[0], message)
-        else:
-            source.problems.append(Problem(str(source.path), None, message))
-        source.raise_problems()
+        return _whole_file(source, wanted)
     levels = {s.id(): storey_elevation(source, s) for s in storeys}
     ordered = sorted(storeys, key=lambda s: (levels[s.id()], s.id()))
     listing = tuple((str(s.Name or f"#{s.id()}"), levels[s.id()]) for s in ordered)
@@ -181,3 +191,30 @@ def choose_storey(source: IfcSource, wanted: str | None = None) -> StoreyChoice:
             counts[storey.id()] += 1
     best = max(ground, key=lambda s: (counts[s.id()], -s.id()))
     return StoreyChoice(best, levels[best.id()], "the one holding the most walls", listing)
+
+
+WHOLE_FILE_CLASSES = ("IfcBuilding", "IfcSite", "IfcProject")
+"""What stands for the level of a file without storeys: the first of these the file has."""
+
+
+def _whole_file(source: IfcSource, wanted: str | None) -> StoreyChoice:
+    """The level of a file without storeys: its first IfcBuilding (else IfcSite, else
+    IfcProject) by step id, every element on it."""
+    level = None
+    for cls in WHOLE_FILE_CLASSES:
+        found = source.model.by_type(cls)
+        if found:
+            level = min(found, key=lambda e: e.id())
+            break
+    if level is None:
+        raise InputError.single(str(source.path), None,
+                                "no IfcBuildingStorey, IfcBuilding, IfcSite or IfcProject: "
+                                "nothing to build a world from")
+    if wanted is not None:
+        raise InputError.single(
+            "--storey", None,
+            f"the file has no IfcBuildingStorey: it is read whole, as one level ({level.is_a()} "
+            f"'{level.Name or '#' + str(level.id())}'); leave --storey out",
+        )
+    return StoreyChoice(level, storey_elevation(source, level),
+                        "no IfcBuildingStorey in the file: every element read, as one level", ())

@@ -41,16 +41,17 @@ def test_not_an_ifc_file(tmp_path, capsys):
     assert err.strip() == f"{bad}:1: not an IFC file: it does not start with 'ISO-10303-21;'"
 
 
-def test_no_storey(tmp_path, capsys):
-    b = three_rooms(with_storey=False)
-    path = b.write(tmp_path / "flat.ifc")
-    project = b.file.by_type("IfcProject")[0]
+def test_a_file_holding_no_spatial_structure(tmp_path, capsys):
+    # no storey, building, site or project: nothing stands for a level to build
+    f = ifcopenshell.file(schema="IFC4")
+    f.createIfcWall(ifcopenshell.guid.new(), None, "Alone")
+    path = tmp_path / "bare.ifc"
+    f.write(str(path))
     code, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 2
-    assert err.strip() == (
-        f"{path}:{_line_of(path, project.id())}: #{project.id()} IfcProject 'Three rooms': "
-        "no IfcBuildingStorey: the world is built from the walls of one storey"
-    )
+    assert err.strip().endswith(
+        "no IfcBuildingStorey, IfcBuilding, IfcSite or IfcProject: nothing to build a world from")
+    assert err.strip().startswith(f"{path}")
 
 
 def test_unsupported_geometry_of_a_round_wall(tmp_path, capsys):
