@@ -33,7 +33,16 @@ class UnreadGrid(Exception):
 def grid_placement_matrix(placement: Any, placement_of: Callable[[Any], np.ndarray]) -> np.ndarray:
     """The 4x4 matrix (file units) of an IfcGridPlacement; ``placement_of`` gives that of the
     grid's own placement."""
+    try:
+        return _grid_placement(placement, placement_of)
+    except (AttributeError, TypeError, IndexError) as exc:  # an attribute left empty
+        raise UnreadGrid(f"it is incomplete ({exc})") from None
+
+
+def _grid_placement(placement: Any, placement_of: Callable[[Any], np.ndarray]) -> np.ndarray:
     location = placement.PlacementLocation
+    if location is None:
+        raise UnreadGrid("it names no grid intersection")
     origin, along = crossing(location)
     ref = placement.PlacementRefDirection
     if ref is None:
@@ -99,7 +108,7 @@ def _offset_segments(axis: Any, offset: float) -> list[tuple[np.ndarray, np.ndar
     """The axis as (start, vector) segments in its running sense, moved ``offset`` to its
     left."""
     points = _axis_points(axis)
-    if not axis.SameSense:
+    if axis.SameSense is False:
         points = points[::-1]
     out = []
     for a, b in itertools.pairwise(points):
@@ -118,12 +127,15 @@ def _axis_points(axis: Any) -> np.ndarray:
     """Two or more points (x, y) along a straight grid axis, in its curve's sense."""
     curve = axis.AxisCurve
     name = axis.AxisTag or f"#{axis.id()}"
+    if curve is None:
+        raise UnreadGrid(f"grid axis '{name}' has no curve")
     if curve.is_a("IfcTrimmedCurve") and curve.BasisCurve.is_a("IfcLine"):
         curve = curve.BasisCurve  # the crossing may lie anywhere along the line
     if curve.is_a("IfcPolyline"):
         pts = [tuple(float(v) for v in p.Coordinates[:2]) for p in curve.Points]
-        if len(pts) >= 2:
-            return np.array(pts)
+        if len(pts) < 2:
+            raise UnreadGrid(f"grid axis '{name}' is a polyline of {len(pts)} point(s)")
+        return np.array(pts)
     elif curve.is_a("IfcLine"):
         start = np.array([float(v) for v in curve.Pnt.Coordinates[:2]])
         vector = curve.Dir

@@ -44,6 +44,10 @@ BOX_FILL = 0.9
 (less the mitres of :func:`is_box_like`)."""
 
 
+MAX_PLACEMENT_CHAIN = 64
+"""Placements relative to one another at most, from an element's to the first absolute one."""
+
+
 class UnsupportedGeometry(Exception):
     """The element's geometry cannot be read or is not what bt-manip models."""
 
@@ -89,6 +93,8 @@ class ShapeReader:
         self._settings: Any = None
         self._mapped: dict[int, np.ndarray | None] = {}
         self._placements: dict[int, np.ndarray] = {}
+        self._pending: dict[int, None] = {}
+        """Placements being computed, in the order of the chain (a loop is refused)."""
         self._axes: dict[int, np.ndarray] = {}
         self._mappings: dict[tuple[int, int], np.ndarray] = {}
         self._angle: float | None = None
@@ -102,7 +108,15 @@ class ShapeReader:
 
         key = int(placement.id())
         found = self._placements.get(key)
-        if found is None:
+        if found is not None:
+            return found
+        if key in self._pending or len(self._pending) >= MAX_PLACEMENT_CHAIN:
+            chain = " -> ".join(f"#{k}" for k in [*self._pending, key])
+            why = ("loop" if key in self._pending else
+                   f"go more than {MAX_PLACEMENT_CHAIN} deep")
+            raise UnsupportedGeometry(f"its placements {why} ({chain})")
+        self._pending[key] = None
+        try:
             local = placement.is_a("IfcLocalPlacement")
             parent = placement.get_argument(at.PLACEMENT_REL_TO) if local else None
             if parent is not None:
@@ -117,7 +131,9 @@ class ShapeReader:
                     raise UnsupportedGeometry(f"its grid placement: {exc}") from None
             else:
                 raise UnsupportedGeometry(f"its placement ({placement.is_a()}) is not read")
-            self._placements[key] = found
+        finally:
+            del self._pending[key]
+        self._placements[key] = found
         return found
 
     def axis(self, placement: Any) -> np.ndarray:

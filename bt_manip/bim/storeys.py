@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from bt_manip.bim.ifc_input import IfcSource
+from bt_manip.bim.shapes import ShapeReader, UnsupportedGeometry
 from bt_manip.errors import InputError
 
 ELEVATION_TIE = 0.01
@@ -144,13 +145,16 @@ def storey_elevation(source: IfcSource, storey: Any) -> float:
     """Height (m) of the storey's floor: its placement, else its Elevation attribute (each
     storey's once per source); for the building, site or project standing for the level of a
     file without storeys, its placement's height, else 0."""
-    import ifcopenshell.util.placement as placement
-
     found = source.elevations.get(storey.id())
     if found is None:
         at = getattr(storey, "ObjectPlacement", None)
         if at is not None and at.is_a("IfcLocalPlacement"):
-            found = float(placement.get_local_placement(at)[2][3]) * source.scale
+            try:
+                found = float(ShapeReader(source.scale).placement(at)[2][3]) * source.scale
+            except UnsupportedGeometry as exc:
+                source.fail(storey, f"its elevation cannot be read: {exc}")
+                source.raise_problems()
+                raise  # raise_problems has raised; this line is never reached
         else:
             found = float(getattr(storey, "Elevation", None) or 0.0) * source.scale
         source.elevations[storey.id()] = found
