@@ -45,7 +45,8 @@ BOX_FILL = 0.9
 
 
 MAX_PLACEMENT_CHAIN = 64
-"""Placements relative to one another at most, from an element's to the first absolute one."""
+"""Placements relative to one another at most, from an element's to the first absolute one
+(and representation maps nested in one another at most)."""
 
 
 class UnsupportedGeometry(Exception):
@@ -95,6 +96,8 @@ class ShapeReader:
         self._placements: dict[int, np.ndarray] = {}
         self._pending: dict[int, None] = {}
         """Placements being computed, in the order of the chain (a loop is refused)."""
+        self._pending_maps: dict[int, None] = {}
+        """Representation maps being read, likewise."""
         self._axes: dict[int, np.ndarray] = {}
         self._mappings: dict[tuple[int, int], np.ndarray] = {}
         self._angle: float | None = None
@@ -214,8 +217,14 @@ class ShapeReader:
         faces (M x 3 indices); openings are not subtracted."""
         import ifcopenshell.geom
 
-        if body_representation(element) is None:
+        rep = body_representation(element)
+        if rep is None:
             raise UnsupportedGeometry("it has no body geometry (no 'Body' representation)")
+        # what the kernel would follow round a loop forever (or crash on): refused first
+        placement = _object_placement(element)
+        if placement is not None:
+            self.placement(placement)
+        check_nesting(rep.get_argument(at.ITEMS))
         if self._settings is None:
             settings = ifcopenshell.geom.settings()
             settings.set("use-world-coords", True)
@@ -259,6 +268,7 @@ class ShapeReader:
         else:
             import ifcopenshell.geom
 
+            check_nesting(representation.get_argument(at.ITEMS))
             try:
                 shape: Any = ifcopenshell.geom.create_shape(ifcopenshell.geom.settings(),
                                                             representation)
@@ -324,8 +334,15 @@ class ShapeReader:
             source = item.get_argument(at.MAPPING_SOURCE)
             key = int(source.id())
             if key not in self._mapped:
-                self._mapped[key] = self._source_points(
-                    source.get_argument(at.MAPPED_REPRESENTATION))
+                if key in self._pending_maps or len(self._pending_maps) >= MAX_PLACEMENT_CHAIN:
+                    chain = " -> ".join(f"#{k}" for k in [*self._pending_maps, key])
+                    raise UnsupportedGeometry(f"its mapped representations loop ({chain})")
+                self._pending_maps[key] = None
+                try:
+                    self._mapped[key] = self._source_points(
+                        source.get_argument(at.MAPPED_REPRESENTATION))
+                finally:
+                    del self._pending_maps[key]
             mapped = self._mapped[key]
             if mapped is None:
                 return None
@@ -453,6 +470,69 @@ def _operator_matrix(operator: Any) -> np.ndarray:
     m.T[1] *= scale2
     m.T[2] *= scale3
     return m
+
+
+def _nested(item: Any) -> list[Any]:
+    """The geometry ``item`` is made of, where it may nest: a mapped item's mapped
+    representation's items, a boolean result's operands, a CSG solid's tree, a swept solid's
+    profile and directrix, a profile's curves or parent profiles, a composite curve's
+    segments' curves, a trimmed or offset curve's basis, a geometric set's elements. (Faces,
+    loops and points hold nothing that nests.)"""
+    def some(*values: Any) -> list[Any]:
+        return [v for v in values if v is not None]
+
+    if item.is_a("IfcMappedItem"):
+        source = item.MappingSource
+        rep = source.MappedRepresentation if source is not None else None
+        return list(rep.Items or ()) if rep is not None else []
+    if item.is_a("IfcBooleanResult"):
+        return some(item.FirstOperand, item.SecondOperand)
+    if item.is_a("IfcCsgSolid"):
+        return some(item.TreeRootExpression)
+    if item.is_a("IfcSweptAreaSolid"):
+        return some(item.SweptArea, getattr(item, "Directrix", None))
+    if item.is_a("IfcSweptDiskSolid"):
+        return some(item.Directrix)
+    if item.is_a("IfcArbitraryClosedProfileDef"):
+        return some(item.OuterCurve, *(getattr(item, "InnerCurves", None) or ()))
+    if item.is_a("IfcArbitraryOpenProfileDef"):
+        return some(item.Curve)
+    if item.is_a("IfcCompositeProfileDef"):
+        return some(*(item.Profiles or ()))
+    if item.is_a("IfcDerivedProfileDef"):
+        return some(item.ParentProfile)
+    if item.is_a("IfcCompositeCurve"):
+        return some(*(getattr(s, "ParentCurve", None) for s in item.Segments or ()))
+    if item.is_a("IfcTrimmedCurve") or item.is_a("IfcOffsetCurve2D") or \
+            item.is_a("IfcOffsetCurve3D"):
+        return some(item.BasisCurve)
+    if item.is_a("IfcGeometricSet"):
+        return some(*(item.Elements or ()))
+    return []
+
+
+def check_nesting(items: Any) -> None:
+    """UnsupportedGeometry when the items' geometry nests in a loop (:func:`_nested`: a mapped
+    representation that maps itself, a composite curve that is its own segment) or more than
+    :data:`MAX_PLACEMENT_CHAIN` deep: the geometry kernel would crash on it."""
+    done: set[int] = set()
+    stack: list[tuple[Any, int]] = [(item, 0) for item in items or ()]
+    path: list[int] = []
+    while stack:
+        item, depth = stack.pop()
+        del path[depth:]
+        key = int(item.id())
+        if key in path:
+            chain = " -> ".join(f"#{k}" for k in [*path[path.index(key):], key])
+            raise UnsupportedGeometry(f"its geometry nests in a loop ({chain})")
+        if depth >= MAX_PLACEMENT_CHAIN:
+            raise UnsupportedGeometry(
+                f"its geometry nests more than {MAX_PLACEMENT_CHAIN} deep")
+        if key in done:
+            continue
+        done.add(key)
+        path.append(key)
+        stack += [(child, depth + 1) for child in _nested(item)]
 
 
 def _uncut(item: Any) -> Any:

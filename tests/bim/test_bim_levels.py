@@ -247,27 +247,3 @@ def test_building_services_standing_in_a_room_are_obstacles(tmp_path):
     # neither walls nor slabs: the floor's extent is that of what stands on it
     assert c.building.extent == pytest.approx((1.15, 0.95, 5.5, 3.35), abs=1e-3)
 
-
-def test_placements_that_loop_leave_their_elements_out(tmp_path, capsys):
-    b = three_rooms(with_tasks=False)
-    south, north = b.walls["South"].ObjectPlacement, b.walls["North"].ObjectPlacement
-    south.PlacementRelTo, north.PlacementRelTo = north, south  # each relative to the other
-    path = b.write(tmp_path / "loop.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
-    assert code == 0, err
-    assert (f"#{b.walls['South'].id()} IfcWall 'South' (its placements loop "
-            f"(#{south.id()} -> #{north.id()} -> #{south.id()}))") in out
-    walls = parse_world(tmp_path / "o" / "world.yaml").walls
-    assert len(walls) == 4  # the other four
-
-    # the storey's own placement in a loop: no floor height, the building is refused
-    b = three_rooms(with_tasks=False)
-    api("geometry.edit_object_placement", b.file, product=b.storey, matrix=np.eye(4))
-    at = b.storey.ObjectPlacement
-    at.PlacementRelTo = b.walls["West"].ObjectPlacement
-    b.walls["West"].ObjectPlacement.PlacementRelTo = at
-    path = b.write(tmp_path / "storey_loop.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o2"))
-    assert code == 2
-    assert f"#{b.storey.id()} IfcBuildingStorey 'Ground floor': its elevation cannot be read: " \
-           "its placements loop" in err
