@@ -105,6 +105,24 @@ def _find_definition(data: bytes, step_id: int) -> int | None:
     return None
 
 
+def parsed_release(schema: str) -> str | None:
+    """The schema the parser reads a file of ``schema`` (its header's name) as: the release
+    itself when the parser has it, else the final release of its line (IFC4X3 and its
+    candidates and addenda as IFC4X3_ADD2, IFC2X3_TC1 as IFC2X3, IFC4's addenda as IFC4);
+    None for a schema none of these covers (IFC4X1, IFC4X2)."""
+    import ifcopenshell.ifcopenshell_wrapper as wrapper
+
+    known = set(wrapper.schema_names())
+    if schema in known:
+        return schema
+    for line in ("IFC4X3", "IFC2X3"):
+        if schema.startswith(line):
+            return max((k for k in known if k.startswith(line)), default=None)
+    if schema == "IFC4" or schema.startswith("IFC4_"):
+        return "IFC4" if "IFC4" in known else None
+    return None
+
+
 def open_ifc(path: str | Path) -> IfcSource:
     """Read and parse an IFC file (STEP format, at most :data:`MAX_IFC_BYTES`); an entity the
     parser cannot read is a problem at its line (:mod:`~bt_manip.bim.parse_log`)."""
@@ -130,12 +148,22 @@ def open_ifc(path: str | Path) -> IfcSource:
     if not any(schema.startswith(s) for s in SCHEMAS):
         line = data.count(b"\n", 0, schema_match.start()) + 1
         raise InputError.single(
-            str(path), line, f"schema {schema} is not read; IFC2X3 and IFC4 files are"
+            str(path), line, f"schema {schema} is not read; IFC2X3, IFC4 and IFC4X3 files are"
         )
     try:
         text, exact = data.decode("utf-8"), True
     except UnicodeDecodeError:
         text, exact = data.decode("utf-8", errors="replace"), False
+    release = parsed_release(schema)
+    if release is None:
+        line = data.count(b"\n", 0, schema_match.start()) + 1
+        raise InputError.single(
+            str(path), line, f"schema {schema} is not read; IFC2X3, IFC4 and IFC4X3 files are"
+        )
+    if release != schema:  # the name in the header, as the parser knows it
+        start, end = schema_match.span(1)
+        at = len(data[:start].decode("utf-8", errors="replace"))
+        text = text[:at] + release + text[at + end - start:]
     clear_log()
     try:
         model = ifcopenshell.file.from_string(text)

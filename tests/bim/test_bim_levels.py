@@ -247,3 +247,36 @@ def test_building_services_standing_in_a_room_are_obstacles(tmp_path):
     # neither walls nor slabs: the floor's extent is that of what stands on it
     assert c.building.extent == pytest.approx((1.15, 0.95, 5.5, 3.35), abs=1e-3)
 
+
+
+@pytest.mark.parametrize("header", ["IFC4X3", "IFC4X3_ADD2"])
+def test_ifc4x3_files_named_by_any_release(tmp_path, header):
+    # early IFC4.3 files name the schema IFC4X3, read as its final release IFC4X3_ADD2
+    f, body, storey = _hall(schema="IFC4X3_ADD2")
+    wall = api("root.create_entity", f, ifc_class="IfcWall", name="Lone")
+    rep = api("geometry.add_wall_representation", f, context=body, length=3.0, height=2.5,
+              thickness=0.3)
+    api("geometry.assign_representation", f, product=wall, representation=rep)
+    api("geometry.edit_object_placement", f, product=wall, matrix=np.eye(4))
+    api("spatial.assign_container", f, products=[wall], relating_structure=storey)
+    written = tmp_path / "written.ifc"
+    f.write(str(written))
+    path = tmp_path / "hall.ifc"
+    path.write_bytes(written.read_bytes().replace(b"'IFC4X3_ADD2'", f"'{header}'".encode()))
+    c = convert(BimOptions(path, tmp_path / "out"))
+    assert c.schema == "IFC4X3"
+    assert len(parse_world(c.world_path).walls) == 1
+
+
+def test_an_ifc4_release_the_parser_lacks_is_named_at_its_line(tmp_path, capsys):
+    f, _, _ = _hall(schema="IFC4X3_ADD2")
+    written = tmp_path / "written.ifc"
+    f.write(str(written))
+    path = tmp_path / "hall.ifc"
+    data = written.read_bytes().replace(b"'IFC4X3_ADD2'", b"'IFC4X1'")
+    path.write_bytes(data)
+    line = data[:data.index(b"'IFC4X1'")].count(b"\n") + 1
+    code, _, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    assert code == 2
+    assert err.strip() == (f"{path}:{line}: schema IFC4X1 is not read; IFC2X3, IFC4 and IFC4X3 "
+                           "files are")
