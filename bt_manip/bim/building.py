@@ -30,6 +30,7 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from bt_manip.bim.floor_grid import MARGIN
 from bt_manip.bim.footprints import strip_boxes, wall_gaps
 from bt_manip.bim.ifc_input import IfcSource, check_count
 from bt_manip.bim.shapes import (
@@ -160,8 +161,10 @@ class Building:
     storey: Any
     floor_z: float
     extent: tuple[float, float, float, float]
-    """(xmin, ymin, xmax, ymax) of the slabs (of the walls when there is no slab, of the other
-    obstacles and furniture when there is no wall either)."""
+    """(xmin, ymin, xmax, ymax) of the slabs that reach within the floor grid's margin of
+    the walls' lines (and of those lines too where they lie beyond that margin); of the walls
+    alone when no slab does, of the other obstacles and furniture when there is no wall
+    either."""
     walls: list[Wall] = field(default_factory=list)
     raised: list[Furniture] = field(default_factory=list)
     """Walls that do not stand on the floor, kept as static boxes."""
@@ -247,7 +250,7 @@ def read_building(
         s = storey_of(el, climbed, contained)
         return s is not None and s.id() == storey.id()
 
-    reader = ShapeReader(source.scale, model)
+    reader = ShapeReader(source.scale, model, source.shift)
     floor_z = storey_elevation(source, storey)
     walls_found = [w for w in model.by_type("IfcWall") if w.id() not in exclude]
     check_count(source, "IfcWall", walls_found, MAX_WALLS)
@@ -346,6 +349,10 @@ def read_building(
         if found is not None:
             out.furniture.append(found)
     out.counts = counts
+    if xs:  # slabs away from every wall are not this floor (a survey marker at the origin)
+        w0, v0, w1, v1 = min(xs), min(ys), max(xs), max(ys)
+        slab_xy = [b for b in slab_xy if b[0] <= w1 + MARGIN and b[2] >= w0 - MARGIN
+                   and b[1] <= v1 + MARGIN and b[3] >= v0 - MARGIN]
     if slab_xy:
         out.extent = (
             min(b[0] for b in slab_xy),
@@ -353,6 +360,10 @@ def read_building(
             max(b[2] for b in slab_xy),
             max(b[3] for b in slab_xy),
         )
+        x0, y0, x1, y1 = out.extent
+        if xs and (min(xs) < x0 - MARGIN or max(xs) > x1 + MARGIN or min(ys) < y0 - MARGIN
+                   or max(ys) > y1 + MARGIN):  # walls beyond the slabs' margin: theirs too
+            out.extent = (min([*xs, x0]), min([*ys, y0]), max([*xs, x1]), max([*ys, y1]))
     elif xs:
         out.extent = (min(xs), min(ys), max(xs), max(ys))
     else:  # neither slabs nor walls (a row of columns): what stands on the floor

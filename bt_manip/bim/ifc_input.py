@@ -47,6 +47,9 @@ class IfcSource:
     elevations: dict[int, float] = field(default_factory=dict)
     """Storeys' floor heights (m) by step id, each computed once
     (:func:`~bt_manip.bim.storeys.storey_elevation`)."""
+    shift: tuple[float, float] = (0.0, 0.0)
+    """Subtracted (m) from the model's x and y to give the world's: nonzero for a model placed
+    far from its origin (:func:`~bt_manip.bim.convert.model_shift`)."""
 
     def line_of(self, step_id: int) -> int | None:
         """1-based line on which entity ``#step_id`` is defined (None if not found)."""

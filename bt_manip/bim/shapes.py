@@ -88,9 +88,13 @@ class Box:
 class ShapeReader:
     """Reads element bodies of one IFC file; ``scale`` converts file lengths to metres."""
 
-    def __init__(self, scale: float, model: Any = None) -> None:
+    def __init__(self, scale: float, model: Any = None,
+                 shift: tuple[float, float] = (0.0, 0.0)) -> None:
         self.scale = scale
         self.model = model
+        self.shift = shift
+        """Subtracted (m) from the x and y of every point read (a model far from its
+        origin, :attr:`~bt_manip.bim.ifc_input.IfcSource.shift`)."""
         self._settings: Any = None
         self._mapped: dict[int, np.ndarray | None] = {}
         self._placements: dict[int, np.ndarray] = {}
@@ -202,7 +206,7 @@ class ShapeReader:
             pts = (world @ local @ np.vstack([base, top]).T).T[:, :3]
             all_points.append(pts)
             volume += _polygon_area(profile) * abs(float(direction[2]))
-        points = np.vstack(all_points) * self.scale
+        points = self._shifted(np.vstack(all_points) * self.scale)
         return Solid(points, volume * self.scale**3)
 
     # -- anything else, through the geometry kernel -----------------------------------------
@@ -234,7 +238,7 @@ class ShapeReader:
             shape: Any = ifcopenshell.geom.create_shape(self._settings, element)
         except Exception as exc:  # the kernel raises RuntimeError and others
             raise UnsupportedGeometry(f"the geometry kernel cannot read it ({exc})") from None
-        verts = np.asarray(shape.geometry.verts, dtype=float).reshape(-1, 3)
+        verts = self._shifted(np.asarray(shape.geometry.verts, dtype=float).reshape(-1, 3))
         faces = np.asarray(shape.geometry.faces, dtype=int).reshape(-1, 3)
         if len(verts) == 0 or len(faces) == 0:
             raise UnsupportedGeometry("its body geometry is empty")
@@ -255,8 +259,15 @@ class ShapeReader:
             if parts and all(p is not None and len(p) for p in parts):
                 local = np.vstack([p for p in parts if p is not None])
                 pts: np.ndarray = (local @ world[:3, :3].T + world[:3, 3]) * self.scale
-                return pts
+                return self._shifted(pts)
         return self.mesh(element)[0]
+
+    def _shifted(self, points: np.ndarray) -> np.ndarray:
+        """``points`` (N x 3, metres, the model's) in the world: less :attr:`shift`."""
+        if self.shift != (0.0, 0.0):
+            points[:, 0] -= self.shift[0]
+            points[:, 1] -= self.shift[1]
+        return points
 
     def _source_points(self, representation: Any) -> np.ndarray | None:
         """A mapped representation's points, read once per file: directly, else from the

@@ -4,6 +4,7 @@ building services standing in a room."""
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import Any
@@ -280,3 +281,52 @@ def test_an_ifc4_release_the_parser_lacks_is_named_at_its_line(tmp_path, capsys)
     assert code == 2
     assert err.strip() == (f"{path}:{line}: schema IFC4X1 is not read; IFC2X3, IFC4 and IFC4X3 "
                            "files are")
+
+
+def test_a_model_far_from_its_origin_is_moved_to_the_worlds(tmp_path, capsys):
+    # the three rooms, placed on a storey 500 km east and 4,000 km north of the model's
+    # origin (surveyed coordinates), with a survey marker (a 5 cm slab) at the origin
+    near = three_rooms()
+    far = three_rooms()
+    f = far.file
+    api("geometry.edit_object_placement", f, product=far.storey,
+        matrix=_matrix(500_000.0, 4_000_000.0, 0.0, 0.0))
+    storey_at = far.storey.ObjectPlacement
+    for product in f.by_type("IfcProduct"):
+        at = product.ObjectPlacement
+        if at is not None and at.PlacementRelTo is None and not any(
+                product.is_a(c) for c in ("IfcSite", "IfcBuilding", "IfcBuildingStorey")):
+            at.PlacementRelTo = storey_at
+    marker = api("root.create_entity", f, ifc_class="IfcSlab", name="Survey marker")
+    marker.Representation = _extruded_box(f, far.body, 50.0, 50.0, 10.0)
+    api("geometry.edit_object_placement", f, product=marker, matrix=np.eye(4))
+    api("spatial.assign_container", f, products=[marker], relating_structure=far.storey)
+    code, out, err = _run(capsys, str(far.write(tmp_path / "far.ifc")), "--out",
+                          str(tmp_path / "far"))
+    assert code == 0, err
+    assert ("note: the storey lies 4,031.1 km from the model's origin: the world is moved; "
+            "the model's x, y = the world's + (500000, 4000000) m") in out
+    c = convert(BimOptions(near.write(tmp_path / "near.ifc"), tmp_path / "near"))
+    a, b = _world(tmp_path / "far" / "world.yaml"), _world(c.world_path)
+    # the same world, walls to poses, as the building at the origin gives: to the millimetre,
+    # and spots found on the 5 cm floor grid (the stock, the start, the spaces' poses) to a
+    # cell (which cell wins a tie may depend on the last bit of a coordinate)
+    assert _alike(a["walls"], b["walls"], 1e-3)
+    for key in ("objects", "poses", "robots", "groups"):
+        assert _alike(a[key], b[key], 0.051), key
+    assert "(500000, 4000000) m" in a["description"]
+    far_targets = [e["target"] for e in
+                   json.loads((tmp_path / "far" / "schedule.json").read_text())["elements"]]
+    near_targets = [e["target"] for e in json.loads(c.schedule_path.read_text())["elements"]]
+    assert _alike(far_targets, near_targets, 1e-3)
+
+
+def _alike(a: Any, b: Any, tol: float) -> bool:
+    """Equal, numbers within ``tol``, through dicts and lists."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(_alike(a[k], b[k], tol) for k in a)
+    if isinstance(a, list) and isinstance(b, list):
+        return len(a) == len(b) and all(_alike(x, y, tol) for x, y in zip(a, b, strict=True))
+    if isinstance(a, int | float) and isinstance(b, int | float):
+        return abs(a - b) <= tol
+    return bool(a == b)
