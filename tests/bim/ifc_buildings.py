@@ -312,3 +312,45 @@ def stepped_top(b: Building) -> Building:
         ], b.storey)
     api("root.remove_product", f, product=store)
     return b
+
+
+def empty_storey(schema: str = "IFC4") -> tuple[Any, Any, Any]:
+    """A project in millimetres with a site, a building 'Hall' and an empty storey 'Ground':
+    the file, its Body context and the storey."""
+    f = ifcopenshell.file(schema=schema)
+    project = api("root.create_entity", f, ifc_class="IfcProject", name="Hall")
+    api("unit.assign_unit", f, units=[api("unit.add_si_unit", f, unit_type="LENGTHUNIT",
+                                          prefix="MILLI")])
+    model = api("context.add_context", f, context_type="Model")
+    body = api("context.add_context", f, context_type="Model", context_identifier="Body",
+               target_view="MODEL_VIEW", parent=model)
+    site = api("root.create_entity", f, ifc_class="IfcSite", name="Site")
+    building = api("root.create_entity", f, ifc_class="IfcBuilding", name="Hall")
+    storey = api("root.create_entity", f, ifc_class="IfcBuildingStorey", name="Ground")
+    api("aggregate.assign_object", f, products=[site], relating_object=project)
+    api("aggregate.assign_object", f, products=[building], relating_object=site)
+    api("aggregate.assign_object", f, products=[storey], relating_object=building)
+    return f, body, storey
+
+
+def add_wall(f: Any, body: Any, storey: Any, name: str, length: float, thickness: float,
+             matrix: np.ndarray) -> Any:
+    """A 2.5 m high wall of ``length`` and ``thickness`` (m) from its placement ``matrix``
+    along its x axis, on ``storey``."""
+    wall = api("root.create_entity", f, ifc_class="IfcWall", name=name)
+    rep = api("geometry.add_wall_representation", f, context=body, length=length, height=2.5,
+              thickness=thickness)
+    api("geometry.assign_representation", f, product=wall, representation=rep)
+    api("geometry.edit_object_placement", f, product=wall, matrix=matrix)
+    api("spatial.assign_container", f, products=[wall], relating_structure=storey)
+    return wall
+
+
+def bim_cli(capsys: Any, *argv: str) -> tuple[int, str, str]:
+    """``bt-manip bim ARGV``: its exit code, standard output and error (never a traceback)."""
+    from bt_manip.cli import main
+
+    code = main(["bim", *argv])
+    out, err = capsys.readouterr()
+    assert "Traceback" not in err
+    return code, out, err

@@ -1,6 +1,7 @@
-"""Files the way small exports and IFC4.3 sample models write them: no storey (elements in the
-building), columns placed on a design grid (IfcGridPlacement), no spaces and no slab,
-building services standing in a room."""
+"""Files the way small exports, surveyed models and IFC4.3 sample models write them: no
+storey (elements in the building), columns placed on a design grid (IfcGridPlacement), no
+spaces and no slab, building services standing in a room, a header naming the schema IFC4X3,
+a storey thousands of kilometres from the model's origin."""
 
 from __future__ import annotations
 
@@ -17,10 +18,9 @@ pytest.importorskip("ifcopenshell")
 
 import ifcopenshell
 import ifcopenshell.api
-from ifc_buildings import PANELS, _matrix, three_rooms
+from ifc_buildings import PANELS, _matrix, add_wall, bim_cli, empty_storey, three_rooms
 
 from bt_manip.bim.convert import BimOptions, convert
-from bt_manip.cli import main
 from bt_manip.sim.world_reader import parse_world
 
 api = ifcopenshell.api.run
@@ -31,17 +31,10 @@ def _world(path: Path) -> dict[str, Any]:
     return yaml.safe_load(path.read_text())
 
 
-def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = main(["bim", *argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return code, out, err
-
-
 def test_a_file_without_storeys_is_read_whole_as_one_level(tmp_path, capsys):
     flat = three_rooms(with_storey=False).write(tmp_path / "flat.ifc")
     storeyed = three_rooms().write(tmp_path / "storeyed.ifc")
-    code, out, err = _run(capsys, str(flat), "--out", str(tmp_path / "flat"))
+    code, out, err = bim_cli(capsys, str(flat), "--out", str(tmp_path / "flat"))
     assert code == 0, err
     assert ("level 'Building' (IfcBuilding, elevation 0.00 m: no IfcBuildingStorey in the "
             "file: every element read, as one level)") in out
@@ -56,30 +49,12 @@ def test_a_file_without_storeys_is_read_whole_as_one_level(tmp_path, capsys):
 
 def test_storey_given_for_a_file_without_storeys(tmp_path, capsys):
     flat = three_rooms(with_storey=False).write(tmp_path / "flat.ifc")
-    code, _, err = _run(capsys, str(flat), "--out", str(tmp_path / "o"), "--storey", "0")
+    code, _, err = bim_cli(capsys, str(flat), "--out", str(tmp_path / "o"), "--storey", "0")
     assert code == 2
     assert err.strip() == (
         "--storey: the file has no IfcBuildingStorey: it is read whole, as one level "
         "(IfcBuilding 'Building'); leave --storey out")
     assert not (tmp_path / "o").exists()
-
-
-def _hall(schema: str = "IFC4") -> tuple[Any, Any, Any]:
-    """An empty storey in millimetres: the file, its Body context and the storey."""
-    f = ifcopenshell.file(schema=schema)
-    project = api("root.create_entity", f, ifc_class="IfcProject", name="Hall")
-    api("unit.assign_unit", f, units=[api("unit.add_si_unit", f, unit_type="LENGTHUNIT",
-                                          prefix="MILLI")])
-    model = api("context.add_context", f, context_type="Model")
-    body = api("context.add_context", f, context_type="Model", context_identifier="Body",
-               target_view="MODEL_VIEW", parent=model)
-    site = api("root.create_entity", f, ifc_class="IfcSite", name="Site")
-    building = api("root.create_entity", f, ifc_class="IfcBuilding", name="Hall")
-    storey = api("root.create_entity", f, ifc_class="IfcBuildingStorey", name="Ground")
-    api("aggregate.assign_object", f, products=[site], relating_object=project)
-    api("aggregate.assign_object", f, products=[building], relating_object=site)
-    api("aggregate.assign_object", f, products=[storey], relating_object=building)
-    return f, body, storey
 
 
 def _extruded_box(f: Any, body: Any, x: float, y: float, height: float) -> Any:
@@ -97,12 +72,12 @@ GRID_AT = (2.0, 1.0, math.radians(30))
 """The grid's placement in the storey: (x, y) in metres and its heading."""
 
 
-def _grid_hall() -> tuple[Any, dict[str, Any]]:
+def _gridempty_storey() -> tuple[Any, dict[str, Any]]:
     """A hall whose grid is turned 30 deg and moved to (2, 1) m: axes 1 (y = 0, drawn towards
     +x) and 2 (y = 4 m, drawn towards -x but SameSense false: it runs towards +x) across axes
     A (x = 0) and B (x = 6 m), both drawn towards +y, and an arc axis R; 30 x 20 cm columns
     2.5 m high on the crossings."""
-    f, body, storey = _hall()
+    f, body, storey = empty_storey()
     grid = api("root.create_entity", f, ifc_class="IfcGrid", name="Grid")
     api("geometry.edit_object_placement", f, product=grid, matrix=_matrix(*GRID_AT[:2], 0.0,
                                                                           GRID_AT[2]))
@@ -154,7 +129,7 @@ def _same_heading(a: float, b: float) -> bool:
 
 
 def test_columns_placed_on_a_design_grid_stand_where_its_axes_cross(tmp_path):
-    f, columns = _grid_hall()
+    f, columns = _gridempty_storey()
     path = tmp_path / "grid.ifc"
     f.write(str(path))
     c = convert(BimOptions(path, tmp_path / "out"))
@@ -182,13 +157,8 @@ def test_columns_placed_on_a_design_grid_stand_where_its_axes_cross(tmp_path):
 
 
 def test_a_lone_wall_without_spaces_or_slab_becomes_a_world(tmp_path):
-    f, body, storey = _hall()
-    wall = api("root.create_entity", f, ifc_class="IfcWall", name="Lone")
-    rep = api("geometry.add_wall_representation", f, context=body, length=3.0, height=2.5,
-              thickness=0.3)
-    api("geometry.assign_representation", f, product=wall, representation=rep)
-    api("geometry.edit_object_placement", f, product=wall, matrix=np.eye(4))
-    api("spatial.assign_container", f, products=[wall], relating_structure=storey)
+    f, body, storey = empty_storey()
+    add_wall(f, body, storey, "Lone", 3.0, 0.3, np.eye(4))
     path = tmp_path / "wall.ifc"
     f.write(str(path))
     c = convert(BimOptions(path, tmp_path / "out"))
@@ -204,19 +174,14 @@ def test_a_lone_wall_without_spaces_or_slab_becomes_a_world(tmp_path):
 def test_a_closed_cell_without_spaces_leaves_the_start_outside(tmp_path, capsys):
     # a closed 1 m square room (no spaces): the extent holds no spot for the robot, and the
     # floor around it is outside the walls, where it may start
-    f, body, storey = _hall()
+    f, body, storey = empty_storey()
     for name, m in (("S", _matrix(0.0, 0.0, 0.0, 0.0)), ("N", _matrix(0.0, 1.0, 0.0, 0.0)),
                     ("W", _matrix(0.0, 0.0, 0.0, math.pi / 2)),
                     ("E", _matrix(1.0, 0.0, 0.0, math.pi / 2))):
-        wall = api("root.create_entity", f, ifc_class="IfcWall", name=name)
-        rep = api("geometry.add_wall_representation", f, context=body, length=1.0, height=2.5,
-                  thickness=0.1)
-        api("geometry.assign_representation", f, product=wall, representation=rep)
-        api("geometry.edit_object_placement", f, product=wall, matrix=m)
-        api("spatial.assign_container", f, products=[wall], relating_structure=storey)
+        add_wall(f, body, storey, name, 1.0, 0.1, m)
     path = tmp_path / "cell.ifc"
     f.write(str(path))
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 0, err
     x, y = (float(v) for v in out.split("robot start at (")[1].split(")")[0].split(", "))
     assert not (-0.2 < x < 1.2 and -0.2 < y < 1.2)  # outside, clear of the walls
@@ -224,7 +189,7 @@ def test_a_closed_cell_without_spaces_leaves_the_start_outside(tmp_path, capsys)
 
 
 def test_building_services_standing_in_a_room_are_obstacles(tmp_path):
-    f, body, storey = _hall()
+    f, body, storey = empty_storey()
     bath = api("root.create_entity", f, ifc_class="IfcSanitaryTerminal", name="Bath")
     bath.Representation = _extruded_box(f, body, 1700.0, 700.0, 550.0)
     api("geometry.edit_object_placement", f, product=bath, matrix=_matrix(2.0, 3.0, 0.0, 0.0))
@@ -253,13 +218,8 @@ def test_building_services_standing_in_a_room_are_obstacles(tmp_path):
 @pytest.mark.parametrize("header", ["IFC4X3", "IFC4X3_ADD2"])
 def test_ifc4x3_files_named_by_any_release(tmp_path, header):
     # early IFC4.3 files name the schema IFC4X3, read as its final release IFC4X3_ADD2
-    f, body, storey = _hall(schema="IFC4X3_ADD2")
-    wall = api("root.create_entity", f, ifc_class="IfcWall", name="Lone")
-    rep = api("geometry.add_wall_representation", f, context=body, length=3.0, height=2.5,
-              thickness=0.3)
-    api("geometry.assign_representation", f, product=wall, representation=rep)
-    api("geometry.edit_object_placement", f, product=wall, matrix=np.eye(4))
-    api("spatial.assign_container", f, products=[wall], relating_structure=storey)
+    f, body, storey = empty_storey(schema="IFC4X3_ADD2")
+    add_wall(f, body, storey, "Lone", 3.0, 0.3, np.eye(4))
     written = tmp_path / "written.ifc"
     f.write(str(written))
     path = tmp_path / "hall.ifc"
@@ -270,14 +230,14 @@ def test_ifc4x3_files_named_by_any_release(tmp_path, header):
 
 
 def test_an_ifc4_release_the_parser_lacks_is_named_at_its_line(tmp_path, capsys):
-    f, _, _ = _hall(schema="IFC4X3_ADD2")
+    f, _, _ = empty_storey(schema="IFC4X3_ADD2")
     written = tmp_path / "written.ifc"
     f.write(str(written))
     path = tmp_path / "hall.ifc"
     data = written.read_bytes().replace(b"'IFC4X3_ADD2'", b"'IFC4X1'")
     path.write_bytes(data)
     line = data[:data.index(b"'IFC4X1'")].count(b"\n") + 1
-    code, _, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, _, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 2
     assert err.strip() == (f"{path}:{line}: schema IFC4X1 is not read; IFC2X3, IFC4 and IFC4X3 "
                            "files are")
@@ -301,7 +261,7 @@ def test_a_model_far_from_its_origin_is_moved_to_the_worlds(tmp_path, capsys):
     marker.Representation = _extruded_box(f, far.body, 50.0, 50.0, 10.0)
     api("geometry.edit_object_placement", f, product=marker, matrix=np.eye(4))
     api("spatial.assign_container", f, products=[marker], relating_structure=far.storey)
-    code, out, err = _run(capsys, str(far.write(tmp_path / "far.ifc")), "--out",
+    code, out, err = bim_cli(capsys, str(far.write(tmp_path / "far.ifc")), "--out",
                           str(tmp_path / "far"))
     assert code == 0, err
     assert ("note: the storey lies 4,031.1 km from the model's origin: the world is moved; "

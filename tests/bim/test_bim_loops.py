@@ -13,19 +13,11 @@ import pytest
 pytest.importorskip("ifcopenshell")
 
 import ifcopenshell.api
-from ifc_buildings import three_rooms
+from ifc_buildings import bim_cli, three_rooms
 
-from bt_manip.cli import main
 from bt_manip.sim.world_reader import parse_world
 
 api = ifcopenshell.api.run
-
-
-def _run(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
-    code = main(["bim", *argv])
-    out, err = capsys.readouterr()
-    assert "Traceback" not in err
-    return code, out, err
 
 
 def test_placements_that_loop_leave_their_elements_out(tmp_path, capsys):
@@ -33,7 +25,7 @@ def test_placements_that_loop_leave_their_elements_out(tmp_path, capsys):
     south, north = b.walls["South"].ObjectPlacement, b.walls["North"].ObjectPlacement
     south.PlacementRelTo, north.PlacementRelTo = north, south  # each relative to the other
     path = b.write(tmp_path / "loop.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 0, err
     assert (f"#{b.walls['South'].id()} IfcWall 'South' (its placements loop "
             f"(#{south.id()} -> #{north.id()} -> #{south.id()}))") in out
@@ -47,7 +39,7 @@ def test_placements_that_loop_leave_their_elements_out(tmp_path, capsys):
     at.PlacementRelTo = b.walls["West"].ObjectPlacement
     b.walls["West"].ObjectPlacement.PlacementRelTo = at
     path = b.write(tmp_path / "storey_loop.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o2"))
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o2"))
     assert code == 2
     assert f"#{b.storey.id()} IfcBuildingStorey 'Ground floor': its elevation cannot be read: " \
            "its placements loop" in err
@@ -74,7 +66,7 @@ def test_a_representation_that_maps_itself(tmp_path, capsys):
     api("spatial.assign_container", b.file, products=[proxy], relating_structure=b.storey)
     proxy.Representation, item = _self_mapping(b.file, b.body)
     path = b.write(tmp_path / "proxy.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 0, err
     assert (f"#{proxy.id()} IfcBuildingElementProxy 'Loop' (its mapped representations loop "
             f"(#{item.MappingSource.id()} -> #{item.MappingSource.id()}))") in out
@@ -84,11 +76,11 @@ def test_a_representation_that_maps_itself(tmp_path, capsys):
     panel = b.panels[0]
     panel.Representation, item = _self_mapping(b.file, b.body)
     path = b.write(tmp_path / "panel.ifc")
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o2"))
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o2"))
     assert code == 2
     assert (f"#{panel.id()} IfcPlate 'Panel W1': unsupported geometry: its geometry nests in "
             f"a loop (#{item.id()} -> #{item.id()})") in err
-    code, out, err = _run(capsys, str(path), "--out", str(tmp_path / "o3"),
+    code, out, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o3"),
                           "--skip-uninstallable")
     assert code == 0, err
     assert "5 elements to install" in out
@@ -114,7 +106,7 @@ def test_a_profile_curve_that_is_its_own_segment(tmp_path, capsys):
     panel = b.panels[0]
     panel.Representation = f.createIfcProductDefinitionShape(None, None, [rep])
     path = b.write(tmp_path / "curve.ifc")
-    code, _, err = _run(capsys, str(path), "--out", str(tmp_path / "o"))
+    code, _, err = bim_cli(capsys, str(path), "--out", str(tmp_path / "o"))
     assert code == 2
     assert (f"#{panel.id()} IfcPlate 'Panel W1': unsupported geometry: its geometry nests in "
             f"a loop (#{curve.id()} -> #{curve.id()})") in err
