@@ -43,7 +43,8 @@ def add_bim_arguments(bim: argparse.ArgumentParser) -> None:
     bim.add_argument(
         "--storey", metavar="NAME|INDEX",
         help="storey to build: its name, or its index (0-based, by ascending elevation); "
-        "default: the ground storey (elevation nearest 0, then the most walls)",
+        "default: the ground storey (elevation nearest 0, then the most walls); a file "
+        "without storeys is read whole",
     )
     bim.add_argument(
         "--skip-uninstallable", action="store_true",
