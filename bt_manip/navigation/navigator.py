@@ -70,7 +70,7 @@ from bt_manip.navigation.controller import (
 from bt_manip.navigation.costmap import CostMap, InflationOptions, clearance
 from bt_manip.navigation.distance import squared_distances
 from bt_manip.navigation.footprint import PlanarFootprint
-from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, rasterise
+from bt_manip.navigation.grid import DEFAULT_RESOLUTION, OccupancyGrid, bodies_extent, rasterise
 from bt_manip.navigation.holonomic import HolonomicFollower, base_limited, turning_footprint
 from bt_manip.navigation.lattice import LatticeOptions, PosePlan, plan_poses
 from bt_manip.navigation.layered import RobotCostmaps
@@ -133,6 +133,32 @@ def robot_top(robot: Any) -> float:
     return float(top)
 
 
+MAP_PAD = 0.5
+"""Free floor (m) the map keeps round the obstacles, before the room to drive round them."""
+MAP_ALIGN = 0.1
+"""The map's margin is a whole number of these (m): a multiple of the grid's cells and of the
+pose search's bins, so a wider margin leaves every cell and bin where it was."""
+
+
+def map_extent(client: int, obstacles: Sequence[int], robot_xy: Sequence[float],
+               footprint: PlanarFootprint) -> tuple[float, float, float, float] | None:
+    """The map's rectangle: the obstacles' extent with :data:`MAP_PAD` of free floor round it
+    (None: :func:`rasterise`'s default, the same), or, for a robot that stands outside the
+    obstacles' extent (a world open round a lone wall or a row of columns), a margin with
+    room to drive round the outermost obstacle too (the footprint's turning diameter and a
+    cell, in whole :data:`MAP_ALIGN` steps, so cells and pose bins stay where they were),
+    grown to hold the robot."""
+    if not obstacles:
+        return None
+    x0, y0, x1, y1 = bodies_extent(client, obstacles, 0.0)
+    x, y = float(robot_xy[0]), float(robot_xy[1])
+    if x0 <= x <= x1 and y0 <= y <= y1:
+        return None
+    room = 2.0 * footprint.circumradius + 0.05
+    pad = round(MAP_PAD + math.ceil(room / MAP_ALIGN - 1e-9) * MAP_ALIGN, 9)
+    return (min(x0, x) - pad, min(y0, y) - pad, max(x1, x) + pad, max(y1, y) + pad)
+
+
 class Navigator:
     """Map, footprint and path following for ``robot`` among ``obstacles`` and ``movable``.
 
@@ -170,11 +196,14 @@ class Navigator:
             else {b: f"body {b}" for b in movable}
         )
         self.band: ZBand = options.band or (0.02, robot_top(robot) + 0.05)
+        self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.static: OccupancyGrid = rasterise(
             self.client,
             list(obstacles),
             resolution=options.resolution,
             band=self.band,
+            extent=map_extent(self.client, list(obstacles), robot.base_pose2d()[:2],
+                              self.base_footprint),
             remember=False,
         )
         self.known: dict[int, np.ndarray] = {}
@@ -186,7 +215,6 @@ class Navigator:
                                                                         self.band)]
                 if parts:
                     self.known[body] = np.unique(np.concatenate(parts))
-        self.base_footprint = PlanarFootprint.of_robot(robot, band=self.band)
         self.footprint = self.base_footprint
         self.attached: dict[int, str] = {}
         self.costmap = CostMap(self._compose(), options.inflation)
