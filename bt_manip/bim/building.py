@@ -190,11 +190,14 @@ class Building:
     def read_text(self) -> str:
         """What was read, and what was left out, in one paragraph."""
         c = self.counts
+
+        def n(key: str) -> str:  # "2 walls", "1 wall"
+            count = c.get(key, 0)
+            return f"{count} {key if count != 1 else key[:-1]}"
+
         text = (
-            f"{c.get('walls', 0)} walls, {c.get('curtain walls', 0)} curtain walls "
-            f"({c.get('plates', 0)} plates, {c.get('members', 0)} members), "
-            f"{c.get('doors', 0)} doors, {c.get('windows', 0)} windows, "
-            f"{c.get('other obstacles', 0)} other obstacles of storey "
+            f"{n('walls')}, {n('curtain walls')} ({n('plates')}, {n('members')}), "
+            f"{n('doors')}, {n('windows')}, {n('other obstacles')} of storey "
             f"'{self.storey.Name or '#' + str(self.storey.id())}'"
         )
         if self.skipped:

@@ -74,9 +74,11 @@ def test_sample_buildings_become_worlds_with_ifcopenshells_counts(name, tmp_path
     assert counts["plates"] == sum(1 for p in parts if p.is_a("IfcPlate"))
     assert counts["members"] == sum(1 for p in parts if p.is_a("IfcMember"))
     text = c.summary()
-    assert (f"{counts['walls']} walls, {counts['curtain walls']} curtain walls "
-            f"({counts['plates']} plates, {counts['members']} members), {counts['doors']} doors, "
-            f"{counts['windows']} windows") in text
+    def n(key: str) -> str:  # the count and its noun, singular for one
+        return f"{counts[key]} {key[:-1] if counts[key] == 1 else key}"
+
+    assert (f"{n('walls')}, {n('curtain walls')} ({n('plates')}, {n('members')}), "
+            f"{n('doors')}, {n('windows')}") in text
     # the world alone: nothing is scheduled in these exports
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["world.yaml"]
     spec = parse_world(c.world_path)
