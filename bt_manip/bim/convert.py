@@ -64,6 +64,7 @@ from bt_manip.bim.storeys import (
     one_level,
     storey_elevation,
     storey_of,
+    storey_origin,
 )
 from bt_manip.bim.world_file import building_entries, r
 from bt_manip.bim.world_yaml import world_yaml
@@ -389,10 +390,10 @@ def model_shift(source: IfcSource, storey: Any) -> tuple[float, float]:
     position rounded to whole metres when it lies more than :data:`FAR_AWAY` from the
     model's origin (an export in surveyed coordinates, a kilometre or a thousand away: the
     simulation's single-precision physics would be centimetres coarse there), else nothing."""
-    at = getattr(storey, "ObjectPlacement", None)
-    if at is None or not at.is_a("IfcLocalPlacement"):
+    origin = storey_origin(source, storey)
+    if origin is None:
         return (0.0, 0.0)
-    x, y = (ShapeReader(source.scale).placement(at)[:2, 3] * source.scale).tolist()
+    x, y, _ = origin
     if math.hypot(x, y) <= FAR_AWAY:
         return (0.0, 0.0)
     return (float(round(x)), float(round(y)))

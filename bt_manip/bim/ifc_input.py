@@ -44,9 +44,9 @@ class IfcSource:
     _starts: Any = None
     _offsets: dict[int, int] | None = None
     _lookups: int = 0
-    elevations: dict[int, float] = field(default_factory=dict)
-    """Storeys' floor heights (m) by step id, each computed once
-    (:func:`~bt_manip.bim.storeys.storey_elevation`)."""
+    origins: dict[int, tuple[float, float, float] | None] = field(default_factory=dict)
+    """Storeys' placement origins (m) by step id, each computed once
+    (:func:`~bt_manip.bim.storeys.storey_origin`)."""
     shift: tuple[float, float] = (0.0, 0.0)
     """Subtracted (m) from the model's x and y to give the world's: nonzero for a model placed
     far from its origin (:func:`~bt_manip.bim.convert.model_shift`)."""
@@ -112,9 +112,12 @@ def parsed_release(schema: str) -> str | None:
     """The schema the parser reads a file of ``schema`` (its header's name) as: the release
     itself when the parser has it, else the final release of its line (IFC4X3 and its
     candidates and addenda as IFC4X3_ADD2, IFC2X3_TC1 as IFC2X3, IFC4's addenda as IFC4);
-    None for a schema none of these covers (IFC4X1, IFC4X2)."""
+    None for a schema none of these covers (IFC4X1, IFC4X2) or not of :data:`SCHEMAS`' lines
+    at all."""
     import ifcopenshell.ifcopenshell_wrapper as wrapper
 
+    if not schema.startswith(SCHEMAS):
+        return None
     known = set(wrapper.schema_names())
     if schema in known:
         return schema
@@ -148,7 +151,8 @@ def open_ifc(path: str | Path) -> IfcSource:
     if schema_match is None:
         raise InputError.single(str(path), 1, "not an IFC file: no FILE_SCHEMA in its header")
     schema = schema_match.group(1).decode().upper()
-    if not any(schema.startswith(s) for s in SCHEMAS):
+    release = parsed_release(schema)
+    if release is None:
         line = data.count(b"\n", 0, schema_match.start()) + 1
         raise InputError.single(
             str(path), line, f"schema {schema} is not read; IFC2X3, IFC4 and IFC4X3 files are"
@@ -157,12 +161,6 @@ def open_ifc(path: str | Path) -> IfcSource:
         text, exact = data.decode("utf-8"), True
     except UnicodeDecodeError:
         text, exact = data.decode("utf-8", errors="replace"), False
-    release = parsed_release(schema)
-    if release is None:
-        line = data.count(b"\n", 0, schema_match.start()) + 1
-        raise InputError.single(
-            str(path), line, f"schema {schema} is not read; IFC2X3, IFC4 and IFC4X3 files are"
-        )
     if release != schema:  # the name in the header, as the parser knows it
         start, end = schema_match.span(1)
         at = len(data[:start].decode("utf-8", errors="replace"))

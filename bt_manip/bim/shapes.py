@@ -26,6 +26,8 @@ ifcopenshell's own walk. Attributes are read by position
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
@@ -51,6 +53,22 @@ MAX_PLACEMENT_CHAIN = 64
 
 class UnsupportedGeometry(Exception):
     """The element's geometry cannot be read or is not what bt-manip models."""
+
+
+@contextmanager
+def _following(pending: dict[int, None], key: int, what: str) -> Iterator[None]:
+    """Mark entity ``key`` as being read for the block, ``pending`` holding those of the chain
+    being followed in order; UnsupportedGeometry naming the chain when ``key`` is already in
+    it (a loop) or the chain is :data:`MAX_PLACEMENT_CHAIN` long."""
+    if key in pending or len(pending) >= MAX_PLACEMENT_CHAIN:
+        chain = " -> ".join(f"#{k}" for k in [*pending, key])
+        why = "loop" if key in pending else f"go more than {MAX_PLACEMENT_CHAIN} deep"
+        raise UnsupportedGeometry(f"its {what} {why} ({chain})")
+    pending[key] = None
+    try:
+        yield
+    finally:
+        del pending[key]
 
 
 @dataclass(frozen=True)
@@ -117,13 +135,7 @@ class ShapeReader:
         found = self._placements.get(key)
         if found is not None:
             return found
-        if key in self._pending or len(self._pending) >= MAX_PLACEMENT_CHAIN:
-            chain = " -> ".join(f"#{k}" for k in [*self._pending, key])
-            why = ("loop" if key in self._pending else
-                   f"go more than {MAX_PLACEMENT_CHAIN} deep")
-            raise UnsupportedGeometry(f"its placements {why} ({chain})")
-        self._pending[key] = None
-        try:
+        with _following(self._pending, key, "placements"):
             local = placement.is_a("IfcLocalPlacement")
             parent = placement.get_argument(at.PLACEMENT_REL_TO) if local else None
             if parent is not None:
@@ -138,8 +150,6 @@ class ShapeReader:
                     raise UnsupportedGeometry(f"its grid placement: {exc}") from None
             else:
                 raise UnsupportedGeometry(f"its placement ({placement.is_a()}) is not read")
-        finally:
-            del self._pending[key]
         self._placements[key] = found
         return found
 
@@ -345,15 +355,9 @@ class ShapeReader:
             source = item.get_argument(at.MAPPING_SOURCE)
             key = int(source.id())
             if key not in self._mapped:
-                if key in self._pending_maps or len(self._pending_maps) >= MAX_PLACEMENT_CHAIN:
-                    chain = " -> ".join(f"#{k}" for k in [*self._pending_maps, key])
-                    raise UnsupportedGeometry(f"its mapped representations loop ({chain})")
-                self._pending_maps[key] = None
-                try:
+                with _following(self._pending_maps, key, "mapped representations"):
                     self._mapped[key] = self._source_points(
                         source.get_argument(at.MAPPED_REPRESENTATION))
-                finally:
-                    del self._pending_maps[key]
             mapped = self._mapped[key]
             if mapped is None:
                 return None

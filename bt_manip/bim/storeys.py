@@ -141,24 +141,34 @@ def one_level(model: Any) -> bool:
     return len(model.by_type("IfcBuildingStorey")) <= 1
 
 
-def storey_elevation(source: IfcSource, storey: Any) -> float:
-    """Height (m) of the storey's floor: its placement, else its Elevation attribute (each
-    storey's once per source); for the building, site or project standing for the level of a
-    file without storeys, its placement's height, else 0."""
-    found = source.elevations.get(storey.id())
-    if found is None:
+def storey_origin(source: IfcSource, storey: Any) -> tuple[float, float, float] | None:
+    """Where (m) the storey's local placement puts its origin (each storey's once per
+    source); None without one. A placement that cannot be read (a loop) is the storey's
+    problem, raised."""
+    key = int(storey.id())
+    if key not in source.origins:
         at = getattr(storey, "ObjectPlacement", None)
+        found = None
         if at is not None and at.is_a("IfcLocalPlacement"):
             try:
-                found = float(ShapeReader(source.scale).placement(at)[2][3]) * source.scale
+                matrix = ShapeReader(source.scale).placement(at)
             except UnsupportedGeometry as exc:
-                source.fail(storey, f"its elevation cannot be read: {exc}")
-                source.raise_problems()
-                raise  # raise_problems has raised; this line is never reached
-        else:
-            found = float(getattr(storey, "Elevation", None) or 0.0) * source.scale
-        source.elevations[storey.id()] = found
-    return found
+                raise InputError([source.problem(
+                    storey, f"its elevation cannot be read: {exc}")]) from None
+            x, y, z = (float(v) * source.scale for v in matrix[:3, 3])
+            found = (x, y, z)
+        source.origins[key] = found
+    return source.origins[key]
+
+
+def storey_elevation(source: IfcSource, storey: Any) -> float:
+    """Height (m) of the storey's floor: its placement (:func:`storey_origin`), else its
+    Elevation attribute; for the building, site or project standing for the level of a file
+    without storeys, its placement's height, else 0."""
+    origin = storey_origin(source, storey)
+    if origin is not None:
+        return origin[2]
+    return float(getattr(storey, "Elevation", None) or 0.0) * source.scale
 
 
 def choose_storey(source: IfcSource, wanted: str | None = None) -> StoreyChoice:

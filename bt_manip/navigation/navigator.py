@@ -143,7 +143,7 @@ pose search's bins, so a wider margin leaves every cell and bin where it was."""
 def map_extent(client: int, obstacles: Sequence[int], robot_xy: Sequence[float],
                footprint: PlanarFootprint) -> tuple[float, float, float, float] | None:
     """The map's rectangle: the obstacles' extent with :data:`MAP_PAD` of free floor round it
-    (None: :func:`rasterise`'s default, the same), or, for a robot that stands outside the
+    (None without obstacles: :func:`rasterise` says so), or, for a robot that stands outside the
     obstacles' extent (a world open round a lone wall or a row of columns), a margin with
     room to drive round the outermost obstacle too (the footprint's turning diameter and a
     cell, in whole :data:`MAP_ALIGN` steps, so cells and pose bins stay where they were),
@@ -153,7 +153,7 @@ def map_extent(client: int, obstacles: Sequence[int], robot_xy: Sequence[float],
     x0, y0, x1, y1 = bodies_extent(client, obstacles, 0.0)
     x, y = float(robot_xy[0]), float(robot_xy[1])
     if x0 <= x <= x1 and y0 <= y <= y1:
-        return None
+        return x0 - MAP_PAD, y0 - MAP_PAD, x1 + MAP_PAD, y1 + MAP_PAD
     room = 2.0 * footprint.circumradius + 0.05
     pad = round(MAP_PAD + math.ceil(room / MAP_ALIGN - 1e-9) * MAP_ALIGN, 9)
     return (min(x0, x) - pad, min(y0, y) - pad, max(x1, x) + pad, max(y1, y) + pad)
