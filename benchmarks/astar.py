@@ -45,6 +45,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from bt_manip.cli.args import positive
 from bt_manip.navigation import astar
 
 Cell = tuple[int, int]
@@ -253,9 +254,9 @@ def corner_to_corner(
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--repeat", type=int, default=3, help="runs per query (best is kept)")
-    ap.add_argument("--queries", type=int, default=10, help="start/goal pairs per grid")
-    ap.add_argument("--calls", type=int, default=3, help="timed corner-to-corner calls")
+    ap.add_argument("--repeat", type=positive(int), default=3, help="runs per query (best is kept)")
+    ap.add_argument("--queries", type=positive(int), default=10, help="start/goal pairs per grid")
+    ap.add_argument("--calls", type=positive(int), default=3, help="timed corner-to-corner calls")
     ap.add_argument("--no-house", action="store_true")
     ap.add_argument("--corners-only", action="store_true", help="skip the random queries")
     args = ap.parse_args(argv)

@@ -41,6 +41,8 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.cli.args import positive
+
 WALL_T = 0.2
 WALL_H = 2.5
 ROOM = 6.0
@@ -205,11 +207,11 @@ def time_samples(folder: Path, out: Path, repeat: int) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rooms", type=int, default=7, help="rooms per side (default 7)")
+    parser.add_argument("--rooms", type=positive(int), default=7, help="rooms per side (default 7)")
     parser.add_argument("--keep", type=Path, help="folder to keep the IFC file and outputs in")
     parser.add_argument("--samples", type=Path, default=Path("../shared/samples/ifc"),
                         help="folder of real IFC exports (default ../shared/samples/ifc)")
-    parser.add_argument("--repeat", type=int, default=3, help="runs per figure (median)")
+    parser.add_argument("--repeat", type=positive(int), default=3, help="runs per figure (median)")
     args = parser.parse_args()
     from bt_manip.bim.convert import BimOptions, convert
 

@@ -21,6 +21,7 @@ from bt_manip.bt import Tree, TreeContext
 from bt_manip.bt.controls import Fallback, Sequence
 from bt_manip.bt.decorators import Inverter
 from bt_manip.bt.leaves import AlwaysFailure, AlwaysSuccess
+from bt_manip.cli.args import positive
 from bt_manip.clock import ManualClock
 
 FANOUT = (9, 10, 10)
@@ -105,7 +106,7 @@ def tick_py_trees(root: py_trees.behaviour.Behaviour) -> Callable[[], object]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--ticks", type=int, default=200)
+    parser.add_argument("--ticks", type=positive(int), default=200)
     args = parser.parse_args()
     for shape, ours, theirs in (("all_success_sequences", ours_all_success, theirs_all_success),
                                 ("mixed_fallback_inverter", ours_mixed, theirs_mixed)):

@@ -21,10 +21,13 @@ sys.path.insert(0, str(ROOT))
 
 from differential.campaign import run_campaign, write_mismatch_files  # noqa: E402
 
+from bt_manip.cli.args import positive  # noqa: E402
+
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--trees", type=int, default=1000, help="number of trees (default 1000)")
+    parser.add_argument("--trees", type=positive(int), default=1000,
+                        help="number of trees (default 1000)")
     parser.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     parser.add_argument("--shrink", type=int, default=200,
                         help="shrink at most this many mismatches (default 200)")

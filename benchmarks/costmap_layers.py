@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+from bt_manip.cli.args import positive
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.run.faults import parse_fault
 
@@ -57,7 +58,7 @@ def run_one(spec: EpisodeSpec, layers: bool) -> dict[str, Any]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seeds", type=int, default=6)
+    parser.add_argument("--seeds", type=positive(int), default=6)
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--tree", default=str(ROOT / "trees" / "husky_carry_wall.xml"))
     parser.add_argument("--world", default=str(ROOT / "worlds" / "tb3_house.yaml"))

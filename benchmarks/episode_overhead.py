@@ -32,6 +32,7 @@ from typing import Any
 import pybullet
 
 import bt_manip.bench.episodes as bench
+from bt_manip.cli.args import positive
 from bt_manip.episode import EpisodeSpec
 
 SCENARIOS = {
@@ -83,7 +84,7 @@ def instrument(clocks: Clocks) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--scenario", choices=sorted(SCENARIOS), default="A")
-    ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument("--seeds", type=positive(int), default=5)
     ap.add_argument("--first-seed", type=int, default=0)
     args = ap.parse_args()
     tree, world = SCENARIOS[args.scenario]

@@ -27,6 +27,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from bt_manip.cli.args import positive
 from bt_manip.navigation.grid import MAX_CELLS, save_cost_png
 from bt_manip.navigation.navigator import Navigator
 from bt_manip.sim.world import World
@@ -77,7 +78,7 @@ def world_text(cells: int) -> tuple[str, float]:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--cells", type=int, default=MAX_CELLS)
+    ap.add_argument("--cells", type=positive(int), default=MAX_CELLS)
     ap.add_argument("--png", type=Path, default=None, help="write the grid images here")
     ap.add_argument(
         "--carry",

@@ -20,6 +20,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from bt_manip.bt import TreeContext, load_tree_string
+from bt_manip.cli.args import positive
 from bt_manip.clock import ManualClock
 from bt_manip.groot import BtlogWriter, GrootPublisher, TreeMonitor
 
@@ -82,7 +83,7 @@ def theirs(case: str, ticks: int, folder: Path) -> float | None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--ticks", type=int, default=300)
+    parser.add_argument("--ticks", type=positive(int), default=300)
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)

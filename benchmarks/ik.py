@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bt_manip.cli.args import positive
 from bt_manip.kinematics import ArmModel, IKOptions, IKSolver
 from bt_manip.sim.assets import REPO_ROOT, ur3_urdf
 
@@ -146,7 +147,8 @@ def run_arm(case: ArmCase, n: int, seed: int) -> list[dict]:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--n", type=int, default=10_000, help="poses per arm (default 10000)")
+    parser.add_argument("--n", type=positive(int), default=10_000,
+                        help="poses per arm (default 10000)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random poses")
     parser.add_argument("--arms", nargs="+", default=["ur3", "sawyer"], choices=["ur3", "sawyer"])
     args = parser.parse_args(argv)

@@ -24,6 +24,7 @@ import time
 import numpy as np
 import pybullet as pb
 
+from bt_manip.cli.args import positive
 from bt_manip.sensing.lidar import Lidar
 from bt_manip.sim import pybullet_queries as pbq
 from bt_manip.sim.world import World
@@ -46,9 +47,9 @@ def free_poses(world: World, n: int, seed: int) -> list[tuple[float, float, floa
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--poses", type=int, default=50)
-    parser.add_argument("--repeat", type=int, default=5)
-    parser.add_argument("--threads", type=int, default=1)
+    parser.add_argument("--poses", type=positive(int), default=50)
+    parser.add_argument("--repeat", type=positive(int), default=5)
+    parser.add_argument("--threads", type=positive(int), default=1)
     parser.add_argument("--seed", type=int, default=1)
     args = parser.parse_args()
     world = World("worlds/tb3_house.yaml")

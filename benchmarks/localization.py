@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.cli.args import positive
 from bt_manip.localization import (
     LikelihoodField,
     LocalizationOptions,
@@ -271,8 +272,10 @@ def run(filters: list[Any], truth: np.ndarray, odom: np.ndarray,
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=5, help="runs (odometry, scan, filter seeds)")
-    ap.add_argument("--particles", type=int, default=500, help="most particles per filter")
+    ap.add_argument("--seeds", type=positive(int), default=5,
+                    help="runs (odometry, scan, filter seeds)")
+    ap.add_argument("--particles", type=positive(int), default=500,
+                    help="most particles per filter")
     ap.add_argument("--no-peer", action="store_true", help="bt-manip only")
     args = ap.parse_args(argv)
     if not 1 <= args.seeds <= 100 or not 1 <= args.particles <= 100_000:

@@ -44,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from bt_manip.cli.args import positive
 from bt_manip.manipulation.mbm import family_problems, read_problem
 from bt_manip.manipulation.mbm_data import fetch_mbm
 from bt_manip.manipulation.motion_bench import (
@@ -232,10 +233,12 @@ def plot(rows: list[dict], families: list[str], planners: list[str], png: Path) 
 # -- the run -----------------------------------------------------------------------------------
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--per-family", type=int, default=None, help="first N problems of each")
+    parser.add_argument("--per-family", type=positive(int), default=None,
+                        help="first N problems of each")
     parser.add_argument("--families", default="", help="comma-separated family folder names")
-    parser.add_argument("--time-limit", type=float, default=1.0, help="seconds per problem")
-    parser.add_argument("--step", type=float, default=0.05, help="collision step (rad)")
+    parser.add_argument("--time-limit", type=positive(float), default=1.0,
+                        help="seconds per problem")
+    parser.add_argument("--step", type=positive(float), default=0.05, help="collision step (rad)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--planners", default=",".join(PLANNERS))
     parser.add_argument("--data", default=None, help="an unpacked resources/panda folder with "

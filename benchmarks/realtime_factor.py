@@ -102,16 +102,28 @@ def uptime() -> str:
         return "load: " + " ".join(f"{x:.2f}" for x in os.getloadavg())
 
 
+def _count(text: str) -> int:
+    """An argparse type: a whole number of at least 1 (this script imports no bt-manip: it
+    measures other checkouts)."""
+    try:
+        n = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a whole number, got '{text}'") from None
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return n
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--checkout", action="append", required=True, metavar="NAME=FOLDER",
                     help="a bt-manip checkout to measure (give two or more)")
     ap.add_argument("--scenario", action="append", choices=sorted(SCENARIOS))
-    ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--seeds", type=_count, default=10)
     ap.add_argument("--first-seed", type=int, default=0)
-    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--rounds", type=_count, default=3)
     ap.add_argument("--python", default=sys.executable)
-    ap.add_argument("--blas-threads", type=int, default=None,
+    ap.add_argument("--blas-threads", type=_count, default=None,
                     help="pin OpenBLAS/OpenMP threads in both checkouts (default: as set)")
     args = ap.parse_args()
     checkouts = []

@@ -34,6 +34,7 @@ from py_trees.common import Status
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
+from bt_manip.cli.args import positive  # noqa: E402
 from bt_manip.run.runner import Runner, RunOptions  # noqa: E402
 from bt_manip.sim.world import World  # noqa: E402
 
@@ -144,9 +145,10 @@ def _record(sim: float) -> dict[str, Any]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sim", type=float, default=30.0, help="sim seconds per paced run")
+    parser.add_argument("--sim", type=positive(float), default=30.0,
+                        help="sim seconds per paced run")
     parser.add_argument("--no-browser", action="store_true")
-    parser.add_argument("--record-sim", type=float, default=240.0)
+    parser.add_argument("--record-sim", type=positive(float), default=240.0)
     args = parser.parse_args()
     browser = not args.no_browser and shutil.which("chromium") is not None
 

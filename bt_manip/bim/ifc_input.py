@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from bisect import bisect_right
 from dataclasses import dataclass, field
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -114,11 +115,9 @@ def parsed_release(schema: str) -> str | None:
     candidates and addenda as IFC4X3_ADD2, IFC2X3_TC1 as IFC2X3, IFC4's addenda as IFC4);
     None for a schema none of these covers (IFC4X1, IFC4X2) or not of :data:`SCHEMAS`' lines
     at all."""
-    import ifcopenshell.ifcopenshell_wrapper as wrapper
-
     if not schema.startswith(SCHEMAS):
         return None
-    known = set(wrapper.schema_names())
+    known = _parser_schemas()
     if schema in known:
         return schema
     for line in ("IFC4X3", "IFC2X3"):
@@ -127,6 +126,15 @@ def parsed_release(schema: str) -> str | None:
     if schema == "IFC4" or schema.startswith("IFC4_"):
         return "IFC4" if "IFC4" in known else None
     return None
+
+
+@cache
+def _parser_schemas() -> frozenset[str]:
+    """The schemas ifcopenshell's parser reads (asked once: the call takes about a
+    millisecond, as long as parsing a small file)."""
+    import ifcopenshell.ifcopenshell_wrapper as wrapper
+
+    return frozenset(wrapper.schema_names())
 
 
 def open_ifc(path: str | Path) -> IfcSource:
