@@ -37,6 +37,11 @@ array reads and writes skip numba's wrap of negative indices (every index is ins
 a move that would leave the grid is offered to the expanded cell itself), a pool entry is one
 int64 (the cell and the next slot of its bucket), and the cell pushed last onto the current
 bucket, the next to be expanded, waits outside the pool.
+
+Arrays are copied by loops, never by assigning one array to a slice of another: numba checks
+such an assignment's shapes and compiles, for its error message, its string formatting (join,
+str of integers), seconds on the first run after an install, for a copy LLVM emits the same
+either way.
 """
 
 from __future__ import annotations
@@ -290,7 +295,8 @@ def trace(parent: np.ndarray, start: int, goal: int, cols: int) -> np.ndarray:
 def _doubled(a: np.ndarray) -> np.ndarray:
     """A copy of ``a`` with twice the room (the new half is left uninitialised)."""
     out = np.empty(a.shape[0] * 2, a.dtype)
-    out[: a.shape[0]] = a
+    for i in range(a.shape[0]):  # a loop, not a slice copy: see the module's docstring
+        out[i] = a[i]
     return out
 
 
@@ -609,7 +615,8 @@ def _bucket_rounds(
 def _grown(a: np.ndarray, used: int) -> np.ndarray:
     """A copy of ``a`` with twice the room, its first ``used`` entries kept."""
     out = np.empty(a.shape[0] * 2, a.dtype)
-    out[:used] = a[:used]
+    for i in range(used):
+        out[i] = a[i]
     return out
 
 

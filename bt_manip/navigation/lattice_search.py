@@ -6,6 +6,11 @@ checks (:func:`pose_fits`), its binary heap, and the goal's obstacle-aware dista
 the heuristic reads (:class:`GoalField`, computed only as far as the search asks). The options,
 the checks of start and goal and the result (:class:`~bt_manip.navigation.lattice.PosePlan`)
 are the API's, in :mod:`bt_manip.navigation.lattice`.
+
+Arrays are copied by loops, never by assigning one array to a slice of another: numba checks
+such an assignment's shapes and compiles, for its error message, its string formatting (join,
+str of integers), seconds on the first run after an install, for a copy LLVM emits the same
+either way.
 """
 
 from __future__ import annotations
@@ -64,7 +69,8 @@ def _heap_pop(keys: np.ndarray, vals: np.ndarray, size: int) -> tuple[float, int
 def _grown(a: np.ndarray, n: int) -> np.ndarray:
     """A copy of the 1-D array ``a`` with room for ``n`` entries (the new ones uninitialised)."""
     out = np.empty(n, a.dtype)
-    out[: a.shape[0]] = a
+    for i in range(a.shape[0]):  # a loop: see the module's docstring
+        out[i] = a[i]
     return out
 
 
@@ -72,7 +78,9 @@ def _grown(a: np.ndarray, n: int) -> np.ndarray:
 def _grown_rows(a: np.ndarray, n: int) -> np.ndarray:
     """A copy of the 2-D array ``a`` with room for ``n`` rows (the new ones uninitialised)."""
     out = np.empty((n, a.shape[1]), a.dtype)
-    out[: a.shape[0]] = a
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            out[i, j] = a[i, j]
     return out
 
 
@@ -484,8 +492,9 @@ def search_poses(
             if size == hf.shape[0]:
                 nhf = np.empty(size * 2)
                 nhi = np.empty(size * 2, np.int64)
-                nhf[:size] = hf
-                nhi[:size] = hi
+                for i in range(size):
+                    nhf[i] = hf[i]
+                    nhi[i] = hi[i]
                 hf = nhf
                 hi = nhi
             h, heap_d, heap_i = _heuristic(

@@ -18,6 +18,7 @@ from bt_manip.bt.status import as_status
 from bt_manip.bt.walk import walk_nodes
 from bt_manip.outputs import write_text
 from bt_manip.run.failure_cause import FailureCause
+from bt_manip.run.jit_clock import JIT_NOTE_S
 from bt_manip.run.node_counts import NodeCounter
 from bt_manip.run.status import RunStatus
 
@@ -53,6 +54,9 @@ class RunReport:
     sim_time: float
     wall_time: float
     ticks: int
+    jit_time: float = 0.0
+    """Seconds of ``wall_time`` numba spent compiling kernels (the first run after an install)
+    or loading them from its cache (milliseconds): :mod:`bt_manip.run.jit_clock`."""
     tree: str = ""
     world: str = ""
     seed: int | None = None
@@ -118,6 +122,10 @@ class RunReport:
             f"  sim time {self.sim_time:.2f} s, wall time {self.wall_time:.2f} s "
             f"({rtf_text}), {self.ticks} ticks",
         ]
+        if self.jit_time >= JIT_NOTE_S:
+            lines.append(
+                f"  of which {self.jit_time:.1f} s compiling bt-manip's kernels, once after an "
+                "install (later runs load them from numba's cache)")
         if self.localization is not None:
             loc = self.localization
             lines.append(

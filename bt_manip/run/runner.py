@@ -30,6 +30,7 @@ import py_trees
 from bt_manip.bt.node import BtNode, TreeRuntimeError
 from bt_manip.run.failure_cause import FailureCause, failure_cause
 from bt_manip.run.hooks import RunHook, TickCallback, close_hooks
+from bt_manip.run.jit_clock import JitClock
 from bt_manip.run.node_counts import NodeCounter
 from bt_manip.run.report import NodeReport, RunReport, cause_json, node_reports
 from bt_manip.run.status import RunStatus
@@ -139,32 +140,34 @@ class Runner:
         status, reason = RunStatus.BUDGET, ""
         counter = NodeCounter(self.tree).attach() if NodeCounter.can_watch(self.tree) else None
         self.counter = counter
+        jit = JitClock()
         try:
-            while True:
-                for sense in self.before_tick:
-                    sense(self)
-                result = self.tree.tick().name
-                self.ticks += 1
-                for hook in self.on_tick:
-                    hook(self)
-                if result == "SUCCESS":
-                    status = RunStatus.SUCCESS
-                    break
-                if result == "FAILURE":
-                    status = RunStatus.FAILURE
-                    reason = self._failure_reason()
-                    break
-                if result == "SKIPPED":
-                    status = RunStatus.SKIPPED
-                    reason = "every node the root would run was skipped by a pre-condition"
-                    break
-                if opts.max_ticks is not None and self.ticks >= opts.max_ticks:
-                    reason = f"tick budget of {opts.max_ticks} spent"
-                    break
-                if opts.max_sim_time is not None and self.sim_time >= opts.max_sim_time:
-                    reason = f"time budget of {opts.max_sim_time:g} s spent"
-                    break
-                self._advance()
+            with jit:
+                while True:
+                    for sense in self.before_tick:
+                        sense(self)
+                    result = self.tree.tick().name
+                    self.ticks += 1
+                    for hook in self.on_tick:
+                        hook(self)
+                    if result == "SUCCESS":
+                        status = RunStatus.SUCCESS
+                        break
+                    if result == "FAILURE":
+                        status = RunStatus.FAILURE
+                        reason = self._failure_reason()
+                        break
+                    if result == "SKIPPED":
+                        status = RunStatus.SKIPPED
+                        reason = "every node the root would run was skipped by a pre-condition"
+                        break
+                    if opts.max_ticks is not None and self.ticks >= opts.max_ticks:
+                        reason = f"tick budget of {opts.max_ticks} spent"
+                        break
+                    if opts.max_sim_time is not None and self.sim_time >= opts.max_sim_time:
+                        reason = f"time budget of {opts.max_sim_time:g} s spent"
+                        break
+                    self._advance()
         except KeyboardInterrupt:
             status, reason = RunStatus.INTERRUPTED, INTERRUPTED_REASON
         except SystemError as exc:
@@ -188,6 +191,7 @@ class Runner:
             reason=reason,
             sim_time=self.sim_time,
             wall_time=wall,
+            jit_time=jit.seconds,
             ticks=self.ticks,
             nodes=self._records(),
             cause=cause_json(self.cause),

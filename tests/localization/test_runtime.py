@@ -41,6 +41,7 @@ def _spec(**kw: Any) -> EpisodeSpec:
 def _comparable(report: Any) -> dict[str, Any]:
     data = report.to_json()
     data.pop("wall_time")
+    data.pop("jit_time")
     data.pop("real_time_factor")
     return dict(data)
 
