@@ -197,7 +197,7 @@ def test_trees_deep_chains_bad_literals_and_flags(tmp_path: Path) -> None:
         "    <Sequence>",
         '      <Script code="x := ' + "(" * 5000 + "1" + ")" * 5000 + '"/>',  # line 4
         '      <Script code="x := ' + "-" * 5000 + '1"/>',
-        '      <Script code="x := 1' + " + 1" * 20000 + '"/>',
+        '      <Script code="x := 1' + " + 1" * 4000 + '"/>',  # under the length limit
         '      <AlwaysSuccess _skipIf="' + "!" * 200 + 'true"/>',
         '      <Script code="x := ' + "(" * 20 + "1" + " + 1" * 90 + ")" * 20 + '"/>',  # fine
         "    </Sequence>",
@@ -373,6 +373,57 @@ def _furniture_world(folder: Path, name: str, mesh: str) -> Path:
     world.write_text(f"name: {name}\nfurniture:\n  - name: statue\n    urdf: {name}.urdf\n"
                      "    pose: [1, 0, 0]\n")
     return world
+
+
+def _doubling(path: Path, levels: int) -> Path:
+    """T0 -> T1 -> ... -> T<levels>: each tree a Sequence of two SubTrees of the next, so T0
+    holds 2 ** (levels + 2) - 3 nodes once expanded."""
+    trees = [f'<BehaviorTree ID="T{i}"><Sequence><SubTree ID="T{i + 1}"/>'
+             f'<SubTree ID="T{i + 1}"/></Sequence></BehaviorTree>' for i in range(levels)]
+    path.write_text('<root BTCPP_format="4" main_tree_to_execute="T0">\n' + "\n".join(trees)
+                    + f'\n<BehaviorTree ID="T{levels}"><AlwaysSuccess/></BehaviorTree>\n</root>\n')
+    return path
+
+
+def _scripts(path: Path, codes: list[str]) -> Path:
+    """Main: a Sequence of one Script per code, each on its own line (the first on line 4)."""
+    return _tree(path, "    <Sequence>\n" + "\n".join(
+        f'      <Script code="{code}"/>' for code in codes) + "\n    </Sequence>")
+
+
+def test_subtrees_that_multiply_and_scripts_that_add_up_are_refused_before_building(
+        tmp_path: Path) -> None:
+    big = "x:=x+1;" * 2800  # 19,600 characters, under the limit of one script
+    results = run_cli(
+        tmp_path,
+        ["validate", _doubling(tmp_path / "d60.xml", 60)],
+        ["run", _doubling(tmp_path / "d14.xml", 14), "--quiet"],
+        ["run", _doubling(tmp_path / "d3.xml", 3), "--quiet"],
+        ["validate", _scripts(tmp_path / "long.xml", ["x:=1;" * 1_000_000])],
+        ["validate", _scripts(tmp_path / "many.xml", [f"y{i}:=0;{big}" for i in range(30)])],
+        ["run", _scripts(tmp_path / "same.xml", ["x:=0;"] + [big] * 100), "--quiet",
+         "--bb-out", tmp_path / "bb.json"],
+    )
+    d60, d14, d3, long, many, same = results
+    assert d60["code"] == 2
+    assert d60["err"] == (f"{tmp_path / 'd60.xml'}:2: tree 'T0' holds about 4.6e+18 nodes once "
+                          "its SubTrees are expanded; bt-manip builds at most 50,000\n")
+    assert d14["code"] == 2
+    assert d14["err"] == (f"{tmp_path / 'd14.xml'}:2: tree 'T0' holds 65,533 nodes once its "
+                          "SubTrees are expanded; bt-manip builds at most 50,000\n")
+    assert d3["code"] == 0 and "result: SUCCESS" in d3["out"]
+    assert long["code"] == 2
+    assert long["err"] == (
+        f"{tmp_path / 'long.xml'}:4: script syntax error in code of Script: script of "
+        "5,000,000 characters, more than the limit of 20,000; split it into several scripts "
+        "(column 1 of the script)\n")
+    # 12 scripts of 19,6xx characters fit in 250,000, the 13th (line 4 + 12) does not
+    assert many["code"] == 2
+    assert many["err"] == (f"{tmp_path / 'many.xml'}:16: the scripts of this file pass 250,000 "
+                           "characters at code of Script; bt-manip reads at most that many\n")
+    # the same text a hundred times counts once, and is parsed once
+    assert same["code"] == 0 and "result: SUCCESS" in same["out"]
+    assert json.loads((tmp_path / "bb.json").read_text())["x"] == 280_000
 
 
 def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:

@@ -20,8 +20,10 @@ variable, bad operand types) are :class:`ScriptRuntimeError`.
 from __future__ import annotations
 
 import math
+import re
 import sys
 from dataclasses import dataclass
+from functools import lru_cache
 from types import FrameType
 from typing import Any, Protocol, TypeGuard, cast
 
@@ -56,6 +58,8 @@ _OPERATORS = sorted(
     key=len,
     reverse=True,
 )
+_OPERATOR = re.compile("|".join(re.escape(op) for op in _OPERATORS))
+"""The longest operator at a position (the alternatives are tried longest first)."""
 
 
 @dataclass(frozen=True)
@@ -98,13 +102,12 @@ def tokenize(code: str) -> list[Token]:
                 tokens.append(Token("name", word, word, i))
             i = j
             continue
-        for op in _OPERATORS:
-            if code.startswith(op, i):
-                tokens.append(Token("op", op, op, i))
-                i += len(op)
-                break
-        else:
+        match = _OPERATOR.match(code, i)
+        if match is None:
             raise ScriptSyntaxError(f"unexpected character '{c}'", i + 1)
+        op = match.group()
+        tokens.append(Token("op", op, op, i))
+        i += len(op)
     tokens.append(Token("end", "", None, n))
     return tokens
 
@@ -326,12 +329,14 @@ def _convert_for(key: str, old: Any, value: Any) -> Any:
     return value
 
 
-@dataclass
+@dataclass(frozen=True)
 class Script:
-    """A parsed script: call :meth:`run` with the blackboard to execute it."""
+    """A parsed script: call :meth:`run` with the blackboard to execute it. Running it changes
+    nothing in it, so the nodes of every script of the same text share one
+    (:func:`parse_script` keeps them)."""
 
     code: str
-    statements: list[Expr]
+    statements: tuple[Expr, ...]
 
     def run(self, env: Variables) -> Any:
         result: Any = None
@@ -618,14 +623,29 @@ class _Parser:
 
 MAX_SCRIPT_DEPTH = 100
 """Expressions nested in expressions (parentheses, operators, operands): at most this deep."""
+MAX_SCRIPT_CHARS = 20_000
+"""Characters of one script: at most this many (parsing takes several microseconds each)."""
+PARSED_KEPT = 4096
+"""Parsed scripts kept by :func:`parse_script` for texts met again."""
 
 
 def parse_script(code: str) -> Script:
     """Parse ``code``; raises :class:`ScriptSyntaxError` (with column) when it is not valid.
 
-    A script nested deeper than :data:`MAX_SCRIPT_DEPTH` is refused, so that neither parsing
-    nor running it can exhaust Python's stack.
+    A script longer than :data:`MAX_SCRIPT_CHARS` or nested deeper than
+    :data:`MAX_SCRIPT_DEPTH` is refused, so that neither parsing nor running it can take long
+    or exhaust Python's stack. The last :data:`PARSED_KEPT` scripts parsed are kept: a text
+    met again (the same script in every instance of a SubTree, checked then built) is not
+    parsed again.
     """
+    if len(code) > MAX_SCRIPT_CHARS:
+        raise ScriptSyntaxError(f"script of {len(code):,} characters, more than the limit of "
+                                f"{MAX_SCRIPT_CHARS:,}; split it into several scripts", 1)
+    return _parsed(code)
+
+
+@lru_cache(maxsize=PARSED_KEPT)
+def _parsed(code: str) -> Script:
     try:
         statements = _parse_in_budget(code)
     except RecursionError:
@@ -634,7 +654,7 @@ def parse_script(code: str) -> Script:
     if any(_depth(statement) > MAX_SCRIPT_DEPTH for statement in statements):
         raise ScriptSyntaxError(f"expression nested deeper than {MAX_SCRIPT_DEPTH} levels; "
                                 "split it into several statements", 1)
-    return Script(code, statements)
+    return Script(code, tuple(statements))
 
 
 PARSE_FRAMES = 4000

@@ -11,7 +11,7 @@ then instantiates the main tree, each ``<SubTree>`` instance getting its own cop
 from __future__ import annotations
 
 import sys
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from functools import cached_property
 from typing import Any, cast
 
@@ -19,6 +19,8 @@ from py_trees.common import Status
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.attributes import (
+    POST_CONDITIONS,
+    PRE_CONDITIONS,
     AttributeCheck,
     closest,
     parse_condition_scripts,
@@ -39,6 +41,7 @@ from bt_manip.bt.node import (
 from bt_manip.bt.port_rules import keys_used, one_of_problem, world_name_problem
 from bt_manip.bt.ports import convert_literal, parse_reference, type_from_name
 from bt_manip.bt.registry import SUBTREE_ID, NodeRegistry, registry
+from bt_manip.bt.script import MAX_SCRIPT_CHARS
 from bt_manip.bt.status import NodeStatus
 from bt_manip.bt.subtree import SubTree
 from bt_manip.bt.tree import Tree
@@ -49,6 +52,14 @@ MAX_SUBTREE_DEPTH = 256
 """SubTrees nested in SubTrees: at most this many levels (like the nesting of XML elements)."""
 MAX_NODE_DEPTH = 2048
 """Nodes nested in nodes, SubTrees expanded: at most this many levels."""
+MAX_SCRIPTS_CHARS = 250_000
+"""Characters of a document's scripts, each text counted once: at most this many (parsing
+takes a few microseconds a character; one script alone is bounded by
+:data:`~bt_manip.bt.script.MAX_SCRIPT_CHARS`)."""
+MAX_TREE_NODES = 50_000
+"""Nodes of one tree, SubTrees expanded: at most this many. A few SubTrees that each use the
+next twice multiply (30 levels make a billion nodes); building and checking a node takes
+tens of microseconds, so this bounds a tree's loading to seconds."""
 FRAMES_PER_LEVEL = 8
 """Python frames that ticking, halting or walking one level of a tree may take."""
 
@@ -91,6 +102,8 @@ class _Checker:
         self.problems.append(Problem(file, element.line, message))
 
     def check_all(self) -> None:
+        if not self.check_script_sizes():
+            return
         for tree in self.doc.trees.values():
             self.edges[tree.tree_id] = []
             roots = tree.element.children
@@ -133,6 +146,30 @@ class _Checker:
                 if lacking:
                     out[node_id] = lacking
         return out
+
+    def check_script_sizes(self) -> bool:
+        """Refuse a document whose scripts hold more than :data:`MAX_SCRIPTS_CHARS`
+        characters, at the script that passes the limit, before any is parsed; False then."""
+        seen: set[str] = set()
+        total = 0
+        for tree in self.doc.trees.values():
+            for element in _in_order(tree.element):
+                node_id = element.get("ID") if element.tag in EXPLICIT_TAGS else element.tag
+                cls = self.reg.get(node_id or "")
+                keys = PRE_CONDITIONS + POST_CONDITIONS + (cls.SCRIPT_PORTS if cls else ())
+                for key in keys:
+                    text = element.get(key)
+                    if text is None or text in seen or len(text) > MAX_SCRIPT_CHARS:
+                        continue  # a script too long alone is refused where it is parsed
+                    seen.add(text)
+                    total += len(text)
+                    if total > MAX_SCRIPTS_CHARS:
+                        self.add(tree.file, element,
+                                 f"the scripts of this file pass {MAX_SCRIPTS_CHARS:,} "
+                                 f"characters at {key} of {node_id}; bt-manip reads at most "
+                                 "that many")
+                        return False
+        return True
 
     def check_node(self, element: Element, tree: TreeDef) -> None:
         file = tree.file
@@ -279,6 +316,7 @@ class _Checker:
         state: dict[str, int] = {}  # 1 = on the stack, 2 = done
         depth: dict[str, int] = {}  # SubTree levels below each tree (cycles not counted)
         nodes: dict[str, int] = {}  # nodes nested below each tree's root, SubTrees expanded
+        sizes: dict[str, int] = {}  # nodes of each tree, SubTrees expanded
         below: dict[str, str | None] = {}  # the tree through which the deepest chain goes
         reported: set[tuple[str, int]] = set()
         for start in self.doc.trees:
@@ -310,7 +348,10 @@ class _Checker:
                 path.pop()
                 state[tree_id] = 2
                 self._measure(tree_id, depth, nodes, below)
+                sizes[tree_id] = sum(_size(root, sizes)
+                                     for root in self.doc.trees[tree_id].element.children)
         self._check_depth(depth, nodes, below)
+        self._check_size(sizes)
 
     def _measure(self, tree_id: str, depth: dict[str, int], nodes: dict[str, int],
                  below: dict[str, str | None]) -> None:
@@ -348,6 +389,42 @@ class _Checker:
             self.add(tree.file, tree.element,
                      f"tree '{deepest}' nests nodes {nodes[deepest]} levels deep once its "
                      f"SubTrees are expanded; bt-manip allows at most {MAX_NODE_DEPTH}")
+
+
+    def _check_size(self, sizes: dict[str, int]) -> None:
+        """Refuse the largest tree when it holds more than :data:`MAX_TREE_NODES` nodes."""
+        largest = max(self.doc.trees, key=lambda t: sizes.get(t, 0), default=None)
+        if largest is None or sizes.get(largest, 0) <= MAX_TREE_NODES:
+            return
+        tree = self.doc.trees[largest]
+        count = sizes[largest]
+        shown = f"{count:,}" if count < 10**15 else f"about {float(count):.1e}"
+        self.add(tree.file, tree.element,
+                 f"tree '{largest}' holds {shown} nodes once its SubTrees are expanded; "
+                 f"bt-manip builds at most {MAX_TREE_NODES:,}")
+
+
+def _size(root: Element, sizes: dict[str, int]) -> int:
+    """Nodes under ``root`` (itself included), each SubTree counted with the nodes of its tree
+    (``sizes``; a tree not in it, as in a cycle, counts none)."""
+    total = 0
+    stack = [root]
+    while stack:
+        element = stack.pop()
+        total += 1
+        if element.tag == SUBTREE_ID:
+            total += sizes.get(element.get("ID") or "", 0)
+        stack.extend(element.children)
+    return total
+
+
+def _in_order(root: Element) -> Iterator[Element]:
+    """``root`` and the elements under it, in the order of the file."""
+    stack = [root]
+    while stack:
+        element = stack.pop()
+        yield element
+        stack.extend(reversed(element.children))
 
 
 def _elements(root: Element) -> list[Element]:
