@@ -426,6 +426,54 @@ def test_subtrees_that_multiply_and_scripts_that_add_up_are_refused_before_build
     assert json.loads((tmp_path / "bb.json").read_text())["x"] == 280_000
 
 
+def _chain_urdf(path: Path, links: int, one_line: bool = False) -> Path:
+    """A robot of ``links`` boxes in a chain of revolute joints (links on lines 2.. unless
+    ``one_line``)."""
+    box = '<geometry><box size="0.1 0.1 0.1"/></geometry>'
+    parts = [f'<link name="l{i}"><inertial><mass value="1"/><inertia ixx="0.1" iyy="0.1" '
+             f'izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial><collision>{box}</collision>'
+             "</link>" for i in range(links)]
+    parts += [f'<joint name="j{i}" type="revolute"><parent link="l{i}"/><child link="l{i + 1}"/>'
+              '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+              for i in range(links - 1)]
+    sep = "" if one_line else "\n"
+    path.write_text(f'<robot name="chain">{sep}' + sep.join(parts) + f"{sep}</robot>\n")
+    return path
+
+
+def test_urdfs_of_too_many_links_are_refused_before_a_library_reads_them(tmp_path: Path) -> None:
+    huge = _chain_urdf(tmp_path / "huge.urdf", 20_000)  # 7 MB: under the byte limit
+    assert huge.stat().st_size < 8 * 1024 * 1024
+    one_line = _chain_urdf(tmp_path / "one_line.urdf", 20_000, one_line=True)
+    wide = _chain_urdf(tmp_path / "wide.urdf", 200)
+    fits = _chain_urdf(tmp_path / "fits.urdf", 20)
+    world = tmp_path / "statue.yaml"
+    world.write_text("name: statue\nfurniture:\n  - name: statue\n    urdf: huge.urdf\n"
+                     "    pose: [1, 0, 0]\n  - name: wide\n    urdf: wide.urdf\n"
+                     "    pose: [3, 0, 0]\n")
+    loaded = tmp_path / "wide_only.yaml"
+    loaded.write_text("name: wide\nfurniture:\n  - name: wide\n    urdf: wide.urdf\n"
+                      "    pose: [3, 0, 0]\n")
+
+    def init(urdf: Path) -> list[str]:
+        return ["robot", "init", str(urdf), "--base-link", "l0", "--arm-tip", "l7",
+                "--out", str(tmp_path / f"{urdf.stem}.yaml")]
+
+    big, flat, many, ok, furniture, wide_world = run_cli(
+        tmp_path, init(huge), init(one_line), init(wide), init(fits),
+        ["world", str(world)], ["world", str(loaded)])
+    limit = "the URDF has 20,000 <link> elements, more than the limit of 1,000"
+    assert (big["code"], big["err"]) == (2, f"{huge}:1002: {limit}\n")
+    assert (flat["code"], flat["err"]) == (2, f"{one_line}:1: {limit}\n")
+    pybullet = "PyBullet answers for at most 128 links of one body, and this URDF loads as 200"
+    assert many["code"] == 2 and many["err"].endswith(f"{wide}: {pybullet}\n")
+    assert ok["code"] == 0 and "arm 7 joints (l0 -> l7)" in ok["out"]
+    assert furniture["code"] == 2
+    assert f"{world}:4: furniture[0].urdf: {limit} (huge.urdf:1002)" in furniture["err"]
+    assert wide_world["code"] == 2
+    assert wide_world["err"].endswith(f"{loaded}:3: 'wide': {pybullet} ({wide})\n")
+
+
 def test_worlds_alias_bombs_sizes_devices_and_meshes(tmp_path: Path) -> None:
     bomb = _alias_bomb(tmp_path / "bomb.yaml")
     assert bomb.stat().st_size < 600

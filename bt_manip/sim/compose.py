@@ -40,6 +40,7 @@ from bt_manip.errors import InputError, Problem
 from bt_manip.input_files import line_of_text, read_bounded
 from bt_manip.sim.assets import resolve_uri
 from bt_manip.sim.mesh_check import mesh_problem
+from bt_manip.sim.urdf_bounds import check_urdf_size
 from bt_manip.sim.yaml_lines import FieldReader
 
 if TYPE_CHECKING:
@@ -221,6 +222,7 @@ def _read_urdf(path: Path) -> ET.Element:
         raise InputError.single(str(path), None, f"unreadable URDF: {exc}") from None
     if root.tag != "robot":
         raise InputError.single(str(path), None, f"root element is <{root.tag}>, not <robot>")
+    check_urdf_size(path, root, data)
     for tag in DROPPED_TAGS:
         for el in root.findall(tag):
             root.remove(el)

@@ -138,6 +138,20 @@ def _text(value: bytes | str) -> str:
     return value.decode() if isinstance(value, bytes) else value
 
 
+MAX_BODY_LINKS = 128
+"""Links of one PyBullet body (its base included) that PyBullet answers queries about: a body
+loaded with more has them all refused (``getLinkState failed``)."""
+
+
+def too_many_links(client: int, body: int) -> str | None:
+    """Why PyBullet cannot serve ``body`` (more than :data:`MAX_BODY_LINKS` links), or None."""
+    links = joint_count(client, body) + 1
+    if links <= MAX_BODY_LINKS:
+        return None
+    return (f"PyBullet answers for at most {MAX_BODY_LINKS} links of one body, and this URDF "
+            f"loads as {links}")
+
+
 def joint_count(client: int, body: int) -> int:
     """Number of joints (= links other than the root) of ``body``."""
     return int(pb.getNumJoints(body, physicsClientId=client))

@@ -171,6 +171,12 @@ class Robot:
                 str(description.path), None,
                 f"PyBullet cannot load the robot's URDF {path} (check its links and meshes)"
             ) from None
+        why = pbq.too_many_links(client, body)
+        if why is not None:
+            pb.removeBody(body, physicsClientId=client)
+            raise InputError.single(str(description.path), None,
+                                    f"{why} ({path}, fixed links merged)" if merged else
+                                    f"{why} ({path})")
         robot = cls(client, body, description, merged)
         robot._apply_friction()
         robot._couple_fingers()

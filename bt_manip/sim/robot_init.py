@@ -34,6 +34,7 @@ import contextlib
 import dataclasses
 import math
 import os
+import re
 import tempfile
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
@@ -58,6 +59,7 @@ from bt_manip.sim.gripper_survey import (
     survey_gripper,
 )
 from bt_manip.sim.robot_description import APPROACH_AXES, RobotDescription, load_description
+from bt_manip.sim.urdf_bounds import check_urdf_size
 
 __all__ = ["MOBILE_KINDS", "InitOptions", "holonomic_joints", "init_descriptor", "urdf_uri"]
 
@@ -139,8 +141,10 @@ class _Urdf:
             raise InputError.single(str(path), None, f"the URDF does not parse: {exc}") from None
         if root.tag != "robot":
             raise InputError.single(str(path), 1, f"root element is <{root.tag}>, not <robot>")
+        check_urdf_size(path, root, data)
         self.robot_name = root.get("name", "") or path.stem
         text = data.decode("utf-8", errors="replace")
+        lines = _declared_lines(text)
         self.links: dict[str, int | None] = {}
         self.round_shapes: dict[str, tuple[float, tuple[float, float, float] | None]] = {}
         """Links whose only collision shape is a cylinder or a sphere: its radius and, for a
@@ -149,7 +153,7 @@ class _Urdf:
         """Links with at least one collision shape."""
         for el in root.findall("link"):
             name = el.get("name", "")
-            self.links[name] = _line(text, "link", name)
+            self.links[name] = lines.get(("link", name))
             if el.find("collision") is not None:
                 self.shaped.add(name)
             round_shape = _round_shape(el)
@@ -160,7 +164,7 @@ class _Urdf:
         """Follower joint -> (leader, multiplier, offset)."""
         for el in root.findall("joint"):
             name = el.get("name", "")
-            jline = _line(text, "joint", name)
+            jline = lines.get(("joint", name))
             mimic = el.find("mimic")
             if mimic is not None and mimic.get("joint"):
                 with contextlib.suppress(ValueError):
@@ -302,12 +306,19 @@ def _triple(
     return values
 
 
-def _line(text: str, tag: str, name: str) -> int | None:
-    for quote in ('"', "'"):
-        at = text.find(f"<{tag} name={quote}{name}{quote}")
-        if at >= 0:
-            return text.count("\n", 0, at) + 1
-    return None
+_DECLARED = re.compile(r"""<(link|joint) name=(["'])(.*?)\2""")
+
+
+def _declared_lines(text: str) -> dict[tuple[str, str], int]:
+    """The line of each ``<link name="...">`` and ``<joint name="...">`` of a URDF's text,
+    by (tag, name): the first declaration of a name (one pass over the text)."""
+    out: dict[tuple[str, str], int] = {}
+    line, counted = 1, 0
+    for match in _DECLARED.finditer(text):
+        line += text.count("\n", counted, match.start())
+        counted = match.start()
+        out.setdefault((match.group(1), match.group(3)), line)
+    return out
 
 
 def _end(el: ET.Element, which: str) -> str:
@@ -630,6 +641,9 @@ class _Geometry:
                 raise InputError.single(
                     str(opts.urdf), None, "PyBullet cannot load this URDF (check links and meshes)"
                 ) from None
+            why = pbq.too_many_links(client, body)
+            if why is not None:
+                raise InputError.single(str(opts.urdf), None, why)
             names = {-1: pbq.root_link_name(client, body)}
             infos = pbq.joint_infos(client, body)
             for info in infos:

@@ -246,6 +246,10 @@ class World:
                     str(self.path), spec.line,
                     f"'{spec.name}': PyBullet cannot load its URDF {spec.urdf} (check its links "
                     "and meshes)") from None
+            why = pbq.too_many_links(c, body)
+            if why is not None:
+                raise InputError.single(str(self.path), spec.line,
+                                        f"'{spec.name}': {why} ({spec.urdf})")
         else:
             body = self._make_compound(spec, pos, quat)
         if spec.movable:

@@ -41,6 +41,7 @@ from bt_manip.sim.compose import MAX_URDF_BYTES
 from bt_manip.sim.groups import parse_groups
 from bt_manip.sim.mesh_check import mesh_problem
 from bt_manip.sim.robot_description import find_descriptor, known_robots
+from bt_manip.sim.urdf_bounds import check_urdf_size
 from bt_manip.sim.world_spec import (
     COLOURS,
     DEFAULT_INITIAL_SIGMAS,
@@ -370,6 +371,12 @@ def _check_urdf_meshes(urdf: Path) -> list[str]:
         root = SafeET.fromstring(data)
     except Exception as exc:
         return [f"cannot parse {urdf.name}: {exc}"]
+    try:
+        check_urdf_size(urdf, root, data)
+    except InputError as exc:
+        first = exc.problems[0]
+        where = f"{urdf.name}:{first.line}" if first.line else urdf.name
+        return [f"{first.message} ({where})"]
     names = dict.fromkeys(mesh.get("filename", "") for mesh in root.iter("mesh"))
     out = []
     for fn in names:
