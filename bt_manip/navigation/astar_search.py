@@ -545,31 +545,32 @@ def _bucket_rounds(
             wl = _get(flat, left)  # type: ignore[call-arg]
             wr = _get(flat, right)  # type: ignore[call-arg]
         # moves in the order of DR/DC: up, down, left, right, then the diagonals, each
-        # allowed only when both side cells beside it are free
+        # allowed only when both side cells beside it are free; a move's index is an int64,
+        # not a literal: numba would compile _relax once per literal (eight times)
         free, used, n_open, g_goal, bound, pending = _relax(
-            0, up, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
+            np.int64(0), up, r - 1, c, gn + wu, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
             free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         free, used, n_open, g_goal, bound, pending = _relax(
-            1, down, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
+            np.int64(1), down, r + 1, c, gn + wd, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
             free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         free, used, n_open, g_goal, bound, pending = _relax(
-            2, left, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
+            np.int64(2), left, r, c - 1, gn + wl, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
             free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         free, used, n_open, g_goal, bound, pending = _relax(
-            3, right, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
+            np.int64(3), right, r, c + 1, gn + wr, g, parent, lo, hi, heads, pool,
             goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
             free, used, n_open, g_goal, bound, pending,
         )  # fmt: skip
         if diagonal:
             if wu != inf and wl != inf:
                 free, used, n_open, g_goal, bound, pending = _relax(
-                    4, node - cols - 1, r - 1, c - 1,
+                    np.int64(4), node - cols - 1, r - 1, c - 1,
                     gn + sqrt2 * _get(flat, node - cols - 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
@@ -577,7 +578,7 @@ def _bucket_rounds(
                 )  # fmt: skip
             if wu != inf and wr != inf:
                 free, used, n_open, g_goal, bound, pending = _relax(
-                    5, node - cols + 1, r - 1, c + 1,
+                    np.int64(5), node - cols + 1, r - 1, c + 1,
                     gn + sqrt2 * _get(flat, node - cols + 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
@@ -585,7 +586,7 @@ def _bucket_rounds(
                 )  # fmt: skip
             if wd != inf and wl != inf:
                 free, used, n_open, g_goal, bound, pending = _relax(
-                    6, node + cols - 1, r + 1, c - 1,
+                    np.int64(6), node + cols - 1, r + 1, c - 1,
                     gn + sqrt2 * _get(flat, node + cols - 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
@@ -593,7 +594,7 @@ def _bucket_rounds(
                 )  # fmt: skip
             if wd != inf and wr != inf:
                 free, used, n_open, g_goal, bound, pending = _relax(
-                    7, node + cols + 1, r + 1, c + 1,
+                    np.int64(7), node + cols + 1, r + 1, c + 1,
                     gn + sqrt2 * _get(flat, node + cols + 1),  # type: ignore[call-arg]
                     g, parent, lo, hi, heads, pool,
                     goal, gr, gc, diagonal, hmin, inv_delta, mask, cur,
