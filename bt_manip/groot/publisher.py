@@ -43,6 +43,9 @@ if TYPE_CHECKING:
 
 DEFAULT_GROOT_PORT = 1667
 MAX_TRANSITIONS = 1000
+MAX_REQUEST_BYTES = 1024 * 1024
+"""Largest request frame the server takes (Groot2's are a few hundred bytes: a hook in JSON,
+blackboard names); ZMQ drops the connection of a client that sends a larger one."""
 _TWO_PARTS = (RequestType.BLACKBOARD, RequestType.HOOK_INSERT, RequestType.HOOK_REMOVE,
               RequestType.BREAKPOINT_UNLOCK, RequestType.TOGGLE_RECORDING)
 
@@ -88,6 +91,7 @@ class GrootPublisher:
             sock.setsockopt(zmq.LINGER, 0)
             sock.setsockopt(zmq.RCVTIMEO, 100)
             sock.setsockopt(zmq.SNDTIMEO, 1000)
+        self._server.setsockopt(zmq.MAXMSGSIZE, MAX_REQUEST_BYTES)
         try:
             self.port = self._bind(bind, port)
         except BaseException:

@@ -9,6 +9,7 @@ from collections.abc import Iterator
 from typing import Any
 
 import pytest
+import zmq
 from groot_client import GrootClient, sync_subscription
 
 from bt_manip.bt import TreeContext, load_tree_string
@@ -123,6 +124,21 @@ def test_malformed_hook_requests_get_an_error_reply(rig: Rig, kind: str, body: s
     assert reply[0] == b"error"
     assert reply[1].decode().startswith(message)
     assert json.loads(rig.client.request("D")[1]) == []
+
+
+def test_a_request_past_the_size_limit_drops_its_client_and_the_server_goes_on(
+        rig: Rig) -> None:
+    from bt_manip.groot.publisher import MAX_REQUEST_BYTES
+
+    huge = GrootClient(rig.publisher.port, timeout_ms=500)
+    try:
+        with pytest.raises(zmq.Again):  # no reply: ZMQ dropped the connection
+            huge.request("B", b"x" * (MAX_REQUEST_BYTES + 1))
+    finally:
+        huge.close()
+    assert json.loads(rig.client.request("D")[1]) == []  # the server still answers
+    names = rig.client.request("B", b"x" * 1000)  # within the limit: answered
+    assert len(names) == 2
 
 
 def test_a_closed_monitor_gives_the_nodes_their_own_classes_back() -> None:
