@@ -205,7 +205,7 @@ class ArmPlanner:
         for a, b in itertools.pairwise(qs):
             n = max(1, math.ceil(float(np.max(np.abs(b - a))) / step))
             for k in range(n + (b is qs[-1])):
-                pin.framesForwardKinematics(model, data, a + (b - a) * (k / n))
+                pin.framesForwardKinematics(model, data, scene.pin_q(a + (b - a) * (k / n)))
                 p = world_from_root @ np.append(data.oMf[frame].translation, 1.0)
                 points.append(p[:3])
         return np.asarray(points, dtype=float).reshape(-1, 3)

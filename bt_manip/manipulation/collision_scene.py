@@ -153,6 +153,37 @@ def _read(path: Path) -> pin.GeometryModel | None:
     return geometry
 
 
+JOINT_SUFFIX = "#joint"
+"""Added, while the planning model is reduced, to the name of a joint named like a link."""
+
+
+def _distinct_joint_names(full: pin.Model) -> pin.Model:
+    """``full``, or a copy of it whose joints and joint frames named like a link carry
+    :data:`JOINT_SUFFIX` (ANYmal C's ``RF_KFE`` is a joint and a link, so is the SO-100's
+    ``gripper``; the B1's arm has a fixed joint and a link ``gripperStator``): Pinocchio's model
+    reduction looks frames up by name and stops at two of one name."""
+    links = {f.name for f in full.frames if f.type == pin.FrameType.BODY}
+    clash = links & ({full.names[i] for i in range(1, full.njoints)}
+                     | {f.name for f in full.frames if f.type != pin.FrameType.BODY})
+    if not clash:
+        return full
+    full = pin.Model(full)
+    for i in range(1, full.njoints):
+        if full.names[i] in clash:
+            full.names[i] = full.names[i] + JOINT_SUFFIX
+    for i in range(len(full.frames)):
+        frame = full.frames[i]
+        if frame.type != pin.FrameType.BODY and frame.name in clash:
+            frame.name = frame.name + JOINT_SUFFIX
+            full.frames[i] = frame
+    return full
+
+
+def _plain(name: str) -> str:
+    """A joint's name without :data:`JOINT_SUFFIX`."""
+    return name.removesuffix(JOINT_SUFFIX)
+
+
 def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.GeometryModel]:
     """The URDF's model and its collision geometry with every mesh replaced by its convex
     hull. Reading meshes and building their bounding-volume trees is most of what a scene
@@ -173,7 +204,12 @@ def _hulls(urdf: Path, package_dirs: tuple[str, ...]) -> tuple[pin.Model, pin.Ge
                     # the convex hull itself: buildConvexRepresentation keeps the mesh's
                     # vertices and faces as they are, whose support search gets stuck on a
                     # concave mesh and can find it free where the mesh touches
-                    shape.buildConvexHull(True, "Qt")
+                    try:
+                        shape.buildConvexHull(True, "Qt")
+                    except RuntimeError:
+                        # qhull gives up on some meshes ("Too many neighbors": Centauro's
+                        # pelvis); a joggled hull (QJ) of the same points is built instead
+                        shape.buildConvexHull(True, "QJ")
                     g.geometry = shape.convex
             _save(hulls, path)
         known = (pin.buildModelFromUrdf(str(urdf)), hulls)
@@ -268,27 +304,38 @@ class CollisionScene:
         urdf = composed_urdf(urdf)  # mesh paths made absolute, as PyBullet loads them
         self._source = (Path(urdf), tuple(package_dirs))
         full, geometry = (_loaded if exact else _hulls)(*self._source)
-        names = [full.names[i] for i in range(1, full.njoints)]
+        full = _distinct_joint_names(full)
+        names = [_plain(full.names[i]) for i in range(1, full.njoints)]
         missing = [j for j in joints if j not in names]
         if missing:
             raise SceneError(f"{urdf}: no joint {missing} (joints: {', '.join(names)})")
         q0 = pin.neutral(full)
         for name, value in (locked or {}).items():
             if name in names:
-                joint = full.joints[full.getJointId(name)]
+                joint = full.joints[names.index(name) + 1]
                 if joint.nq == 2:  # a continuous joint: its angle as (cos, sin)
                     q0[joint.idx_q:joint.idx_q + 2] = (math.cos(value), math.sin(value))
                 else:
                     q0[joint.idx_q] = value
-        lock = [full.getJointId(n) for n in names if n not in joints]
+        lock = [i + 1 for i, n in enumerate(names) if n not in joints]
         self._reduce = (full, lock, q0)
         self.model, self.geometry = pin.buildReducedModel(full, geometry, lock, q0)
+        for i in range(1, self.model.njoints):
+            self.model.names[i] = _plain(self.model.names[i])
         self.joint_names = tuple(self.model.names[i] for i in range(1, self.model.njoints))
         order = [self.joint_names.index(j) for j in joints]
-        if order != sorted(order) or self.model.nq != len(joints):
-            raise SceneError("the planned joints must be single-valued joints listed in URDF order")
-        self.lower = np.asarray(self.model.lowerPositionLimit, dtype=float)
-        self.upper = np.asarray(self.model.upperPositionLimit, dtype=float)
+        if order != sorted(order) or self.model.nv != len(joints):
+            raise SceneError("the planned joints must be one-axis joints listed in URDF order")
+        # a continuous joint is stored as (cos, sin) in Pinocchio's configuration; the scene
+        # takes its angle, within -pi .. pi as the arm's kinematics gives it
+        self._turning = [self.model.joints[i].idx_q for i in range(1, self.model.njoints)
+                         if self.model.joints[i].nq == 2]
+        slots = [self.model.joints[i].idx_q for i in range(1, self.model.njoints)]
+        self.lower = np.array([-math.pi if s in self._turning else
+                               float(self.model.lowerPositionLimit[s]) for s in slots])
+        self.upper = np.array([math.pi if s in self._turning else
+                               float(self.model.upperPositionLimit[s]) for s in slots])
+        self._angle_slot = slots
         self._robot_geoms = self.geometry.ngeoms
         self.exact = exact
         """Whether the scene checks the meshes only (no hull pass)."""
@@ -454,7 +501,7 @@ class CollisionScene:
         ``touching`` links (the fingers and hand holding it). Call before adding obstacles."""
         if self.obstacles:
             raise SceneError("hold objects before adding obstacles (clear_obstacles first)")
-        frame_id = self.model.getFrameId(link)
+        frame_id = self.model.getFrameId(link, pin.FrameType.BODY)
         if frame_id >= len(self.model.frames):
             raise SceneError(f"no link '{link}' in the planning model")
         frame = self.model.frames[frame_id]
@@ -508,10 +555,27 @@ class CollisionScene:
         self.checks += 1
         self._fresh()
         return bool(pin.computeCollisions(self.model, self.data, self._broad,
-                                          np.asarray(q, dtype=float), True))
+                                          self.pin_q(np.asarray(q, dtype=float)), True))
+
+    def pin_q(self, q: np.ndarray) -> np.ndarray:
+        """Pinocchio's configuration of the planning model for joint values ``q`` (one a
+        joint): ``q`` itself unless a joint is continuous (its angle as (cos, sin))."""
+        if not self._turning:
+            return q
+        out = np.empty(self.model.nq)
+        for k, slot in enumerate(self._angle_slot):
+            if slot in self._turning:
+                out[slot], out[slot + 1] = math.cos(q[k]), math.sin(q[k])
+            else:
+                out[slot] = q[k]
+        return out
 
     def _hit(self, q: np.ndarray) -> bool:
         """Whether ``q`` is in contact (the caller has made the data fresh)."""
+        return self._hit_pin(self.pin_q(q))
+
+    def _hit_pin(self, q: np.ndarray) -> bool:
+        """:meth:`_hit` of Pinocchio's configuration ``q``."""
         if not pin.computeCollisions(self.model, self.data, self._broad, q, True):
             return False  # the hulls are free: so are the meshes inside them
         if self.exact:
@@ -522,10 +586,10 @@ class CollisionScene:
         self._confirms += 1
         if self._confirms > PAIRWISE_CONFIRMS:
             self.mesh_geometry  # noqa: B018 (read now: many confirms to come)
-            return self._hit(q)
+            return self._hit_pin(q)
         return self._confirmed(q)
 
-    def _confirmed(self, q: np.ndarray) -> bool:
+    def _confirmed(self, q: np.ndarray) -> bool:  # q: Pinocchio's configuration
         """After the hulls touched at ``q``: whether the shapes themselves do. A mesh lies
         inside its hull, so only the pairs whose hulls touch can touch; each is tested again
         with the robot's meshes (each read the first time it is needed) and primitives. (Once
@@ -563,7 +627,7 @@ class CollisionScene:
         geometry, gdata = ((self.mesh_geometry, self._mesh_gdata)
                            if self.mesh_geometry is not None else (self.geometry, self._gdata))
         pin.computeCollisions(self.model, self._mesh_data, geometry, gdata,
-                              np.asarray(q, dtype=float), False)
+                              self.pin_q(np.asarray(q, dtype=float)), False)
         out: list[tuple[str, str]] = []
         for k, pair in enumerate(geometry.collisionPairs):
             named = (self.link_of[pair.first], self.link_of[pair.second])
@@ -605,7 +669,7 @@ class CollisionScene:
             collisions = pin.computeCollisions
 
             def hit(q: np.ndarray) -> bool:
-                return bool(collisions(model, data, broad, q, True))
+                return bool(collisions(model, data, broad, self.pin_q(q), True))
         else:
             hit = self._hit
         # the end first (as the bisection order has it): most blocked segments stop here,
@@ -684,7 +748,7 @@ def never_colliding_pairs(
     touched = np.zeros(len(pairs), dtype=bool)
     gdata = scene.gdata
     for _ in range(samples):
-        q = rng.uniform(lo, hi)
+        q = scene.pin_q(rng.uniform(lo, hi))
         pin.computeCollisions(scene.model, scene.data, scene.geometry, gdata, q, False)
         for n, (k, _) in enumerate(pairs):
             if not touched[n] and gdata.collisionResults[k].isCollision():

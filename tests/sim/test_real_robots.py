@@ -14,6 +14,7 @@ import yaml
 from bt_manip.cli import main
 from bt_manip.episode import Episode, EpisodeSpec
 from bt_manip.errors import InputError
+from bt_manip.manipulation.collision_scene import CollisionScene
 from bt_manip.manipulation.self_collisions import add_planning_section
 from bt_manip.sim.assets import example_robot_data_share
 from bt_manip.sim.robot_description import APPROACH_FRAME
@@ -24,6 +25,16 @@ ERD = example_robot_data_share() / "example-robot-data" / "robots"
 TIAGO = ERD / "tiago_description" / "robots" / "tiago.urdf"
 PANDA = ERD / "panda_description" / "urdf" / "panda.urdf"
 SO101 = ERD / "so_arm_description" / "urdf" / "so101.urdf"
+PLANNING_CASES = {
+    # a mobile manipulator whose forearm and wrist roll joints are continuous
+    "pr2": (ERD / "pr2_description" / "urdf" / "pr2.urdf", "torso_lift_link",
+            "r_gripper_tool_frame", ("r_forearm_roll_joint", "r_wrist_roll_joint")),
+    # its jaw joint and the link it moves are both called 'gripper'
+    "so100": (ERD / "so_arm_description" / "urdf" / "so100.urdf", "base", "gripper", ()),
+    # a pelvis mesh whose convex hull qhull refuses to build as it is ("Too many neighbors")
+    "centauro": (ERD / "centauro_description" / "urdf" / "centauro.urdf", "pelvis",
+                 "arm1_8", ()),
+}
 
 
 def _tiago(folder: Path, **kw: object) -> InitOptions:
@@ -66,6 +77,24 @@ def test_tiago_hand_casters_footprint_and_approach_axis(tmp_path: Path) -> None:
     assert recipe.drop_links == ("hand_safety_box",)  # type: ignore[union-attr]
     assert 0.45 < desc.footprint.length < 0.6 and 0.45 < desc.footprint.width < 0.6
     assert any("rgbd_laser_link" in n or "without a collision shape" in n for n in notes)
+
+
+@pytest.mark.parametrize("robot", sorted(PLANNING_CASES))
+def test_robots_whose_urdfs_stopped_the_planning_section_get_one(robot: str,
+                                                                 tmp_path: Path) -> None:
+    urdf, base, tip, turning = PLANNING_CASES[robot]
+    desc, allowed = add_planning_section(
+        init_descriptor(InitOptions(urdf, base, tip, tmp_path / f"{robot}.yaml")))
+    assert allowed.never  # pairs found apart in every sampled configuration
+    written = yaml.safe_load((tmp_path / f"{robot}.yaml").read_text())
+    never = written["planning"]["allowed_collisions"]["never"]
+    assert {frozenset(p) for p in never} == allowed.never
+    for joint in turning:
+        assert joint in desc.arm.joints
+    scene = CollisionScene(desc.urdf_path, list(desc.arm.joints))
+    state = np.asarray(desc.state("home"))
+    assert scene.within_limits(state)
+    assert scene.contacts(state) is not None
 
 
 def test_shipped_tiago_is_what_init_writes_but_its_states(tmp_path: Path) -> None:
