@@ -12,7 +12,9 @@ line of the original. What it rewrites:
   ``RetryUntilSuccesful`` -> ``RetryUntilSuccessful``, ``SubTreePlus`` -> ``SubTree``;
 - ``Parallel``'s ``threshold`` / ``success_threshold`` -> ``success_count`` and
   ``failure_threshold`` -> ``failure_count``;
-- a SubTree's ``__shared_blackboard`` and a SubTreePlus's ``__autoremap`` -> ``_autoremap``.
+- a SubTree's ``__shared_blackboard`` and a SubTreePlus's ``__autoremap`` -> ``_autoremap``;
+- a blackboard reference written ``"${key}"`` (v3 reads it as ``"{key}"``; v4 does not) ->
+  ``"{key}"``.
 
 Everything else (attributes, comments, spacing) is kept as it is.
 """
@@ -43,7 +45,10 @@ EXPLICIT = ("Action", "Condition", "Decorator", "Control")
 Rewrite = tuple[int, str]
 """(line, what was rewritten), e.g. ``(12, "SequenceStar -> SequenceWithMemory")``."""
 
-_TOKEN = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<![^>]*>|</?[^<>]*>", re.S)
+_TOKEN = re.compile(r"<!--.*?-->|<!\[CDATA\[.*?\]\]>|<\?.*?\?>|<![^>]*>"
+                    r"""|</?[^<>"']*(?:(?:"[^"]*"|'[^']*')[^<>"']*)*>""", re.S)
+"""A comment, CDATA, processing instruction, declaration or tag (a ``>`` inside a quoted
+attribute value, legal XML, does not end the tag)."""
 _NAME = re.compile(r"</?\s*([^\s/>]+)")
 _ATTR = re.compile(r"""([^\s=/>]+)(\s*=\s*)("[^"]*"|'[^']*')""")
 
@@ -142,7 +147,25 @@ def _start_tag(token: str, tag: str, line: int, in_model: bool, rewrites: list[R
              else SUBTREE_PORTS if written == "SubTree" else {})
     if ports:
         new = _rename_attributes(new, ports, old_type, line, rewrites)
-    return new, written
+    return _dollar_references(new, line, rewrites), written
+
+
+_DOLLAR = re.compile(r"\s*\$\{(.*)\}\s*", re.S)
+"""A v3 blackboard reference ``${key}`` (spaces around it allowed, as v3 strips them)."""
+
+
+def _dollar_references(token: str, line: int, rewrites: list[Rewrite]) -> str:
+    """``token`` with each attribute value that is a v3 ``${key}`` reference written
+    ``{key}`` (the element's ``ID`` and ``name`` are names, left as they are)."""
+    def swap(m: re.Match[str]) -> str:
+        key, quoted = m.group(1), m.group(3)
+        ref = _DOLLAR.fullmatch(quoted[1:-1])
+        if key in ("ID", "name") or ref is None:
+            return m.group(0)
+        rewrites.append((line, f"{key}: ${{{ref.group(1)}}} -> {{{ref.group(1)}}}"))
+        return key + m.group(2) + quoted[0] + "{" + ref.group(1) + "}" + quoted[0]
+
+    return _ATTR.sub(swap, token)
 
 
 def _plain_name(name: str) -> bool:

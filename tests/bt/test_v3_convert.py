@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -96,6 +97,36 @@ def test_run_and_validate_load_v3_with_a_warning_per_rewrite(tmp_path: Path) -> 
     assert any(":1: warning: <root> has no BTCPP_format" in w for w in warnings)
     assert any(":3: warning: v3 form: SequenceStar -> SequenceWithMemory" in w
                for w in warnings)
+
+
+def test_v3_dollar_references_and_a_greater_than_in_a_value(tmp_path: Path) -> None:
+    # v3 reads "${key}" as a blackboard reference, spaces around it stripped; a ">" in a
+    # quoted value is legal XML and does not end the tag
+    src = tmp_path / "dollar.xml"
+    src.write_text("""<root main_tree_to_execute="A">
+  <BehaviorTree ID="A">
+    <Sequence name="a>b">
+      <SetBlackboard output_key="x" value="3"/>
+      <SetBlackboard output_key="y" value=" ${x} "/>
+      <Action ID="SetBlackboard" name="${x}" output_key="z" value="${x}"/>
+    </Sequence>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <Action ID="Custom"><output_port name="out" type="std::vector&lt;int> >"/></Action>
+  </TreeNodesModel>
+</root>
+""")
+    v4, rewrites = convert_v3(src.read_text())
+    assert '<Sequence name="a>b">' in v4 and "</Sequence>" in v4 and v4.endswith("</root>\n")
+    assert '<SetBlackboard output_key="y" value="{x}"/>' in v4
+    assert '<SetBlackboard name="${x}" output_key="z" value="{x}"/>' in v4  # a name stays
+    assert '<output_port name="out" type="std::vector&lt;int> >"/>' in v4
+    assert (5, "value: ${x} -> {x}") in rewrites and (6, "value: ${x} -> {x}") in rewrites
+    out = tmp_path / "bb.json"
+    code = main(["run", str(src), "--quiet", "--bb-out", str(out)])
+    assert code == 0
+    assert {k: v for k, v in json.loads(out.read_text()).items() if k in "xyz"} == {
+        "x": "3", "y": "3", "z": "3"}
 
 
 def structure(path: Path) -> list[tuple[str, str, str, dict[str, str]]]:
