@@ -7,12 +7,13 @@ that finished is only set back to IDLE.
 
 from __future__ import annotations
 
+import sys
 from typing import Any
 
 from py_trees.ports import PortInformation
 
 from bt_manip.bt.node import BtNode, ControlNode
-from bt_manip.bt.ports import NON_NEGATIVE, Port
+from bt_manip.bt.ports import Accepts, Port
 from bt_manip.bt.registry import registry
 from bt_manip.bt.status import NodeStatus
 
@@ -84,13 +85,20 @@ class RecoveryNode(ControlNode):
     - FAILURE: halt both, return FAILURE;
     - SKIPPED: no recovery is possible: halt it and return FAILURE (not counted as a retry).
 
-    Halting resets the retry count.
+    Halting resets the retry count. ``number_of_retries="-1"`` sets no limit: the first child
+    is tried again after every successful recovery (Nav2's trees with a RecoveryManager, which
+    decides when recovering is over, write it so). Without a limit, after
+    :attr:`RETRIES_PER_TICK` retries in one tick it returns RUNNING and goes on at the next
+    tick, so that two children that fail and recover at once cannot hold a tick forever.
     """
+
+    RETRIES_PER_TICK = 100
 
     MIN_CHILDREN = 2
     MAX_CHILDREN = 2
     INPUT_PORTS: dict[str, PortInformation] = {
-        "number_of_retries": Port(int, False, "Number of retries", 1, NON_NEGATIVE),
+        "number_of_retries": Port(int, False, "Number of retries (-1: no limit)", 1,
+                                  Accepts(low=0, also=(-1,))),
     }
 
     def __init__(self, name: str | None = None, children: list[BtNode] | None = None,
@@ -101,6 +109,10 @@ class RecoveryNode(ControlNode):
 
     def tick_node(self) -> NodeStatus:
         allowed = int(self.get_input("number_of_retries"))
+        unlimited = allowed < 0
+        if unlimited:
+            allowed = sys.maxsize
+        this_tick = 0
         self.set_running()
         while self.retries <= allowed:
             status = self.bt_children()[self.current].execute_tick()
@@ -128,6 +140,9 @@ class RecoveryNode(ControlNode):
                 self.halt_child(1)
                 self.retries += 1
                 self.current = 0
+                this_tick += 1
+                if unlimited and this_tick >= self.RETRIES_PER_TICK:
+                    return RUNNING
         self.halt()
         return FAILURE
 

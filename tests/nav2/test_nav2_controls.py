@@ -13,6 +13,7 @@ from py_trees.ports import PortInformation
 import bt_manip.nav2  # noqa: F401  (registers the Nav2 nodes)
 from bt_manip.bt import ActionNode, Tree, TreeContext, load_tree_string, registry
 from bt_manip.clock import ManualClock
+from bt_manip.errors import InputError
 from bt_manip.nav2.path import Nav2Path
 
 SCRIPTS: dict[str, list[str]] = {}
@@ -116,6 +117,30 @@ def test_recovery_node_fails_when_retries_are_spent_or_the_recovery_fails() -> N
     tree, _ = make(f"<RecoveryNode>{kid('w2')}{kid('f2')}</RecoveryNode>",
                    {"w2": "F", "f2": "F"})
     assert tick(tree) == ("FAILURE", [("tick", "w2"), ("tick", "f2")])
+
+
+def test_recovery_node_without_a_limit_retries_until_work_succeeds() -> None:
+    # Nav2's recovery-manager trees write number_of_retries="-1": no limit
+    tree, _ = make(
+        f'<RecoveryNode number_of_retries="-1">{kid("work")}{kid("fix")}</RecoveryNode>',
+        {"work": "F" * 5 + "S", "fix": "S"},
+    )
+    status, ticks = tick(tree)
+    assert status == "SUCCESS"
+    assert ticks == [("tick", "work"), ("tick", "fix")] * 5 + [("tick", "work")]
+    # children that fail and recover at once forever: the tick still ends, RUNNING
+    from bt_manip.nav2.controls import RecoveryNode
+
+    tree, _ = make(
+        f'<RecoveryNode number_of_retries="-1">{kid("w3")}{kid("f3")}</RecoveryNode>',
+        {"w3": "F" * 1000, "f3": "S" * 1000},
+    )
+    status, ticks = tick(tree)
+    assert status == "RUNNING"
+    assert ticks.count(("tick", "f3")) == RecoveryNode.RETRIES_PER_TICK
+    with pytest.raises(InputError, match="must be >= 0 or -1, got -2"):
+        make(f'<RecoveryNode number_of_retries="-2">{kid("w4")}{kid("f4")}</RecoveryNode>',
+             {"w4": "F", "f4": "S"})
 
 
 def test_round_robin_takes_turns_across_activations() -> None:
