@@ -127,8 +127,10 @@ def _upgrade_v3(doc: Document, path: str, text: str | None, fmt: str | None) -> 
         doc.problems.extend(e.problems)
         return None
     except (ConvertError, XmlError, UnicodeDecodeError) as e:
-        doc.problems.append(e.problem if isinstance(e, XmlError)
-                            else Problem(path, getattr(e, "line", None), str(e)))
+        doc.problems.append(
+            e.problem if isinstance(e, XmlError)
+            else Problem(path, e.line, f"malformed XML: {e.message}")
+            if isinstance(e, ConvertError) else Problem(path, None, str(e)))
         return None
     doc.warnings.append(Problem(path, root.line, f"warning: <root> {what}; reading it as "
                                 "BehaviorTree.CPP v3, converted to BTCPP_format=\"4\""))

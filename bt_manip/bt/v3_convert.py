@@ -25,6 +25,8 @@ import re
 from dataclasses import dataclass
 from xml.parsers import expat
 
+from bt_manip.bt.xml_parse import as_strict_xml
+
 RENAMED = {
     "SequenceStar": "SequenceWithMemory",
     "RetryUntilSuccesful": "RetryUntilSuccessful",
@@ -70,10 +72,20 @@ class _Open:
 
 
 def check_well_formed(text: str) -> None:
-    """Raise :class:`ConvertError` with the line when ``text`` is not well-formed XML."""
-    parser = expat.ParserCreate()
+    """Raise :class:`ConvertError` with the line when ``text`` is not XML that BehaviorTree.CPP
+    reads: well-formed, or so once what its parser takes and strict XML refuses (text before
+    the first element, a raw ``<`` in an attribute value, a ``&`` that starts no reference)
+    is stood in for, as the loader does (:func:`~bt_manip.bt.xml_parse.as_strict_xml`)."""
     try:
-        parser.Parse(text.encode("utf-8"), True)
+        expat.ParserCreate().Parse(text.encode("utf-8"), True)
+        return
+    except expat.ExpatError as exc:
+        first = exc
+    strict = as_strict_xml(text)
+    if strict is None:
+        raise ConvertError(first.lineno, expat.ErrorString(first.code)) from None
+    try:
+        expat.ParserCreate().Parse(strict.encode("utf-8"), True)
     except expat.ExpatError as exc:
         raise ConvertError(exc.lineno, expat.ErrorString(exc.code)) from None
 

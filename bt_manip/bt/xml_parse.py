@@ -100,6 +100,13 @@ def _blank(match: re.Match[str]) -> str:
     return bom + "\n".join(" " * len(line) for line in text[len(bom):].split("\n"))
 
 
+def as_strict_xml(text: str) -> str | None:
+    """``text`` with what BehaviorTree.CPP's parser takes and strict XML refuses stood in for
+    (the module docstring), or None when there is nothing to change; lines and columns are
+    those of ``text``."""
+    return _lenient(text)
+
+
 def _lenient(text: str) -> str | None:
     """``text`` as strict XML takes it, or None when there is nothing to change (see the
     module docstring). Linear in the length of the text: no expression rescans what it

@@ -129,6 +129,28 @@ def test_v3_dollar_references_and_a_greater_than_in_a_value(tmp_path: Path) -> N
         "x": "3", "y": "3", "z": "3"}
 
 
+def test_v3_files_are_read_as_leniently_as_v4_ones(tmp_path: Path,
+                                                   capsys: pytest.CaptureFixture) -> None:
+    # BehaviorTree.CPP's parser takes text before the first element and a raw "<" in a
+    # value; the loader takes them in v4 files, convert and the v3 path take them too
+    lead = tmp_path / "lead.xml"
+    lead.write_text('// clang-format off\n<root>\n  <BehaviorTree ID="A">\n'
+                    '    <Precondition if="1 < 2" else="FAILURE"><AlwaysSuccess/></Precondition>\n'
+                    '  </BehaviorTree>\n</root>\n')
+    assert main(["validate", str(lead)]) == 0
+    capsys.readouterr()
+    assert main(["convert", str(lead)]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith('// clang-format off\n<root BTCPP_format="4">')
+    broken = tmp_path / "broken.xml"
+    broken.write_text("<root>\n  <BehaviorTree ID=\"A\">\n    <AlwaysSuccess>\n"
+                      "  </BehaviorTree>\n</root>\n")
+    assert main(["validate", str(broken)]) == 2
+    err = capsys.readouterr().err  # line and column, the line once
+    assert err.startswith(f"{broken}:4:") and err.endswith(": malformed XML: mismatched tag\n")
+    assert err.count(":4") == 1
+
+
 def structure(path: Path) -> list[tuple[str, str, str, dict[str, str]]]:
     tree = load_tree(str(path))
     return [(w.path, w.node_id, w.name,
