@@ -190,7 +190,11 @@ class _Checker:
             self.check_subtree(element, tree, attributes)
             return
         spec = self.spec(node_id)
-        if spec is None:
+        if spec is None and node_id in self.doc.trees:
+            self.add(file, element,
+                     f"unknown node '{node_id}': it is a <BehaviorTree> of this document; "
+                     f"call it with <SubTree ID=\"{node_id}\"/>")
+        elif spec is None:
             self.add(file, element,
                      f"unknown node '{node_id}'{closest(node_id, self.known_ids())}; register "
                      "it in Python or declare it in a <TreeNodesModel> (--models FILE)")

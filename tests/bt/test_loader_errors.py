@@ -37,6 +37,16 @@ def test_unknown_node_suggests_closest(tmp_path: Path) -> None:
     assert ":2: unknown node 'AlwaysSucess' (did you mean 'AlwaysSuccess'" in out[0]
 
 
+def test_a_tree_used_as_a_node_is_told_how_to_call_it(tmp_path: Path) -> None:
+    # BehaviorTree.CPP refuses <Sub/> too ("Node not recognized"); the message says the fix
+    out = problems_of(tmp_path, '<root BTCPP_format="4" main_tree_to_execute="M">\n'
+                                '<BehaviorTree ID="M"><Sequence>\n<Sub/></Sequence>'
+                                '</BehaviorTree>\n<BehaviorTree ID="Sub"><AlwaysSuccess/>'
+                                "</BehaviorTree></root>")
+    assert out == [f"{tmp_path / 't.xml'}:3: unknown node 'Sub': it is a <BehaviorTree> of "
+                   'this document; call it with <SubTree ID="Sub"/>']
+
+
 def test_attribute_not_a_port(tmp_path: Path) -> None:
     out = problems_of(tmp_path, wrap('<Repeat num_cycles="2" cycles="3"><AlwaysSuccess/></Repeat>'))
     assert out == [f"{tmp_path / 't.xml'}:1: 'cycles' is not a port of Repeat (did you mean "
