@@ -47,6 +47,11 @@ GRIPPER_TOLERANCE = 0.004
 """m the pad opening may end from the commanded one."""
 WIDE = 2.0 * math.pi
 """Half range tried for joints without limits."""
+NO_LIMIT = 1e3
+"""A limit farther out than this (rad or m) counts as none: URDFs written by simulators give
+"unlimited" joints +-1e16."""
+MOVE_TIMEOUT_S = 60.0
+"""Sim seconds a move may take at most, whatever its distance and speed limit."""
 SETTLE_S = 1.0
 BASE_SQUARE = 0.3
 """m: side of the square a holonomic base drives."""
@@ -104,10 +109,10 @@ class CheckReport:
 
 
 def _targets(lower: float, upper: float, start: float) -> tuple[float, float]:
-    if not math.isfinite(lower) or not math.isfinite(upper):
+    if not abs(lower) <= NO_LIMIT or not abs(upper) <= NO_LIMIT:  # inf, nan or 1e16
         lower, upper = start - WIDE, start + WIDE
-        lower = max(lower, -1e3)
-        upper = min(upper, 1e3)
+        lower = max(lower, -NO_LIMIT)
+        upper = min(upper, NO_LIMIT)
     margin = max(MARGIN_MIN, MARGIN_FRACTION * (upper - lower))
     return lower + margin, upper - margin
 
@@ -147,7 +152,8 @@ def _run(client: int, robot: Robot, floor: int) -> CheckReport:
             q = list(start)
             q[i] = value
             here = float(robot.arm_positions()[i])
-            timeout = abs(value - here) / max(velocities[i], 1e-3) * 2.0 + 2.0
+            timeout = min(abs(value - here) / max(velocities[i], 1e-3) * 2.0 + 2.0,
+                          MOVE_TIMEOUT_S)
             robot.set_arm_targets(q)
             took = _until(client, timeout, lambda i=i, v=value: abs(robot.arm_positions()[i] - v))
             report.moves.append(
@@ -160,7 +166,7 @@ def _run(client: int, robot: Robot, floor: int) -> CheckReport:
         moves = (("open", g.max_opening), ("close", g.min_opening), ("open", g.max_opening))
         for phase, opening in moves:
             robot.set_gripper(opening)
-            timeout = g.stroke_time * 2.0 + 2.0
+            timeout = min(g.stroke_time * 2.0 + 2.0, MOVE_TIMEOUT_S)
             took = _until(client, timeout, lambda o=opening: abs(robot.gripper_opening() - o))
             report.moves.append(
                 MoveResult("gripper", phase, opening, robot.gripper_opening(), took)
@@ -189,7 +195,7 @@ def _check_holonomic(client: int, robot: Robot, report: CheckReport) -> None:
     for axis, phase, value in moves:
         goal[axis] = value
         speed = base.max_yaw_rate if axis == 2 else base.max_speed
-        timeout = BASE_SQUARE / max(speed, 1e-3) * 3.0 + 3.0
+        timeout = min(BASE_SQUARE / max(speed, 1e-3) * 3.0 + 3.0, MOVE_TIMEOUT_S)
         took = _drive_base(client, robot, list(goal), timeout)
         reached = float(robot._positions(robot.base_joint_ids)[axis])
         report.moves.append(MoveResult(names[axis], phase, value, reached, took))

@@ -5,6 +5,7 @@ and the shipped husky_ur3 and omni_sawyer pass the whole check."""
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import pytest
@@ -166,3 +167,25 @@ def test_shipped_mobile_robots_pass_the_whole_check(name: str) -> None:
     if name == "omni_sawyer":  # the square is still driven before
         phases = [m.phase for m in report.moves if m.joint.startswith("base_")]
         assert phases == ["+", "+", "back", "back", "turn", "back"]
+
+
+def test_a_joint_whose_limits_say_unlimited_is_turned_a_turn_each_way(tmp_path: Path) -> None:
+    # URDFs written by simulators give a free joint +-1e16 (example-robot-data's iris): the
+    # check turns it one turn each way, as a joint without limits, in bounded time
+    urdf = tmp_path / "spinner.urdf"
+    urdf.write_text(
+        '<robot name="spinner">\n' + _link("base", 5.0, '<collision><geometry><box size="0.2 '
+                                           '0.2 0.1"/></geometry></collision>') + "\n"
+        '  <joint name="spin" type="revolute"><parent link="base"/><child link="blade"/>'
+        '<origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>'
+        '<limit lower="-1e+16" upper="1e+16" effort="5" velocity="2"/></joint>\n'
+        + _link("blade", 0.2, '<collision><geometry><box size="0.3 0.02 0.01"/></geometry>'
+                "</collision>") + "\n</robot>\n")
+    out = tmp_path / "spinner.yaml"
+    assert main(["robot", "init", str(urdf), "--base-link", "base", "--arm-tip", "blade",
+                 "--out", str(out)]) == 0
+    report = check_robot(RobotDescription.load(out))
+    targets = [(m.phase, round(m.target, 4)) for m in report.moves]
+    turn = round(2 * math.pi - max(0.02, 0.02 * 4 * math.pi), 4)
+    assert targets == [("lower", -turn), ("upper", turn), ("back", 0.0)]
+    assert all(m.ok for m in report.moves)
