@@ -181,11 +181,22 @@ class Robot:
         robot._apply_friction()
         robot._couple_fingers()
         robot._hold_other_joints()
+        robot._arm_within_limits()
         robot.hold_arm()
         robot.set_gripper(robot.gripper_opening())
         if robot.has_wheels or robot.is_holonomic:
             robot.stop_base()
         return robot
+
+    def _arm_within_limits(self) -> None:
+        """PyBullet loads every joint at 0; an arm joint whose limits leave 0 out (a Kinova's
+        second, third and fifth joints, 47-313 deg) is set at its nearest limit, where the real
+        arm could be: a plan then starts from a configuration within the limits."""
+        q = self.arm_positions()
+        inside = np.clip(q, self.description.arm.lower, self.description.arm.upper)
+        for j, was, now in zip(self.arm_joint_ids, q, inside, strict=True):
+            if now != was:
+                pb.resetJointState(self.body, j, float(now), 0.0, physicsClientId=self.client)
 
     def _apply_friction(self) -> None:
         base = self.description.base

@@ -189,3 +189,32 @@ def test_a_joint_whose_limits_say_unlimited_is_turned_a_turn_each_way(tmp_path: 
     turn = round(2 * math.pi - max(0.02, 0.02 * 4 * math.pi), 4)
     assert targets == [("lower", -turn), ("upper", turn), ("back", 0.0)]
     assert all(m.ok for m in report.moves)
+
+
+def test_an_arm_whose_limits_leave_zero_out_spawns_at_its_nearest_limit(tmp_path: Path) -> None:
+    # PyBullet loads joints at 0; a Kinova's 2nd, 3rd and 5th joints cannot be there
+    import pybullet as pb
+
+    from bt_manip.sim.robot import Robot
+
+    urdf = tmp_path / "bent.urdf"
+    box = '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'
+    urdf.write_text(
+        '<robot name="bent">\n' + _link("base", 5.0, box) + "\n"
+        + "".join(
+            f'  <joint name="j{i}" type="revolute"><parent link="{parent}"/>'
+            f'<child link="l{i}"/><origin xyz="0 0 0.2"/><axis xyz="0 1 0"/>'
+            f'<limit lower="{lo}" upper="{hi}" effort="50" velocity="1"/></joint>\n'
+            + _link(f"l{i}", 0.5, box) + "\n"
+            for i, (parent, lo, hi) in enumerate(
+                [("base", 0.5, 1.5), ("l0", -1.0, 1.0), ("l1", -2.0, -0.25)]))
+        + "</robot>\n")
+    out = tmp_path / "bent.yaml"
+    assert main(["robot", "init", str(urdf), "--base-link", "base", "--arm-tip", "l2",
+                 "--out", str(out)]) == 0
+    client = pb.connect(pb.DIRECT)
+    try:
+        robot = Robot.spawn(client, RobotDescription.load(out), 0.0, 0.0, 0.0)
+        assert list(robot.arm_positions()) == pytest.approx([0.5, 0.0, -0.25], abs=1e-9)
+    finally:
+        pb.disconnect(client)
