@@ -95,7 +95,8 @@ def _in_package(rest: str, folder: Path) -> Path | None:
 def resolve_uri(uri: str, relative_to: Path | None = None) -> Path:
     """Turn an asset URI into an absolute path on this machine (the file may not exist)."""
     if uri.startswith("package://"):
-        rest = uri[len("package://") :]
+        # "package:///pkg/..." (an empty host, as Talos' full URDFs write it) is "package://pkg/..."
+        rest = uri[len("package://") :].lstrip("/")
         shared = example_robot_data_share() / rest
         if shared.exists() or relative_to is None:
             return shared

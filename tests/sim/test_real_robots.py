@@ -34,6 +34,9 @@ PLANNING_CASES = {
     # a pelvis mesh whose convex hull qhull refuses to build as it is ("Too many neighbors")
     "centauro": (ERD / "centauro_description" / "urdf" / "centauro.urdf", "pelvis",
                  "arm1_8", ()),
+    # meshes named "package:///example-robot-data/..." (an empty host)
+    "talos": (ERD / "talos_data" / "robots" / "talos_full_v2.urdf", "torso_2_link",
+              "gripper_left_base_link", ()),
 }
 
 
@@ -80,7 +83,7 @@ def test_tiago_hand_casters_footprint_and_approach_axis(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize("robot", sorted(PLANNING_CASES))
-def test_robots_whose_urdfs_stopped_the_planning_section_get_one(robot: str,
+def test_real_robots_that_stopped_robot_init_get_a_descriptor_and_planning(robot: str,
                                                                  tmp_path: Path) -> None:
     urdf, base, tip, turning = PLANNING_CASES[robot]
     desc, allowed = add_planning_section(
