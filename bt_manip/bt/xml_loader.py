@@ -431,15 +431,6 @@ def _in_order(root: Element) -> Iterator[Element]:
         stack.extend(reversed(element.children))
 
 
-def _elements(root: Element) -> list[Element]:
-    out, stack = [], [root]
-    while stack:
-        element = stack.pop()
-        out.append(element)
-        stack.extend(element.children)
-    return out
-
-
 def allow_depth(levels: int) -> None:
     """Raise Python's recursion limit so that a tree ``levels`` deep can be ticked and walked.
 
@@ -616,7 +607,7 @@ class _Builder:
         order = [tree_id]
         stack = [tree_id]
         while stack:  # every tree reachable from tree_id (the checker refused cycles)
-            for element in _elements(doc.trees[stack.pop()].element):
+            for element in _in_order(doc.trees[stack.pop()].element):
                 target = element.get("ID") if element.tag == SUBTREE_ID else None
                 if target and target not in order:
                     order.append(target)

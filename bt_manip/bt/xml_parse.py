@@ -7,7 +7,7 @@ nesting depth and the number of elements, and records the line and column of eve
 BehaviorTree.CPP reads its files with tinyxml2, which takes what strict XML refuses and real
 trees contain: a raw ``<`` or ``&&`` in an attribute value (``if="A<2 && B>0"``), a ``&`` that
 starts no character reference, text before the first element (``// clang-format off``). A
-document that expat refuses is read again through :func:`_lenient`, which stands a placeholder
+document that expat refuses is read again through :func:`as_strict_xml`, which stands a placeholder
 character in for each of those ``<`` and ``&`` and blanks the text before the first element;
 every replacement keeps the length of what it replaces, so lines and columns stay those of the
 file, and the placeholders are turned back when attribute values and text are read.
@@ -101,17 +101,10 @@ def _blank(match: re.Match[str]) -> str:
 
 
 def as_strict_xml(text: str) -> str | None:
-    """``text`` with what BehaviorTree.CPP's parser takes and strict XML refuses stood in for
-    (the module docstring), or None when there is nothing to change; lines and columns are
-    those of ``text``."""
-    return _lenient(text)
-
-
-def _lenient(text: str) -> str | None:
     """``text`` as strict XML takes it, or None when there is nothing to change (see the
-    module docstring). Linear in the length of the text: no expression rescans what it
-    passed, and Python code runs only for each tag it changes (and each piece of the text
-    before the first element)."""
+    module docstring); lines and columns stay those of ``text``. Linear in the length of the
+    text: no expression rescans what it passed, and Python code runs only for each tag it
+    changes (and each piece of the text before the first element)."""
     if LT in text or AMP in text:
         return None
     out = _REFERENCE.sub("&", text.replace("&", AMP))  # the references are & again
@@ -128,7 +121,7 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
     """Parse XML text into :class:`Element` objects; raises :class:`XmlError`.
 
     A document that expat refuses is read again as BehaviorTree.CPP's parser reads it (see
-    :func:`_lenient`); if that fails too, the error is the second reading's."""
+    :func:`as_strict_xml`); if that fails too, the error is the second reading's."""
     data = text.encode("utf-8") if isinstance(text, str) else text
     if len(data) > MAX_BYTES:
         raise XmlError(Problem(file, None,
@@ -139,7 +132,7 @@ def parse_xml_text(text: str | bytes, file: str) -> Element:
         if not strict.problem.message.startswith("malformed XML"):
             raise
         try:
-            lenient = _lenient(data.decode("utf-8"))
+            lenient = as_strict_xml(data.decode("utf-8"))
         except UnicodeDecodeError:
             lenient = None
         if lenient is None:

@@ -21,6 +21,7 @@ import hashlib
 import math
 import os
 import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import cast
@@ -59,6 +60,20 @@ _REACH_MEMO: dict[bytes, float] = {}
 builds its arm models afresh, and the maximisation (16 quasi-Newton runs) costs more than
 the rest of the model; the value depends on the chain's numbers only."""
 _REACH_MEMO_SIZE = 64
+
+
+def write_configuration(out: np.ndarray, slots: Sequence[tuple[int, int]],
+                        q: np.ndarray) -> np.ndarray:
+    """Write one value a joint, ``q``, into Pinocchio's configuration vector ``out`` at each
+    joint's slot ``(idx_q, nq)``: a continuous joint (nq 2) as the (cos, sin) of its angle.
+    Returns ``out``."""
+    for (idx, nq), value in zip(slots, q, strict=True):
+        if nq == 1:
+            out[idx] = value
+        else:
+            out[idx] = math.cos(value)
+            out[idx + 1] = math.sin(value)
+    return out
 
 
 class ArmModel:
@@ -173,14 +188,7 @@ class ArmModel:
 
     # ------------------------------------------------------------------ kinematics
     def _to_pin(self, q: np.ndarray) -> np.ndarray:
-        qp = self._q_pin
-        for (idx, nq), value in zip(self._slots, q, strict=True):
-            if nq == 1:
-                qp[idx] = value
-            else:
-                qp[idx] = math.cos(value)
-                qp[idx + 1] = math.sin(value)
-        return qp
+        return write_configuration(self._q_pin, self._slots, q)
 
     def fk(self, q: np.ndarray) -> np.ndarray:
         """Pose of the tip link in the base link frame, as a 4x4 homogeneous matrix."""

@@ -41,6 +41,7 @@ import numpy as np
 import pinocchio as pin
 
 from bt_manip.cache import Memo, bytes_key
+from bt_manip.kinematics.arm_model import write_configuration
 from bt_manip.sim.compose import cache_dir, composed_urdf, file_stamp
 
 __all__ = [
@@ -328,14 +329,13 @@ class CollisionScene:
             raise SceneError("the planned joints must be one-axis joints listed in URDF order")
         # a continuous joint is stored as (cos, sin) in Pinocchio's configuration; the scene
         # takes its angle, within -pi .. pi as the arm's kinematics gives it
-        self._turning = [self.model.joints[i].idx_q for i in range(1, self.model.njoints)
-                         if self.model.joints[i].nq == 2]
-        slots = [self.model.joints[i].idx_q for i in range(1, self.model.njoints)]
-        self.lower = np.array([-math.pi if s in self._turning else
-                               float(self.model.lowerPositionLimit[s]) for s in slots])
-        self.upper = np.array([math.pi if s in self._turning else
-                               float(self.model.upperPositionLimit[s]) for s in slots])
-        self._angle_slot = slots
+        self._slots = [(self.model.joints[i].idx_q, self.model.joints[i].nq)
+                       for i in range(1, self.model.njoints)]
+        self._turning = any(nq == 2 for _, nq in self._slots)
+        self.lower = np.array([-math.pi if nq == 2 else float(self.model.lowerPositionLimit[s])
+                               for s, nq in self._slots])
+        self.upper = np.array([math.pi if nq == 2 else float(self.model.upperPositionLimit[s])
+                               for s, nq in self._slots])
         self._robot_geoms = self.geometry.ngeoms
         self.exact = exact
         """Whether the scene checks the meshes only (no hull pass)."""
@@ -562,13 +562,7 @@ class CollisionScene:
         joint): ``q`` itself unless a joint is continuous (its angle as (cos, sin))."""
         if not self._turning:
             return q
-        out = np.empty(self.model.nq)
-        for k, slot in enumerate(self._angle_slot):
-            if slot in self._turning:
-                out[slot], out[slot + 1] = math.cos(q[k]), math.sin(q[k])
-            else:
-                out[slot] = q[k]
-        return out
+        return write_configuration(np.empty(self.model.nq), self._slots, q)
 
     def _hit(self, q: np.ndarray) -> bool:
         """Whether ``q`` is in contact (the caller has made the data fresh)."""

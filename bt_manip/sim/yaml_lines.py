@@ -47,7 +47,12 @@ MAX_YAML_NODES = 100_000
 
 
 class _TooManyNodes(yaml.composer.ComposerError):
-    pass
+    """A value (at ``mark``) whose count, aliases expanded, passes :data:`MAX_YAML_NODES`."""
+
+    def __init__(self, mark: yaml.Mark) -> None:
+        super().__init__(
+            None, None, f"more than {MAX_YAML_NODES} values (the limit of a YAML input; each "
+            "use of an alias counts as a copy of what it names)", mark)
 
 
 _BaseLoader: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # libyaml when installed
@@ -76,10 +81,7 @@ def check_size(root: yaml.Node) -> None:
             opened.discard(key)
             size = 1 + sum(sizes[id(child)] for child in _children(node))
             if size > MAX_YAML_NODES:
-                raise _TooManyNodes(
-                    None, None,
-                    f"more than {MAX_YAML_NODES} values (the limit of a YAML input; each use "
-                    "of an alias counts as a copy of what it names)", node.start_mark)
+                raise _TooManyNodes(node.start_mark)
             sizes[key] = size
             continue
         if key in sizes:
@@ -118,10 +120,7 @@ def check_events(text: str) -> None:
         if isinstance(event, yaml.CollectionEndEvent):
             count, anchor, mark = open_.pop()
             if count > MAX_YAML_NODES:
-                raise _TooManyNodes(
-                    None, None,
-                    f"more than {MAX_YAML_NODES} values (the limit of a YAML input; each use "
-                    "of an alias counts as a copy of what it names)", mark)
+                raise _TooManyNodes(mark)
         elif isinstance(event, yaml.ScalarEvent):
             count, anchor = 1, event.anchor
         elif isinstance(event, yaml.AliasEvent):
